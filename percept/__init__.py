@@ -1,0 +1,1 @@
+"""percept: a camera-only driving stack on highway-env."""

@@ -1,0 +1,8 @@
+"""Shared vocabulary: cameras, the stereo rig, poses and sensor frames. Pure numpy/OpenCV."""
+
+from .camera import PinholeCamera
+from .frame import Frame, ImuSample
+from .poses import Pose2D, Transform, rot_z, wrap_angle
+from .rig import Side, StereoRig
+
+__all__ = ["Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform", "rot_z", "wrap_angle"]

@@ -1,0 +1,119 @@
+"""Stereo rig: two identical rectified pinhole cameras on a car.
+
+The rig is centred on the vehicle's x axis, ``mount_x_m`` ahead of the vehicle centre and
+``mount_height_m`` above the road; the left camera sits at y = +baseline/2, the right one at
+y = -baseline/2 (vehicle frame, y left). Both look forward, pitched down by ``pitch_rad``.
+Reference: Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., sec. 8.1 (homography of a plane).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+from pathlib import Path
+
+import numpy as np
+
+from .camera import PinholeCamera
+from .poses import Transform
+
+
+class Side(str, Enum):
+    LEFT = "left"
+    RIGHT = "right"
+
+
+def _default_camera() -> PinholeCamera:
+    return PinholeCamera.from_hfov(640, 480, math.radians(60.0))
+
+
+@dataclass(frozen=True)
+class StereoRig:
+    """camera: intrinsics shared by both cameras; baseline_m [m]; mount_height_m [m] above the road;
+    pitch_rad [rad], positive looks down; mount_x_m [m] ahead of the vehicle centre."""
+
+    camera: PinholeCamera = field(default_factory=_default_camera)
+    baseline_m: float = 0.54
+    mount_height_m: float = 1.4
+    pitch_rad: float = 0.0
+    mount_x_m: float = 0.8
+
+    def __post_init__(self) -> None:
+        if not self.baseline_m > 0:
+            raise ValueError(f"baseline_m must be positive, got {self.baseline_m}")
+        if not self.mount_height_m > 0:
+            raise ValueError(f"mount_height_m must be positive, got {self.mount_height_m}")
+        if not abs(self.pitch_rad) < 0.5:
+            raise ValueError(f"pitch_rad {self.pitch_rad} is outside (-0.5, 0.5)")
+
+    def camera_position(self, side: Side = Side.LEFT) -> np.ndarray:
+        """Optical centre in the vehicle frame (3,) [m]."""
+        y = self.baseline_m / 2 if Side(side) is Side.LEFT else -self.baseline_m / 2
+        return np.array([self.mount_x_m, y, self.mount_height_m])
+
+    def rotation_cam_from_vehicle(self) -> np.ndarray:
+        """3x3 rotation taking vehicle-frame directions (x fwd, y left, z up) to camera (x right, y down, z fwd)."""
+        # axes swap at zero pitch: x_c = -y_v, y_c = -z_v, z_c = x_v
+        r0 = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+        c, s = math.cos(self.pitch_rad), math.sin(self.pitch_rad)
+        # pitch down by theta = rotation about the camera x axis
+        rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+        return rx @ r0
+
+    def cam_from_vehicle(self, side: Side = Side.LEFT) -> Transform:
+        """Vehicle frame -> camera frame of ``side``: p_c = R (p_v - c)."""
+        R = self.rotation_cam_from_vehicle()
+        return Transform(R, -R @ self.camera_position(side))
+
+    def ground_homography(self, side: Side = Side.LEFT) -> np.ndarray:
+        """3x3 H taking ground points (x_v, y_v, 1) of the vehicle frame (z = 0) to pixels (u, v, 1)."""
+        T = self.cam_from_vehicle(side)
+        # (u, v, 1) ~ K [r1 r2 t] (x, y, 1) for points with z_v = 0
+        return self.camera.K @ np.column_stack([T.R[:, 0], T.R[:, 1], T.t])
+
+    def image_to_ground(self, uv: np.ndarray, side: Side = Side.LEFT) -> np.ndarray:
+        """Pixels (N, 2) -> vehicle-frame ground points (N, 2) [m]; rows above the horizon give garbage."""
+        Hinv = np.linalg.inv(self.ground_homography(side))
+        p = np.column_stack([np.asarray(uv, dtype=np.float64), np.ones(len(uv))]) @ Hinv.T
+        return p[:, :2] / p[:, 2:3]
+
+    def project_vehicle_points(self, points_v: np.ndarray, side: Side = Side.LEFT) -> tuple[np.ndarray, np.ndarray]:
+        """Vehicle-frame points (N, 3) -> pixels (N, 2) and camera depth z (N,) [m]."""
+        pc = self.cam_from_vehicle(side).apply(np.asarray(points_v, dtype=np.float64).reshape(-1, 3))
+        return self.camera.project(pc), pc[:, 2]
+
+    @property
+    def horizon_row(self) -> float:
+        """Image row of the horizon (points at infinity on the ground plane) [px]."""
+        # a direction (1, 0, 0) in the vehicle frame -> camera (0, -sin p, cos p)
+        return self.camera.cy - self.camera.fy * math.tan(self.pitch_rad)
+
+    def disparity_px(self, depth_m: np.ndarray | float) -> np.ndarray | float:
+        """Disparity of a point at camera depth z: d = f b / z [px]."""
+        return self.camera.fx * self.baseline_m / np.asarray(depth_m)
+
+    def to_dict(self) -> dict:
+        d = self.camera.to_dict()
+        d.update(baseline_m=self.baseline_m, mount_height_m=self.mount_height_m, pitch_rad=self.pitch_rad,
+                 mount_x_m=self.mount_x_m)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "StereoRig":
+        cam = PinholeCamera(float(d["fx"]), float(d["fy"]), float(d["cx"]), float(d["cy"]), int(d["width"]), int(d["height"]))
+        return cls(cam, float(d["baseline_m"]), float(d["mount_height_m"]), float(d.get("pitch_rad", 0.0)),
+                   float(d.get("mount_x_m", 0.8)))
+
+    def save(self, path: Path) -> None:
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2))
+
+    @classmethod
+    def load(cls, path: Path) -> "StereoRig":
+        try:
+            return cls.from_dict(json.loads(Path(path).read_text()))
+        except FileNotFoundError:
+            raise ValueError(f"camera file {path} does not exist") from None
+        except (KeyError, json.JSONDecodeError, TypeError) as e:
+            raise ValueError(f"camera file {path} is not a percept camera.json ({e})") from None

@@ -1,0 +1,105 @@
+"""Sampled road geometry in the world frame, built once per scenario from highway-env's lanes.
+
+The renderer never calls highway-env: it reads these arrays. Each lane of the network is sampled
+along its longitudinal coordinate with ``lane.position(s, lateral)`` (highway-env's own geometry),
+converted to the world frame once, here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from highway_env.road.lane import LineType
+
+from .coords import hw_to_world_xy
+
+SAMPLE_STEP_M = 1.0
+MARKING_WIDTH_M = 0.15
+DASH_LENGTH_M = 3.0
+"""US interstate broken line: 10 ft dash, 30 ft gap (MUTCD 3A.06)."""
+DASH_GAP_M = 9.0
+SOLID_PIECE_M = 2.0
+SHOULDER_M = 1.8
+
+WHITE, YELLOW = 0, 1
+
+
+@dataclass(frozen=True)
+class LaneStrip:
+    """One lane's paved surface: left and right edges (N, 2) in the world frame [m], including any shoulder."""
+
+    left: np.ndarray
+    right: np.ndarray
+
+
+@dataclass(frozen=True)
+class RoadGeometry:
+    """strips: paved surface per lane; marking_quads: (Q, 4, 2) world corners [m] of marking pieces;
+    marking_color: (Q,) WHITE or YELLOW; edges: list of (N, 2) outer road-edge polylines (for rails and props)
+    with the outward normal side (+1 left, -1 right of travel)."""
+
+    strips: list[LaneStrip]
+    marking_quads: np.ndarray
+    marking_color: np.ndarray
+    edges: list[tuple[np.ndarray, int]]
+
+
+def _sample(lane, s: np.ndarray, lateral_hw: float) -> np.ndarray:
+    """World positions (N, 2) of lane coordinates (s, lateral) with highway-env's own lane.position."""
+    pts = np.array([lane.position(float(si), lateral_hw) for si in s])
+    return hw_to_world_xy(pts)
+
+
+def _line_pieces(lane, lateral_hw: float, dashed: bool) -> np.ndarray:
+    """Quads (Q, 4, 2) covering one line of the lane, dashed or solid, world frame."""
+    L = float(lane.length)
+    if dashed:
+        period = DASH_LENGTH_M + DASH_GAP_M
+        starts = np.arange(0.0, L, period)
+        ends = np.minimum(starts + DASH_LENGTH_M, L)
+    else:
+        starts = np.arange(0.0, L, SOLID_PIECE_M)
+        ends = np.minimum(starts + SOLID_PIECE_M, L)
+    keep = ends - starts > 0.05
+    starts, ends = starts[keep], ends[keep]
+    hw = MARKING_WIDTH_M / 2
+    a0 = _sample(lane, starts, lateral_hw - hw)
+    a1 = _sample(lane, ends, lateral_hw - hw)
+    b1 = _sample(lane, ends, lateral_hw + hw)
+    b0 = _sample(lane, starts, lateral_hw + hw)
+    return np.stack([a0, a1, b1, b0], axis=1)
+
+
+def build_road_geometry(network) -> RoadGeometry:
+    """Sample every lane of a highway-env RoadNetwork."""
+    strips, quads, colors, edges = [], [], [], []
+    for _from, tos in network.graph.items():
+        for _to, lanes in tos.items():
+            for lane in lanes:
+                L = float(lane.length)
+                n = max(int(np.ceil(L / SAMPLE_STEP_M)), 1)
+                s = np.linspace(0.0, L, n + 1)
+                w = float(lane.width_at(0.0))
+                lt = list(lane.line_types)
+                # highway-env: line_types[0] is at lateral -w/2 (left of travel), [1] at +w/2 (right)
+                left_edge = lt[0] in (LineType.CONTINUOUS, LineType.CONTINUOUS_LINE)
+                right_edge = lt[1] in (LineType.CONTINUOUS, LineType.CONTINUOUS_LINE)
+                lat_l = -w / 2 - (SHOULDER_M if left_edge else 0.0)
+                lat_r = w / 2 + (SHOULDER_M if right_edge else 0.0)
+                strips.append(LaneStrip(_sample(lane, s, lat_l), _sample(lane, s, lat_r)))
+                for side, lat in ((0, -w / 2), (1, w / 2)):
+                    if lt[side] == LineType.NONE:
+                        continue
+                    q = _line_pieces(lane, lat, dashed=lt[side] == LineType.STRIPED)
+                    quads.append(q)
+                    # the left road edge is yellow (US convention), every other line white
+                    col = YELLOW if (side == 0 and left_edge) else WHITE
+                    colors.append(np.full(len(q), col, dtype=np.int8))
+                if left_edge:
+                    edges.append((_sample(lane, s, lat_l), +1))
+                if right_edge:
+                    edges.append((_sample(lane, s, lat_r), -1))
+    mq = np.concatenate(quads) if quads else np.zeros((0, 4, 2))
+    mc = np.concatenate(colors) if colors else np.zeros(0, dtype=np.int8)
+    return RoadGeometry(strips, mq, mc, edges)
