@@ -1,0 +1,102 @@
+"""Actors that highway-env does not have: walking pedestrians, mapped signs and scripted vehicles.
+
+All are highway-env road objects, so its collision handling and its IDM traffic see them.
+Positions and headings here are highway-env's (y to the right); sims/coords.py converts them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from highway_env.vehicle.behavior import IDMVehicle
+from highway_env.vehicle.objects import Landmark, RoadObject
+
+
+class Pedestrian(RoadObject):
+    """A person on foot: walks from its start along ``direction`` at ``walk_speed_mps`` once triggered.
+
+    trigger_x_m: the walk starts when the ego's highway-env x passes this value (None: walks from the
+    start, or never if ``walk_speed_mps`` is 0); walk_distance_m: it stops after this distance.
+    crossing: True for people who cross the road (the ego must stop for them), False for roadside ones.
+    """
+
+    LENGTH = 0.45
+    WIDTH = 0.6
+
+    def __init__(self, road, position, heading: float = 0.0, *, height_m: float = 1.75, style: int = 0,
+                 walk_speed_mps: float = 0.0, walk_distance_m: float = np.inf, trigger_x_m: float | None = None,
+                 crossing: bool = False):
+        super().__init__(road, position, heading, 0.0)
+        self.height_m = height_m
+        self.style = style
+        self.walk_speed_mps = walk_speed_mps
+        self.walk_distance_m = walk_distance_m
+        self.trigger_x_m = trigger_x_m
+        self.crossing = crossing
+        self.walked_m = 0.0
+        self.gait_phase = float(style % 7)
+        self.started = trigger_x_m is None and walk_speed_mps > 0
+        self.check_collisions = False  # vehicles check against it
+
+    def update(self, dt: float, ego_x_hw: float) -> None:
+        """Advance the walk by dt [s]."""
+        if not self.started and self.trigger_x_m is not None and ego_x_hw >= self.trigger_x_m:
+            self.started = True
+        if self.crashed or not self.started or self.walked_m >= self.walk_distance_m:
+            self.speed = 0.0
+            return
+        self.speed = self.walk_speed_mps
+        step = min(self.walk_speed_mps * dt, self.walk_distance_m - self.walked_m)
+        self.position = self.position + step * self.direction
+        self.walked_m += step
+        # gait: one stride (two steps) per ~1.4 m at normal speed: phase rate = 2 pi v / stride
+        stride_m = 0.8 * self.height_m
+        self.gait_phase = (self.gait_phase + 2 * np.pi * step / stride_m) % (2 * np.pi)
+
+
+class Sign(Landmark):
+    """A roadside landmark sign with a unique ArUco face; not solid (cars cannot hit it: it is off the road)."""
+
+    LENGTH = 0.1
+    WIDTH = 0.9
+
+    def __init__(self, road, position, heading: float, marker_id: int):
+        super().__init__(road, position, heading, 0.0)
+        self.marker_id = int(marker_id)
+        self.collidable = False
+
+
+class ScriptedVehicle(IDMVehicle):
+    """IDM traffic with one scripted event.
+
+    brake_at_s: from this time on it brakes at ``brake_mps2`` (< 0) to a standstill (``lead-brake``);
+    cut_in_lane: when its gap ahead of the ego in x is within ``cut_in_gap_m`` it changes to this lane index.
+    The scenario calls ``script(time_s, ego)`` every simulation step.
+    """
+
+    def __init__(self, *args, brake_at_s: float | None = None, brake_mps2: float = -6.0,
+                 cut_in_lane=None, cut_in_gap_m: float = 15.0, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.brake_at_s = brake_at_s
+        self.brake_mps2 = brake_mps2
+        self.cut_in_lane = cut_in_lane
+        self.cut_in_gap_m = cut_in_gap_m
+        self.braking = False
+        self.cut_in_done = False
+        self.enable_lane_change = False
+
+    def script(self, time_s: float, ego) -> None:
+        if self.brake_at_s is not None and time_s >= self.brake_at_s:
+            self.braking = True
+        if self.cut_in_lane is not None and not self.cut_in_done:
+            gap = self.position[0] - ego.position[0] - self.LENGTH
+            if gap <= self.cut_in_gap_m:
+                self.target_lane_index = self.cut_in_lane
+                self.cut_in_done = True
+
+    def act(self, action=None):
+        super().act(action)
+        if self.braking:
+            # brake at a constant deceleration to a standstill, never reversing
+            self.action["acceleration"] = self.brake_mps2 if self.speed > 0.05 else -self.speed * 15
+        if self.speed <= 0.05 and self.braking:
+            self.speed = 0.0

@@ -1,0 +1,111 @@
+"""Photometric conditions applied to rendered frames: night, rain, glare, sensor noise, dropped frames.
+
+Every effect draws from a generator seeded by (run seed, frame index, camera), so a run is reproducible.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+import cv2
+import numpy as np
+
+from percept.sensors import StereoRig
+
+
+class Condition(str, Enum):
+    CLEAR = "clear"
+    NIGHT = "night"
+    RAIN = "rain"
+    GLARE = "glare"
+    NOISE = "noise"
+    DROPOUT = "dropout"
+
+
+CONDITION_SUMMARY = {
+    Condition.CLEAR: "daylight, dry, clean sensor",
+    Condition.NIGHT: "dark sky, headlight beam on the road, glowing tail lights",
+    Condition.RAIN: "low contrast, spray haze, blur, rain streaks and drops on the windscreen",
+    Condition.GLARE: "low sun ahead: bloom, veiling glare and lens flare",
+    Condition.NOISE: "strong sensor noise (sigma 10 grey levels) and row banding",
+    Condition.DROPOUT: "10% of frames missing (the camera delivers nothing)",
+}
+
+DROPOUT_RATE = 0.10
+
+
+def frame_rng(seed: int, frame: int, camera: int) -> np.random.Generator:
+    return np.random.default_rng([seed, frame, camera, 0xC0FFEE])
+
+
+def is_dropped(condition: Condition, seed: int, frame: int) -> bool:
+    """Whether the camera delivers no frame at this step (dropout condition only)."""
+    return condition is Condition.DROPOUT and frame_rng(seed, frame, 9).random() < DROPOUT_RATE
+
+
+class ConditionEffects:
+    """Precomputed masks of one rig for applying a condition to each camera's image."""
+
+    def __init__(self, rig: StereoRig, condition: Condition):
+        self.condition = Condition(condition)
+        cam = rig.camera
+        H, W = cam.height, cam.width
+        hz = rig.horizon_row
+        v, u = np.mgrid[0:H, 0:W].astype(np.float32)
+        # headlight beam: ground points ahead within +-15 deg, brightest near, fading with distance
+        with np.errstate(divide="ignore"):
+            dist = np.where(v > hz + 0.5, rig.mount_height_m * cam.fy / np.maximum(v - hz, 1e-3), np.inf)
+        dist = np.minimum(dist, 1e4)
+        lateral = np.abs(u - cam.cx) / cam.fx * dist
+        beam = np.exp(-(np.maximum(lateral - 1.5, 0) / (0.3 * dist + 1.0)) ** 2) / (1.0 + (dist / 35.0) ** 2)
+        beam = np.where(dist < 1e4, beam, 0.0)
+        # objects standing in the beam are lit too: a blurred copy spreads the beam up from the ground rows
+        lit = cv2.GaussianBlur(beam.astype(np.float32), (0, 0), 25)
+        self.night_gain = (0.08 + 1.1 * np.maximum(beam, 0.7 * lit)).astype(np.float32)[..., None]
+        # glare: the sun low ahead, a little left of centre, above the horizon
+        self.sun_uv = (cam.cx - 0.25 * cam.cx, max(hz - 0.18 * H, 10))
+        r = np.hypot(u - self.sun_uv[0], v - self.sun_uv[1])
+        self.glare = (255 * (np.exp(-r / 40.0) + 0.35 * np.exp(-r / 220.0))).astype(np.float32)[..., None]
+        self.H, self.W = H, W
+
+    def apply(self, img: np.ndarray, seed: int, frame: int, camera: int) -> np.ndarray:
+        c = self.condition
+        if c in (Condition.CLEAR, Condition.DROPOUT):
+            return img
+        rng = frame_rng(seed, frame, camera)
+        f = img.astype(np.float32)
+        if c is Condition.NIGHT:
+            lights = (f[..., 2] > 180) & (f[..., 1] < 90) | (f.min(axis=2) > 215)
+            out = f * self.night_gain
+            glow = cv2.GaussianBlur(np.where(lights[..., None], f, 0), (0, 0), 3) * 1.5
+            out = np.where(lights[..., None], f, out) + glow
+            out += rng.normal(0, 3.0, out.shape[:2]).astype(np.float32)[..., None]
+        elif c is Condition.RAIN:
+            haze = np.array([150, 150, 145], np.float32)
+            out = 0.62 * cv2.GaussianBlur(f, (0, 0), 1.1) + 0.38 * haze
+            streaks = np.zeros((self.H, self.W), np.float32)
+            for _ in range(260):
+                x, y = rng.uniform(0, self.W), rng.uniform(0, self.H)
+                ln = rng.uniform(8, 25)
+                cv2.line(streaks, (int(x), int(y)), (int(x + 0.15 * ln), int(y + ln)), float(rng.uniform(20, 45)), 1,
+                         cv2.LINE_AA)
+            out += streaks[..., None]
+            drops = np.zeros((self.H, self.W), np.float32)
+            for _ in range(18):
+                cv2.circle(drops, (int(rng.uniform(0, self.W)), int(rng.uniform(0, self.H))), int(rng.uniform(4, 12)),
+                           1.0, -1, cv2.LINE_AA)
+            drops = cv2.GaussianBlur(drops, (0, 0), 2)[..., None]
+            out = out * (1 - 0.6 * drops) + 0.6 * drops * cv2.GaussianBlur(out, (0, 0), 6)
+        elif c is Condition.GLARE:
+            out = 0.8 * f + 0.2 * 235 + self.glare * 1.2
+            # lens flare: ghosts on the line through the sun and the image centre
+            su, sv = self.sun_uv
+            for k, rad in ((0.6, 18), (1.3, 30), (1.8, 12)):
+                gu, gv = self.W / 2 + (self.W / 2 - su) * k, self.H / 2 + (self.H / 2 - sv) * k
+                ghost = np.zeros((self.H, self.W), np.float32)
+                cv2.circle(ghost, (int(gu), int(gv)), rad, 45.0, -1, cv2.LINE_AA)
+                out += cv2.GaussianBlur(ghost, (0, 0), 4)[..., None]
+        else:  # NOISE
+            out = f + rng.normal(0, 10.0, f.shape).astype(np.float32)
+            out += rng.normal(0, 3.0, (self.H, 1, 1)).astype(np.float32)
+        return np.clip(out, 0, 255).astype(np.uint8)

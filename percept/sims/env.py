@@ -1,0 +1,88 @@
+"""PerceptEnv: a highway-env environment whose scene comes from a percept scenario.
+
+It keeps highway-env's own machinery (road, IDM traffic, the ego's kinematic bicycle model, collision
+handling, the continuous action) and adds what highway-env lacks: pedestrians that walk, scripted
+vehicles, and an optional autopilot ego for rendering data sets.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from highway_env.envs.common.abstract import AbstractEnv
+from highway_env.vehicle.behavior import IDMVehicle
+
+from .actors import Pedestrian, ScriptedVehicle
+
+ACCEL_RANGE_MPS2 = (-8.0, 4.0)
+"""Braking down to -8 m/s² (highway-env's default continuous range stops at -5)."""
+STEER_RANGE_RAD = (-0.5, 0.5)
+
+
+class PerceptEnv(AbstractEnv):
+    """Config keys beyond highway-env's: ``scenario`` (a Scenario), ``scenario_seed`` (int), ``autopilot`` (bool)."""
+
+    @classmethod
+    def default_config(cls) -> dict:
+        cfg = super().default_config()
+        cfg.update({
+            "observation": {"type": "Kinematics", "vehicles_count": 5},
+            "action": {"type": "ContinuousAction", "acceleration_range": ACCEL_RANGE_MPS2,
+                       "steering_range": STEER_RANGE_RAD, "clip": True},
+            "simulation_frequency": 15,
+            "policy_frequency": 15,
+            "screen_width": 640,
+            "screen_height": 480,
+            "scenario": None,
+            "scenario_seed": 0,
+            "autopilot": False,
+        })
+        return cfg
+
+    def _reset(self) -> None:
+        scenario = self.config["scenario"]
+        if scenario is None:
+            raise ValueError("PerceptEnv needs config['scenario']")
+        rng = np.random.default_rng(self.config["scenario_seed"])
+        # highway-env's own random draws (IDM behaviour) follow the scenario seed too
+        self.road = scenario.build(self, rng)
+        self.pedestrians = [o for o in self.road.objects if isinstance(o, Pedestrian)]
+        self.scripted = [v for v in self.road.vehicles if isinstance(v, ScriptedVehicle)]
+
+    def make_ego(self, lane_index, longitudinal: float, speed: float):
+        """The controlled vehicle: highway-env's kinematic Vehicle, or an IDM autopilot that keeps its lane."""
+        lane = self.road.network.get_lane(lane_index)
+        pos, heading = lane.position(longitudinal, 0.0), lane.heading_at(longitudinal)
+        if self.config["autopilot"]:
+            ego = IDMVehicle(self.road, pos, heading, speed, target_lane_index=lane_index, target_speed=speed,
+                             enable_lane_change=False)
+        else:
+            ego = self.action_type.vehicle_class(self.road, pos, heading, speed)
+        self.cruise_speed_mps = float(speed)
+        self.controlled_vehicles = [ego]
+        self.road.vehicles.insert(0, ego)
+        return ego
+
+    def _simulate(self, action=None) -> None:
+        frames = int(self.config["simulation_frequency"] // self.config["policy_frequency"])
+        dt = 1.0 / self.config["simulation_frequency"]
+        for _ in range(frames):
+            if action is not None and not self.config["autopilot"]:
+                self.action_type.act(action)
+            t = self.steps * dt
+            for v in self.scripted:
+                v.script(t, self.vehicle)
+            self.road.act()
+            self.road.step(dt)
+            for p in self.pedestrians:
+                p.update(dt, self.vehicle.position[0])
+            self.steps += 1
+        self.enable_auto_render = False
+
+    def _reward(self, action) -> float:
+        return 0.0
+
+    def _is_terminated(self) -> bool:
+        return False
+
+    def _is_truncated(self) -> bool:
+        return False

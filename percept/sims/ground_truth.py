@@ -1,0 +1,110 @@
+"""Per-frame ground truth that only the simulator knows: ego, lane geometry, objects, depth, IMU."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from percept.sensors import ImuSample, Pose2D, Side, StereoRig, wrap_angle
+
+from .coords import hw_to_world_yaw
+from .render.scene import ObjectState
+
+
+@dataclass(frozen=True)
+class LaneTruth:
+    """The ego lane in the vehicle frame: offset_m of the vehicle centre from the lane centre (+ left),
+    heading_rad of the vehicle relative to the lane (+ CCW), curvature_1pm of the lane (+ turning left), width_m."""
+
+    offset_m: float
+    heading_rad: float
+    curvature_1pm: float
+    width_m: float
+    lane_index: tuple
+
+
+@dataclass(frozen=True)
+class ObjectTruth:
+    """kind: vehicle | pedestrian | landmark; box_px: (u0, v0, u1, v1) in the left image or None when not seen;
+    visible: 0..1 unoccluded share of its silhouette; distance_m: left-camera depth of the nearest point of its
+    3D box; position_m: (3,) box centre in the vehicle frame; size_m: (length, width, height); yaw_rad: heading
+    relative to the ego; speed_mps; crossing: pedestrians that cross the road; marker_id: landmark sign id."""
+
+    obj_id: int
+    kind: str
+    box_px: tuple | None
+    visible: float
+    distance_m: float
+    position_m: tuple
+    size_m: tuple
+    yaw_rad: float
+    speed_mps: float
+    crossing: bool = False
+    marker_id: int | None = None
+
+    def to_dict(self) -> dict:
+        d = {"kind": self.kind, "id": self.obj_id, "box_px": list(self.box_px) if self.box_px else None,
+             "visible": round(self.visible, 4), "distance_m": round(self.distance_m, 4),
+             "position_m": [round(v, 4) for v in self.position_m], "size_m": list(self.size_m),
+             "yaw_rad": round(self.yaw_rad, 5), "speed_mps": round(self.speed_mps, 4)}
+        if self.kind == "pedestrian":
+            d["crossing"] = self.crossing
+        if self.marker_id is not None:
+            d["marker_id"] = self.marker_id
+        return d
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """time_s; ego pose (world), speed_mps, steering_rad, accel_mps2; lane; objects; depth_m: (H, W) float32
+    left-camera depth [m], inf for sky; imu: the true IMU values; crashed / pedestrian_hit flags."""
+
+    time_s: float
+    ego: Pose2D
+    speed_mps: float
+    lane: LaneTruth
+    objects: tuple[ObjectTruth, ...]
+    depth_m: np.ndarray
+    imu: ImuSample
+    crashed: bool
+    pedestrian_hit: bool
+
+    def to_dict(self) -> dict:
+        return {
+            "time_s": round(self.time_s, 4),
+            "ego": {"x": self.ego.x_m, "y": self.ego.y_m, "yaw": self.ego.yaw_rad, "speed": self.speed_mps},
+            "lane": {"offset_m": self.lane.offset_m, "heading_rad": self.lane.heading_rad,
+                     "curvature_1pm": self.lane.curvature_1pm, "width_m": self.lane.width_m},
+            "imu": {"accel_mps2": self.imu.accel_mps2.tolist(), "gyro_rps": self.imu.gyro_rps.tolist()},
+            "crashed": self.crashed,
+            "pedestrian_hit": self.pedestrian_hit,
+            "objects": [o.to_dict() for o in self.objects],
+        }
+
+
+def lane_truth(ego) -> LaneTruth:
+    """The ego's lane from highway-env's own lane geometry (local_coordinates, heading_at)."""
+    lane = ego.lane
+    s, lat_hw = lane.local_coordinates(ego.position)
+    ds = 1.0
+    # curvature = d(heading)/ds, world yaw = -heading_hw
+    k = -float(wrap_angle(lane.heading_at(s + ds) - lane.heading_at(s - ds))) / (2 * ds)
+    rel = float(wrap_angle(hw_to_world_yaw(ego.heading) - hw_to_world_yaw(lane.heading_at(s))))
+    return LaneTruth(-float(lat_hw), rel, k, float(lane.width_at(s)), tuple(ego.lane_index))
+
+
+def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visible: float, crossing: bool) -> ObjectTruth:
+    """Vehicle-frame position and camera distance of one object."""
+    c = ego.to_vehicle_xy(np.array([state.pose.x_m, state.pose.y_m]))
+    yaw = float(wrap_angle(state.pose.yaw_rad - ego.yaw_rad))
+    # nearest point of the 3D box: sample its corners and face centres in the left camera
+    cy, sy = np.cos(yaw), np.sin(yaw)
+    L, W, H = state.length_m, state.width_m, state.height_m
+    g = np.array([[a, b, h] for a in (-0.5, 0, 0.5) for b in (-0.5, 0, 0.5) for h in (0.0, 0.5, 1.0)])
+    local = g * np.array([L, W, H])
+    pts = np.column_stack([c[0] + cy * local[:, 0] - sy * local[:, 1], c[1] + sy * local[:, 0] + cy * local[:, 1],
+                           local[:, 2]])
+    z = rig.cam_from_vehicle(Side.LEFT).apply(pts)[:, 2]
+    return ObjectTruth(state.obj_id, state.kind.value, box_px, float(visible), float(z.min()),
+                       (float(c[0]), float(c[1]), H / 2), (L, W, H), yaw, state.speed_mps, crossing, state.marker_id)

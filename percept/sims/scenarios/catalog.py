@@ -1,0 +1,203 @@
+"""The scenarios: road, traffic, pedestrians and signs, each deterministic for a seed.
+
+Every builder works in highway-env's plane (y to the right) with highway-env's own classes and
+returns the Road; the ego is made by ``env.make_ego``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from highway_env.road.road import Road
+from highway_env.vehicle.behavior import IDMVehicle
+
+from ..actors import Pedestrian, ScriptedVehicle, Sign
+from .roads import loop_road, straight_road, winding_road
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """name: CLI name; summary: one line; duration_s: default run length [s]; ego_speed_mps: cruise set speed."""
+
+    name: str
+    summary: str
+    duration_s: float
+    build: Callable
+    ego_speed_mps: float = 25.0
+
+
+def _chain(net) -> list[str]:
+    """Node names of a chained network in driving order, starting at "0"."""
+    order, node = ["0"], "0"
+    while node in net.graph and len(order) <= len(net.graph) + 1:
+        node = next(iter(net.graph[node]))
+        if node == "0":
+            break
+        order.append(node)
+    return order
+
+
+def lane_at(net, lane_id: int, s: float):
+    """(lane_index, longitudinal) of distance s along the chain of segments, for lane ``lane_id``."""
+    nodes = _chain(net)
+    for a, b in zip(nodes, nodes[1:] + ["0"]):
+        if b not in net.graph.get(a, {}):
+            break
+        lane = net.graph[a][b][lane_id]
+        if s < lane.length:
+            return (a, b, lane_id), s
+        s -= lane.length
+    raise ValueError(f"position {s:.0f} m is past the end of the road")
+
+
+def _idm(road, idx, s, speed, cls=IDMVehicle, **kw):
+    lane = road.network.get_lane(idx)
+    v = cls(road, lane.position(s, 0.0), lane.heading_at(s), speed, target_lane_index=idx, target_speed=speed,
+            **kw)
+    v.enable_lane_change = False
+    road.vehicles.append(v)
+    return v
+
+
+def _traffic(road, rng, lanes: list[int], s0: float, s1: float, count: int, speeds: tuple[float, float],
+             keep_clear: list[tuple[int, float, float]]) -> None:
+    """``count`` IDM vehicles on ``lanes`` between s0 and s1, at least 25 m apart, outside the keep-clear zones."""
+    placed: list[tuple[int, float]] = [(ln, (a + b) / 2) for ln, a, b in keep_clear]
+    tries = 0
+    while count > 0 and tries < 500:
+        tries += 1
+        ln = int(rng.choice(lanes))
+        s = float(rng.uniform(s0, s1))
+        if any(ln == l2 and a - 8 <= s <= b + 8 for l2, a, b in keep_clear):
+            continue
+        if any(ln == l2 and abs(s - s2) < 25 for l2, s2 in placed):
+            continue
+        idx, ss = lane_at(road.network, ln, s)
+        _idm(road, idx, ss, float(rng.uniform(*speeds)))
+        placed.append((ln, s))
+        count -= 1
+
+
+def _new_road(env, net) -> Road:
+    return Road(network=net, np_random=env.np_random, record_history=False)
+
+
+def build_highway(env, rng) -> Road:
+    road = _new_road(env, straight_road(4, 3000.0))
+    env.road = road
+    ego_lane = int(rng.integers(1, 3))
+    env.make_ego(("0", "1", ego_lane), 60.0, 25.0)
+    lead_s = 60.0 + float(rng.uniform(40.0, 60.0))
+    _idm(road, ("0", "1", ego_lane), lead_s, float(rng.uniform(25.0, 27.0)))
+    _traffic(road, rng, [0, 1, 2, 3], 0.0, 700.0, 14, (25.0, 30.0), [(ego_lane, 30.0, lead_s + 40.0)])
+    return road
+
+
+def build_curves(env, rng) -> Road:
+    road = _new_road(env, winding_road(rng, lanes=3))
+    env.road = road
+    env.make_ego(("0", "1", 1), 40.0, 20.0)
+    idx, s = lane_at(road.network, 1, 95.0)
+    _idm(road, idx, s, 20.0)
+    _traffic(road, rng, [0, 1, 2], 0.0, 800.0, 10, (18.0, 22.0), [(1, 10.0, 140.0)])
+    return road
+
+
+def build_lead_brake(env, rng) -> Road:
+    road = _new_road(env, straight_road(3, 2000.0))
+    env.road = road
+    env.make_ego(("0", "1", 1), 60.0, 25.0)
+    _idm(road, ("0", "1", 1), 60.0 + float(rng.uniform(40.0, 50.0)), 25.0, cls=ScriptedVehicle,
+         brake_at_s=float(rng.uniform(4.0, 6.0)), brake_mps2=-6.0)
+    _traffic(road, rng, [0, 2], 0.0, 500.0, 8, (24.0, 28.0), [])
+    return road
+
+
+def build_cut_in(env, rng) -> Road:
+    road = _new_road(env, straight_road(3, 2000.0))
+    env.road = road
+    env.make_ego(("0", "1", 1), 60.0, 25.0)
+    side = int(rng.choice([0, 2]))
+    _idm(road, ("0", "1", side), 60.0 + float(rng.uniform(35.0, 50.0)), 21.0, cls=ScriptedVehicle,
+         cut_in_lane=("0", "1", 1), cut_in_gap_m=float(rng.uniform(12.0, 20.0)))
+    _idm(road, ("0", "1", 1), 60.0 + 150.0, 24.0)
+    _traffic(road, rng, [2 - side], 0.0, 500.0, 5, (24.0, 28.0), [])
+    return road
+
+
+CROSSING_LANE_W = 3.5
+
+
+def build_crossing(env, rng) -> Road:
+    """Two-lane road; people cross the ego lane at ~5 km/h (Euro NCAP CPNA-like), others stay on the verge."""
+    road = _new_road(env, straight_road(2, 1500.0, width_m=CROSSING_LANE_W, speed_limit=17.0))
+    env.road = road
+    speed = float(rng.uniform(20.0, 60.0)) / 3.6
+    ego_y = CROSSING_LANE_W  # lane 1 centre
+    env.make_ego(("0", "1", 1), 20.0, speed)
+    left_kerb, right_kerb = -CROSSING_LANE_W / 2 - 2.6, ego_y + CROSSING_LANE_W / 2 + 2.6
+    x = 20.0
+    for k in range(3):
+        x += float(rng.uniform(110.0, 160.0))
+        from_left = bool((k + int(rng.integers(2))) % 2)
+        y0, heading = (left_kerb, np.pi / 2) if from_left else (right_kerb, -np.pi / 2)
+        walk = 1.39  # 5 km/h
+        # trigger so that, without braking, the person reaches the ego's path as the ego arrives
+        reach_m = (ego_y - 1.0 - y0) if from_left else (y0 - ego_y - 1.0)
+        trigger = x - speed * reach_m / walk - 2.0
+        road.objects.append(Pedestrian(road, [x, y0], heading, height_m=float(rng.uniform(1.55, 1.9)),
+                                       style=int(rng.integers(1 << 30)), walk_speed_mps=walk,
+                                       walk_distance_m=right_kerb - left_kerb, trigger_x_m=trigger, crossing=True))
+    for k in range(4):
+        px = float(rng.uniform(60.0, 600.0))
+        y0 = left_kerb - 0.6 if rng.random() < 0.5 else right_kerb + 0.6
+        walking = rng.random() < 0.6
+        heading = 0.0 if rng.random() < 0.5 else np.pi
+        road.objects.append(Pedestrian(road, [px, y0], heading, height_m=float(rng.uniform(1.5, 1.95)),
+                                       style=int(rng.integers(1 << 30)), walk_speed_mps=1.2 if walking else 0.0,
+                                       crossing=False))
+    return road
+
+
+LANDMARK_SPACING_M = 80.0
+SIGN_OFFSET_M = 4.0
+
+
+def build_loop(env, rng) -> Road:
+    """A ~3.6 km circuit with ArUco signs at surveyed positions every 80 m, alternating sides."""
+    net = loop_road()
+    road = _new_road(env, net)
+    env.road = road
+    env.make_ego(("0", "1", 1), 30.0, 22.0)
+    _traffic(road, rng, [0, 1], 0.0, 3000.0, 12, (20.0, 24.0), [(1, 0.0, 120.0)])
+    nodes = _chain(net)
+    total = sum(net.graph[a][b][0].length for a, b in zip(nodes, nodes[1:] + ["0"]))
+    n = int(total // LANDMARK_SPACING_M)
+    for k in range(n):
+        s = k * LANDMARK_SPACING_M + 20.0
+        outer_lane = 0 if k % 2 == 0 else 1
+        idx, ss = lane_at(net, outer_lane, s)
+        lane = net.get_lane(idx)
+        # outside the paved edge: half a lane, the shoulder, then the offset (lateral < 0 is left in highway-env)
+        lat = (-1 if outer_lane == 0 else 1) * (lane.width / 2 + 1.8 + SIGN_OFFSET_M)
+        pos = lane.position(ss, lat)
+        # the face looks back down the road, turned 15 degrees towards the carriageway
+        heading = lane.heading_at(ss) + np.pi + (-1 if outer_lane == 0 else 1) * np.radians(15)
+        road.objects.append(Sign(road, pos, heading, marker_id=k))
+    return road
+
+
+SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
+    Scenario("highway", "4-lane straight highway, IDM traffic at 25-30 m/s, a lead vehicle in the ego lane", 40.0,
+             build_highway, 25.0),
+    Scenario("curves", "3-lane winding road of arcs with radii 150-600 m in both directions, traffic", 60.0,
+             build_curves, 20.0),
+    Scenario("lead-brake", "the lead brakes at -6 m/s^2 from 25 m/s to a stop", 20.0, build_lead_brake, 25.0),
+    Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead", 20.0, build_cut_in, 25.0),
+    Scenario("crossing", "pedestrians cross the ego lane at 5 km/h from both sides, others stay on the verge; "
+             "ego at 20-60 km/h", 40.0, build_crossing, 12.0),
+    Scenario("loop", "a 3.6 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,
+             22.0),
+]}

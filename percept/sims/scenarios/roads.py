@@ -1,0 +1,103 @@
+"""Road networks built from highway-env's own lane classes (StraightLane, CircularLane).
+
+All coordinates here are highway-env's (x along travel, y to the right). Lane 0 is the leftmost;
+its left line is the solid road edge, the rightmost lane's right line too, lines between lanes dashed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from highway_env.road.lane import CircularLane, LineType, StraightLane
+from highway_env.road.road import RoadNetwork
+
+C, S, N = LineType.CONTINUOUS_LINE, LineType.STRIPED, LineType.NONE
+
+
+def line_types(i: int, lanes: int) -> list:
+    return [C if i == 0 else S, C if i == lanes - 1 else N]
+
+
+class _Builder:
+    """Chains straight and arc segments of a multi-lane road, tracking the reference (leftmost lane) pose."""
+
+    def __init__(self, lanes: int, width_m: float, speed_limit: float):
+        self.net = RoadNetwork()
+        self.lanes, self.w, self.v = lanes, width_m, speed_limit
+        self.pos = np.zeros(2)  # centre of lane 0 at the current node
+        self.heading = 0.0
+        self.k = 0
+
+    def _node(self) -> str:
+        return str(self.k)
+
+    def straight(self, length_m: float, end_node: str | None = None) -> None:
+        a, b = self._node(), end_node or str(self.k + 1)
+        d = np.array([np.cos(self.heading), np.sin(self.heading)])
+        right = np.array([-d[1], d[0]])  # highway-env: +90 deg from heading is to the right
+        for i in range(self.lanes):
+            p0 = self.pos + i * self.w * right
+            self.net.add_lane(a, b, StraightLane(p0, p0 + length_m * d, width=self.w,
+                                                 line_types=line_types(i, self.lanes), speed_limit=self.v))
+        self.pos = self.pos + length_m * d
+        self.k += 1
+
+    def arc(self, radius_m: float, angle_rad: float, end_node: str | None = None) -> None:
+        """Arc of the reference lane; angle > 0 turns right (clockwise in highway-env's y-down plane)."""
+        a, b = self._node(), end_node or str(self.k + 1)
+        cw = angle_rad > 0
+        d = np.array([np.cos(self.heading), np.sin(self.heading)])
+        right = np.array([-d[1], d[0]])
+        centre = self.pos + (radius_m if cw else -radius_m) * right
+        phi0 = np.arctan2(*(self.pos - centre)[::-1])
+        phi1 = phi0 + angle_rad
+        for i in range(self.lanes):
+            # lanes further right are inside a right turn (smaller radius) and outside a left turn
+            r = radius_m - i * self.w if cw else radius_m + i * self.w
+            self.net.add_lane(a, b, CircularLane(centre, r, phi0, phi1, clockwise=cw, width=self.w,
+                                                 line_types=line_types(i, self.lanes), speed_limit=self.v))
+        self.pos = centre + radius_m * np.array([np.cos(phi1), np.sin(phi1)])
+        self.heading += angle_rad
+        self.k += 1
+
+
+def straight_road(lanes: int, length_m: float, width_m: float = 4.0, speed_limit: float = 30.0) -> RoadNetwork:
+    """A straight multi-lane road from node "0" to "1"."""
+    b = _Builder(lanes, width_m, speed_limit)
+    b.straight(length_m)
+    return b.net
+
+
+def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 4000.0, width_m: float = 4.0,
+                 speed_limit: float = 25.0) -> RoadNetwork:
+    """Straight lead-in, then arcs of radius 150–600 m turning alternately left and right."""
+    b = _Builder(lanes, width_m, speed_limit)
+    b.straight(150.0)
+    total, sign = 150.0, float(rng.choice([-1.0, 1.0]))
+    while total < length_m:
+        r = float(rng.uniform(150.0, 600.0))
+        arc_len = float(rng.uniform(120.0, 280.0))
+        # keep the reference radius >= 150 m for every lane
+        r = max(r, 150.0 + (lanes - 1) * width_m) if sign > 0 else r
+        b.arc(r, sign * arc_len / r)
+        total += arc_len
+        if rng.random() < 0.5:
+            b.straight(float(rng.uniform(40.0, 120.0)))
+            total += 60.0
+        sign = -sign
+    b.straight(300.0)
+    return b.net
+
+
+def loop_road(lanes: int = 2, straight_m: float = 1000.0, radius_m: float = 260.0, width_m: float = 4.0,
+              speed_limit: float = 25.0) -> RoadNetwork:
+    """A closed circuit: two straights joined by two half circles turning right (clockwise); ~3.6 km."""
+    b = _Builder(lanes, width_m, speed_limit)
+    b.straight(straight_m)
+    b.arc(radius_m, np.pi)
+    b.straight(straight_m)
+    b.arc(radius_m, np.pi, end_node="0")
+    return b.net
+
+
+def loop_length_m(straight_m: float = 1000.0, radius_m: float = 260.0) -> float:
+    return 2 * straight_m + 2 * np.pi * radius_m

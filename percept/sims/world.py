@@ -1,0 +1,140 @@
+"""SimWorld: one scenario run — highway-env stepping, stereo rendering, IMU, conditions, ground truth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from percept.sensors import Frame, StereoRig
+
+from .actors import Pedestrian, Sign
+from .conditions import Condition, ConditionEffects, is_dropped
+from .coords import hw_to_world_xy
+from .env import PerceptEnv
+from .ground_truth import GroundTruth, lane_truth, object_truth
+from .imu import ImuModel
+from .render import StereoRenderer
+from .road_geometry import build_road_geometry
+from .scenarios import SCENARIOS
+from .snapshot import ObjectIds, scene_from_road
+
+TRUTH_RANGE_M = 200.0
+
+
+def check_scenario(name: str) -> None:
+    if name not in SCENARIOS:
+        raise ValueError(f"unknown scenario '{name}'; choose one of: {', '.join(SCENARIOS)}")
+
+
+def check_condition(name: str) -> Condition:
+    try:
+        return Condition(name)
+    except ValueError:
+        raise ValueError(f"unknown condition '{name}'; choose one of: {', '.join(c.value for c in Condition)}") from None
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """scenario: a name from SCENARIOS; seed; condition; rig; autopilot: highway-env's IDM drives the ego
+    (for rendering data sets) instead of the actions passed to ``step``; scenery: roadside clutter on/off."""
+
+    scenario: str = "highway"
+    seed: int = 0
+    condition: Condition = Condition.CLEAR
+    rig: StereoRig = field(default_factory=StereoRig)
+    autopilot: bool = False
+    scenery: bool = True
+
+    def __post_init__(self) -> None:
+        check_scenario(self.scenario)
+        object.__setattr__(self, "condition", check_condition(self.condition))
+        if self.seed < 0:
+            raise ValueError(f"seed must be >= 0, got {self.seed}")
+
+
+class SimWorld:
+    """Step with physical actions, observe a Frame (what the car senses) and GroundTruth (what only we know)."""
+
+    def __init__(self, cfg: WorldConfig):
+        self.cfg = cfg
+        self.scenario = SCENARIOS[cfg.scenario]
+        self.env = PerceptEnv(config={"scenario": self.scenario, "scenario_seed": cfg.seed,
+                                      "autopilot": cfg.autopilot})
+        self.env.reset(seed=cfg.seed)
+        self.dt = 1.0 / self.env.config["simulation_frequency"]
+        self.road_geometry = build_road_geometry(self.env.road.network)
+        self.renderer = StereoRenderer(cfg.rig, self.road_geometry, seed=cfg.seed, scenery=cfg.scenery)
+        self.effects = ConditionEffects(cfg.rig, cfg.condition)
+        self.imu = ImuModel(cfg.seed)
+        self.ids = ObjectIds()
+        self.frame_index = 0
+        self.last_action = np.zeros(2)
+        acc = self.env.action_type.acceleration_range
+        steer = self.env.action_type.steering_range
+        self.accel_range_mps2 = (float(acc[0]), float(acc[1]))
+        self.steer_range_rad = (float(steer[0]), float(steer[1]))
+
+    @property
+    def ego(self):
+        return self.env.vehicle
+
+    @property
+    def time_s(self) -> float:
+        return self.frame_index * self.dt
+
+    @property
+    def cruise_speed_mps(self) -> float:
+        return self.env.cruise_speed_mps
+
+    def step(self, accel_mps2: float = 0.0, steering_rad: float = 0.0) -> None:
+        """Advance one frame (1/15 s) with a physical command; it is clipped to the allowed ranges."""
+        a = float(np.clip(accel_mps2, *self.accel_range_mps2))
+        d = float(np.clip(steering_rad, *self.steer_range_rad))
+        self.last_action = np.array([a, d])
+        lo, hi = self.accel_range_mps2
+        slo, shi = self.steer_range_rad
+        # highway-env maps [-1, 1] linearly onto each range: x_n = 2 (x - lo) / (hi - lo) - 1
+        act = np.array([2 * (a - lo) / (hi - lo) - 1, 2 * (d - slo) / (shi - slo) - 1], dtype=np.float32)
+        self.env.step(act)
+        self.frame_index += 1
+
+    def observe(self, render: bool = True) -> tuple[Frame, GroundTruth]:
+        """The sensors' frame and the ground truth at the current step."""
+        ego = self.ego
+        scene = scene_from_road(self.env.road, ego, self.ids)
+        rig = self.cfg.rig
+        truth_imu = self.imu.true_sample(scene.ego.yaw_rad, float(ego.speed), self.dt if self.frame_index else 0.0)
+        imu, wheel = self.imu.measure(truth_imu, float(ego.speed), self.dt)
+        dropped = is_dropped(self.cfg.condition, self.cfg.seed, self.frame_index)
+        if render:
+            img = self.renderer.render(scene)
+            left = self.effects.apply(img.left, self.cfg.seed, self.frame_index, 0)
+            right = self.effects.apply(img.right, self.cfg.seed, self.frame_index, 1)
+            depth, boxes, visible = img.depth_m, img.boxes_px, img.visible
+        else:
+            left = right = None
+            depth = np.full((rig.camera.height, rig.camera.width), np.nan, np.float32)
+            boxes, visible = {}, {}
+        objects = []
+        for st in scene.objects:
+            dx, dy = st.pose.x_m - scene.ego.x_m, st.pose.y_m - scene.ego.y_m
+            if dx * dx + dy * dy > TRUTH_RANGE_M ** 2:
+                continue
+            src = self.ids.objects[st.obj_id]
+            crossing = bool(getattr(src, "crossing", False))
+            objects.append(object_truth(st, scene.ego, rig, boxes.get(st.obj_id), visible.get(st.obj_id, 0.0), crossing))
+        ped_hit = any((p.crashed or p.hit) for p in self.env.road.objects if isinstance(p, Pedestrian))
+        gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
+                         bool(ego.crashed), ped_hit)
+        frame = Frame(self.frame_index, self.time_s, None if dropped else left, None if dropped else right, imu, wheel)
+        return frame, gt
+
+    def landmark_map(self) -> dict[int, list[float]]:
+        """Surveyed landmark signs: marker id -> [x, y, z] of the panel centre in the world frame [m]."""
+        out = {}
+        for o in self.env.road.objects:
+            if isinstance(o, Sign):
+                x, y = hw_to_world_xy(o.position)
+                out[o.marker_id] = [float(x), float(y), 2.05]
+        return out
