@@ -75,7 +75,7 @@ class ConditionEffects:
         rng = frame_rng(seed, frame, camera)
         f = img.astype(np.float32)
         if c is Condition.NIGHT:
-            lights = (f[..., 2] > 180) & (f[..., 1] < 90) | (f.min(axis=2) > 215)
+            lights = (f[..., 2] > 180) & (f[..., 1] < 90)  # tail lights glow; the rest is lit by the beam
             out = f * self.night_gain
             glow = cv2.GaussianBlur(np.where(lights[..., None], f, 0), (0, 0), 3) * 1.5
             out = np.where(lights[..., None], f, out) + glow

@@ -1,0 +1,72 @@
+"""Analytic checks of the camera and rig models."""
+
+import math
+
+import numpy as np
+import pytest
+
+from percept.sensors import PinholeCamera, Pose2D, Side, StereoRig
+
+
+def test_default_camera_matches_the_design():
+    rig = StereoRig()
+    assert (rig.camera.width, rig.camera.height) == (640, 480)
+    assert math.degrees(rig.camera.hfov_rad) == pytest.approx(60.0)
+    assert rig.baseline_m == 0.54 and rig.mount_height_m == 1.4
+
+
+def test_projection_and_ground_homography_agree():
+    rig = StereoRig(pitch_rad=0.03)
+    pts = np.array([[10.0, 1.0, 0.0], [25.0, -3.0, 0.0], [60.0, 0.5, 0.0]])
+    for side in Side:
+        uv, z = rig.project_vehicle_points(pts, side)
+        assert np.all(z > 0)
+        back = rig.image_to_ground(uv, side)
+        np.testing.assert_allclose(back, pts[:, :2], atol=1e-9)
+
+
+def test_stereo_disparity_is_f_b_over_z():
+    rig = StereoRig()
+    p = np.array([[30.0, 0.0, 1.0]])
+    ul, zl = rig.project_vehicle_points(p, Side.LEFT)
+    ur, _ = rig.project_vehicle_points(p, Side.RIGHT)
+    assert ul[0, 0] - ur[0, 0] == pytest.approx(rig.disparity_px(zl[0]))
+    assert ul[0, 1] == pytest.approx(ur[0, 1])
+
+
+def test_horizon_row_follows_pitch():
+    rig = StereoRig(pitch_rad=0.05)
+    uv, _ = rig.project_vehicle_points(np.array([[1e6, 0.27, 1.4]]), Side.LEFT)
+    assert uv[0, 1] == pytest.approx(rig.horizon_row, abs=1e-3)
+    assert rig.horizon_row < rig.camera.cy
+
+
+def test_pose_round_trip():
+    pose = Pose2D(5.0, -2.0, 0.7)
+    p = np.array([[12.0, 3.0]])
+    v = pose.to_vehicle_xy(p)
+    w = pose.world_from_vehicle().apply(np.array([[v[0, 0], v[0, 1], 0.0]]))
+    np.testing.assert_allclose(w[0, :2], p[0], atol=1e-12)
+
+
+def test_rig_save_load_round_trip(tmp_path):
+    rig = StereoRig(baseline_m=0.3, pitch_rad=0.02)
+    rig.save(tmp_path / "camera.json")
+    assert StereoRig.load(tmp_path / "camera.json") == rig
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"baseline_m": 0.0}, "baseline_m must be positive"),
+    ({"mount_height_m": -1.0}, "mount_height_m must be positive"),
+    ({"pitch_rad": 1.0}, "pitch_rad"),
+])
+def test_bad_rig_values_are_rejected(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        StereoRig(**kwargs)
+
+
+def test_bad_camera_values_are_rejected(tmp_path):
+    with pytest.raises(ValueError, match="focal lengths must be positive"):
+        PinholeCamera(0.0, 1.0, 1.0, 1.0, 64, 64)
+    with pytest.raises(ValueError, match="does not exist"):
+        StereoRig.load(tmp_path / "missing.json")
