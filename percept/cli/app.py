@@ -95,6 +95,81 @@ def render(
 
 
 @app.command()
+def drive(
+    scenario: str = typer.Option("highway", help="Scenario name (see `percept scenarios`)."),
+    seed: int = typer.Option(0, help="Random seed; the same seed and options give the same metrics."),
+    condition: str = typer.Option("clear", help="clear | night | rain | glare | noise | dropout."),
+    duration: Optional[float] = typer.Option(None, help="Simulated seconds (default: the scenario's own)."),
+    lateral: str = typer.Option("privileged", help="Lateral slot: vision | privileged."),
+    longitudinal: str = typer.Option("privileged", help="Longitudinal slot: vision | privileged."),
+    pedestrians: str = typer.Option("privileged", help="Pedestrian slot: vision | privileged."),
+    odometry: str = typer.Option("privileged", help="Odometry slot: vision | privileged."),
+    record: Optional[Path] = typer.Option(None, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd)."),
+    no_record: bool = typer.Option(False, "--no-record", help="Do not write a Rerun recording."),
+    json_path: Optional[Path] = typer.Option(None, "--json", help="Write the run metrics to this JSON file."),
+):
+    """Drive a scenario in closed loop from the cameras, score it against ground truth and record it to Rerun."""
+    from percept.drive import DriveConfig, run_drive
+    from percept.review import RunRecorder
+    from percept.sims import WorldConfig
+
+    try:
+        cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration, lateral,
+                          longitudinal, pedestrians, odometry)
+    except ValueError as e:
+        fail(str(e))
+    rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
+    for p in (rec_path, json_path):
+        if p is not None:
+            try:
+                Path(p).parent.mkdir(parents=True, exist_ok=True)
+                probe = Path(p).with_name(Path(p).name + ".probe")
+                probe.write_text("")
+                probe.unlink()
+            except OSError as e:
+                fail(f"cannot write {p}: {e.strerror or e}")
+    recorder_box = {}
+
+    def make_recorder(world):
+        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
+        recorder_box["r"] = RunRecorder(rec_path, world.cfg.rig, lines)
+        return recorder_box["r"]
+
+    with progress_bar() as bar:
+        task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)
+        try:
+            result = run_drive(cfg, recorder_factory=make_recorder if rec_path else None,
+                               progress=lambda i, n: bar.update(task, completed=i, total=n))
+        finally:
+            if "r" in recorder_box:
+                recorder_box["r"].close()
+    write_json(json_path, result)
+    t = Table(title=f"{scenario} / {result['condition']} / seed {seed}: {result['frames']} frames, "
+                    f"{result['duration_s']:.1f} s, realtime x{result['realtime_factor']:.2f}")
+    t.add_column("metric")
+    t.add_column("value", justify="right")
+    rows = [("collisions", result["collisions"]), ("pedestrian collisions", result["pedestrian_collisions"]),
+            ("lane departures", result["lane_departures"]),
+            ("centering RMS / max [m]", f"{result['lane']['centering_rms_m']:.3f} / {result['lane']['centering_max_m']:.3f}"),
+            ("time gap mean / min [s]", _pair(result["longitudinal"]["time_gap_mean_s"], result["longitudinal"]["time_gap_min_s"])),
+            ("pedestrian stops", str(result["pedestrians"]["stops"])),
+            ("render [ms/frame]", _num(result["timing_ms"]["render"]))]
+    for k, v in rows:
+        t.add_row(k, str(v))
+    console.print(t)
+    if rec_path:
+        console.print(f"recording: {rec_path}  (open it with `rerun {rec_path}`)")
+
+
+def _num(x) -> str:
+    return "n/a" if x is None else f"{x:.2f}"
+
+
+def _pair(a, b) -> str:
+    return f"{_num(a)} / {_num(b)}"
+
+
+@app.command()
 def bench(
     json_path: Optional[Path] = typer.Option(None, "--json", help="Also write the figures to this JSON file."),
     frames: int = typer.Option(30, help="Timed calls per stage (median is reported)."),

@@ -88,14 +88,21 @@ class SimWorld:
         return self.env.cruise_speed_mps
 
     def step(self, accel_mps2: float = 0.0, steering_rad: float = 0.0) -> None:
-        """Advance one frame (1/15 s) with a physical command; it is clipped to the allowed ranges."""
+        """Advance one frame (1/15 s) with a physical command, clipped to the allowed ranges.
+
+        steering_rad is ISO 8855 (positive turns left); highway-env's positive steering turns towards its +y,
+        which is to the right, so it is negated here.
+        """
         a = float(np.clip(accel_mps2, *self.accel_range_mps2))
+        # brakes stop the car, they do not drive it backwards
+        a = max(a, -float(self.ego.speed) / self.dt)
         d = float(np.clip(steering_rad, *self.steer_range_rad))
         self.last_action = np.array([a, d])
         lo, hi = self.accel_range_mps2
         slo, shi = self.steer_range_rad
         # highway-env maps [-1, 1] linearly onto each range: x_n = 2 (x - lo) / (hi - lo) - 1
-        act = np.array([2 * (a - lo) / (hi - lo) - 1, 2 * (d - slo) / (shi - slo) - 1], dtype=np.float32)
+        d_hw = -d
+        act = np.array([2 * (a - lo) / (hi - lo) - 1, 2 * (d_hw - slo) / (shi - slo) - 1], dtype=np.float32)
         self.env.step(act)
         self.frame_index += 1
 

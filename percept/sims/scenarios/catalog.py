@@ -89,6 +89,7 @@ def build_highway(env, rng) -> Road:
     env.road = road
     ego_lane = int(rng.integers(1, 3))
     env.make_ego(("0", "1", ego_lane), 60.0, 25.0)
+    env.cruise_speed_mps = 30.0  # faster than the lead, so the ego settles into following it
     lead_s = 60.0 + float(rng.uniform(40.0, 60.0))
     _idm(road, ("0", "1", ego_lane), lead_s, float(rng.uniform(25.0, 27.0)))
     _traffic(road, rng, [0, 1, 2, 3], 0.0, 700.0, 14, (25.0, 30.0), [(ego_lane, 30.0, lead_s + 40.0)])
@@ -139,9 +140,10 @@ def build_crossing(env, rng) -> Road:
     env.make_ego(("0", "1", 1), 20.0, speed)
     left_kerb, right_kerb = -CROSSING_LANE_W / 2 - 2.6, ego_y + CROSSING_LANE_W / 2 + 2.6
     x = 20.0
+    first_side = int(rng.integers(2))
     for k in range(3):
         x += float(rng.uniform(110.0, 160.0))
-        from_left = bool((k + int(rng.integers(2))) % 2)
+        from_left = bool((k + first_side) % 2)  # alternate sides
         y0, heading = (left_kerb, np.pi / 2) if from_left else (right_kerb, -np.pi / 2)
         walk = 1.39  # 5 km/h
         # trigger so that, without braking, the person reaches the ego's path as the ego arrives

@@ -1,0 +1,113 @@
+"""Privileged implementations of the task slots: they read ground truth. Baselines for the vision modules.
+
+Lateral: lane centring with curvature feed-forward; ``y'' + 2 w y' + w^2 y = 0`` with w = 1/T (critically
+damped, T = ``time_constant_s``). Longitudinal: constant time-gap following (ACC) under a set speed, and
+emergency braking (AEB) for vehicles and for pedestrians in or entering the ego's path.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from percept.control import Controller, sideslip_for_curvature, steering_for_curvature
+
+EGO_HALF_LENGTH_M = 2.5
+EGO_HALF_WIDTH_M = 1.0
+
+
+class PrivilegedLateral(Controller):
+    """Steering from the true lane geometry."""
+
+    def __init__(self, time_constant_s: float = 0.8):
+        if time_constant_s <= 0:
+            raise ValueError(f"time_constant_s must be positive, got {time_constant_s}")
+        self.T = time_constant_s
+
+    def update(self, lane, speed_mps: float) -> float:
+        v = max(speed_mps, 3.0)
+        w = 1.0 / self.T
+        # path heading relative to the lane: body heading plus the sideslip of the steady turn
+        theta = lane.heading_rad + sideslip_for_curvature(lane.curvature_1pm)
+        # kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2 (lateral error dynamics y = offset)
+        kappa = lane.curvature_1pm - 2 * w * math.sin(theta) / v - w * w * lane.offset_m / (v * v)
+        return steering_for_curvature(kappa)
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """The nearest thing in the ego's path: gap_m bumper to object [m]; speed_mps along the ego's x; kind."""
+
+    gap_m: float
+    speed_mps: float
+    kind: str
+
+
+def in_path_obstacle(gt, horizon_s: float = 4.0) -> Obstacle | None:
+    """Nearest vehicle or pedestrian in the ego lane's corridor ahead (pedestrians also if they will enter it)."""
+    lane = gt.lane
+    best = None
+    cam_x = 0.8  # objects' distance_m is measured from the camera, mount_x ahead of the centre
+    for o in gt.objects:
+        if o.kind == "landmark":
+            continue
+        x, y = o.position_m[0], o.position_m[1]
+        if x <= 0:
+            continue
+        # lane centre in the vehicle frame at distance x: y_c = -offset - heading x + kappa x^2 / 2
+        yc = -lane.offset_m - math.tan(lane.heading_rad) * x + lane.curvature_1pm * x * x / 2
+        half = EGO_HALF_WIDTH_M + 0.4 + (o.size_m[1] / 2 if o.kind == "vehicle" else 0.3)
+        vx = o.speed_mps * math.cos(o.yaw_rad)
+        vy = o.speed_mps * math.sin(o.yaw_rad)
+        inside = abs(y - yc) < half
+        if o.kind == "pedestrian" and not inside and abs(vy) > 0.2:
+            # will it step into the corridor before the ego gets there (or within the horizon)?
+            t = min(horizon_s, x / max(gt.speed_mps, 1.0))
+            y_future = y + vy * t
+            inside = abs(y_future - yc) < half or (y - yc) * (y_future - yc) < 0
+        if not inside:
+            continue
+        gap = max(o.distance_m - (EGO_HALF_LENGTH_M - cam_x), 0.0)
+        if best is None or gap < best.gap_m:
+            best = Obstacle(gap, vx, o.kind)
+    return best
+
+
+class PrivilegedLongitudinal(Controller):
+    """Acceleration [m/s^2] from the true in-path obstacle: ACC with time gap, AEB below a time to collision."""
+
+    def __init__(self, set_speed_mps: float, time_gap_s: float = 1.8, standstill_m: float = 4.0,
+                 gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5, ped_margin_m: float = 4.0):
+        if time_gap_s <= 0:
+            raise ValueError(f"time_gap_s must be positive, got {time_gap_s}")
+        self.set_speed, self.time_gap, self.d0 = set_speed_mps, time_gap_s, standstill_m
+        self.Td, self.Tv, self.ped_margin = gap_time_constant_s, speed_time_constant_s, ped_margin_m
+
+    def update(self, obstacle: Obstacle | None, speed_mps: float) -> float:
+        v = speed_mps
+        # cruise: first-order approach to the set speed
+        a = (self.set_speed - v) / self.Tv
+        if obstacle is not None:
+            margin = self.ped_margin if obstacle.kind == "pedestrian" else self.d0
+            target_gap = max(self.d0, v * self.time_gap) if obstacle.kind == "vehicle" else margin
+            closing = v - obstacle.speed_mps
+            # gap dynamics critically damped: a = (gap - gap*) / Td^2 - 2 closing / Td
+            a_follow = (obstacle.gap_m - target_gap) / self.Td ** 2 - 2 * closing / self.Td
+            if obstacle.kind == "pedestrian":
+                # yield: a constant deceleration that stops the car ped_margin before the person, a = -v^2 / (2 room)
+                room = max(obstacle.gap_m - margin, 0.1)
+                a_follow = min(a_follow, -v * v / (2 * room))
+            a = min(a, a_follow)
+            # emergency: the deceleration needed to stop the closing before the margin
+            room = obstacle.gap_m - margin
+            if closing > 0:
+                a_req = closing * closing / (2 * max(room, 0.1))
+                if a_req > 2.0:
+                    a = min(a, -1.3 * a_req)
+            if room < 0.5 and v < 1.0:
+                a = min(a, -8.0)  # hold the car at a standstill
+        if v <= 0.05:
+            a = max(a, 0.0) if a > -1e-3 else a
+        return float(np.clip(a, -8.0, 2.5))
