@@ -63,10 +63,12 @@ def in_path_obstacle(gt, horizon_s: float = 4.0) -> Obstacle | None:
         vy = o.speed_mps * math.sin(o.yaw_rad)
         inside = abs(y - yc) < half
         if o.kind == "pedestrian" and not inside and abs(vy) > 0.2:
-            # will it step into the corridor before the ego gets there (or within the horizon)?
+            # a person walking across the carriageway: yield while within a lane of our corridor (either way),
+            # or if they will step into it before the ego gets there (or within the horizon)
             t = min(horizon_s, x / max(gt.speed_mps, 1.0))
             y_future = y + vy * t
-            inside = abs(y_future - yc) < half or (y - yc) * (y_future - yc) < 0
+            inside = (abs(y - yc) < half + lane.width_m or abs(y_future - yc) < half
+                      or (y - yc) * (y_future - yc) < 0)
         if not inside:
             continue
         gap = max(o.distance_m - (EGO_HALF_LENGTH_M - cam_x), 0.0)

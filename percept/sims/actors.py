@@ -96,7 +96,11 @@ class ScriptedVehicle(IDMVehicle):
     def act(self, action=None):
         super().act(action)
         if self.braking:
-            # brake at a constant deceleration to a standstill, never reversing
-            self.action["acceleration"] = self.brake_mps2 if self.speed > 0.05 else -self.speed * 15
-        if self.speed <= 0.05 and self.braking:
+            # brake at a constant deceleration to a standstill
+            self.action["acceleration"] = self.brake_mps2
+
+    def step(self, dt: float) -> None:
+        super().step(dt)
+        # brakes stop the car, they do not drive it backwards
+        if self.speed < 0.0:
             self.speed = 0.0

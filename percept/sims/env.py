@@ -8,7 +8,9 @@ vehicles, and an optional autopilot ego for rendering data sets.
 from __future__ import annotations
 
 import numpy as np
+from gymnasium import spaces
 from highway_env.envs.common.abstract import AbstractEnv
+from highway_env.envs.common.observation import ObservationType
 from highway_env.vehicle.behavior import IDMVehicle
 
 from .actors import Pedestrian, ScriptedVehicle
@@ -18,6 +20,25 @@ ACCEL_RANGE_MPS2 = (-8.0, 4.0)
 STEER_RANGE_RAD = (-0.5, 0.5)
 
 
+class NoObservation(ObservationType):
+    """percept's agent sees only the cameras (rendered by SimWorld), so highway-env computes no observation
+    (its Kinematics table costs about two thirds of a simulation step)."""
+
+    def space(self) -> spaces.Space:
+        return spaces.Box(0.0, 0.0, shape=(0,), dtype=np.float32)
+
+    def observe(self) -> np.ndarray:
+        return np.zeros(0, dtype=np.float32)
+
+
+class AutopilotVehicle(IDMVehicle):
+    """highway-env's IDM car, kept in its lane, that brakes to a standstill but never reverses."""
+
+    def step(self, dt: float) -> None:
+        super().step(dt)
+        self.speed = max(self.speed, 0.0)
+
+
 class PerceptEnv(AbstractEnv):
     """Config keys beyond highway-env's: ``scenario`` (a Scenario), ``scenario_seed`` (int), ``autopilot`` (bool)."""
 
@@ -25,7 +46,7 @@ class PerceptEnv(AbstractEnv):
     def default_config(cls) -> dict:
         cfg = super().default_config()
         cfg.update({
-            "observation": {"type": "Kinematics", "vehicles_count": 5},
+            "observation": {"type": "Kinematics"},  # replaced by NoObservation in define_spaces
             "action": {"type": "ContinuousAction", "acceleration_range": ACCEL_RANGE_MPS2,
                        "steering_range": STEER_RANGE_RAD, "clip": True},
             "simulation_frequency": 15,
@@ -37,6 +58,11 @@ class PerceptEnv(AbstractEnv):
             "autopilot": False,
         })
         return cfg
+
+    def define_spaces(self) -> None:
+        super().define_spaces()
+        self.observation_type = NoObservation(self)
+        self.observation_space = self.observation_type.space()
 
     def _reset(self) -> None:
         scenario = self.config["scenario"]
@@ -53,7 +79,7 @@ class PerceptEnv(AbstractEnv):
         lane = self.road.network.get_lane(lane_index)
         pos, heading = lane.position(longitudinal, 0.0), lane.heading_at(longitudinal)
         if self.config["autopilot"]:
-            ego = IDMVehicle(self.road, pos, heading, speed, target_lane_index=lane_index, target_speed=speed,
+            ego = AutopilotVehicle(self.road, pos, heading, speed, target_lane_index=lane_index, target_speed=speed,
                              enable_lane_change=False)
         else:
             ego = self.action_type.vehicle_class(self.road, pos, heading, speed)

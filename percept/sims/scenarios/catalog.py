@@ -97,7 +97,7 @@ def build_highway(env, rng) -> Road:
 
 
 def build_curves(env, rng) -> Road:
-    road = _new_road(env, winding_road(rng, lanes=3))
+    road = _new_road(env, winding_road(rng, lanes=3, length_m=2600.0))
     env.road = road
     env.make_ego(("0", "1", 1), 40.0, 20.0)
     idx, s = lane_at(road.network, 1, 95.0)

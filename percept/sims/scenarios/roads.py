@@ -76,8 +76,8 @@ def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 400
     while total < length_m:
         r = float(rng.uniform(150.0, 600.0))
         arc_len = float(rng.uniform(120.0, 280.0))
-        # keep the reference radius >= 150 m for every lane
-        r = max(r, 150.0 + (lanes - 1) * width_m) if sign > 0 else r
+        # every lane's radius within [150, 600] m: right turns put lanes inside, left turns outside
+        r = max(r, 150.0 + (lanes - 1) * width_m) if sign > 0 else min(r, 600.0 - (lanes - 1) * width_m)
         b.arc(r, sign * arc_len / r)
         total += arc_len
         if rng.random() < 0.5:
