@@ -86,9 +86,21 @@ class PrivilegedLongitudinal(Controller):
             raise ValueError(f"time_gap_s must be positive, got {time_gap_s}")
         self.set_speed, self.time_gap, self.d0 = set_speed_mps, time_gap_s, standstill_m
         self.Td, self.Tv, self.ped_margin = gap_time_constant_s, speed_time_constant_s, ped_margin_m
+        self.reset()
 
-    def update(self, obstacle: Obstacle | None, speed_mps: float) -> float:
+    def reset(self) -> None:
+        self.travelled_m = 0.0
+        self.stop_at_m: float | None = None  # odometer reading to stop at while yielding to a pedestrian
+
+    def update(self, obstacle: Obstacle | None, speed_mps: float, dt: float = 1.0 / 15) -> float:
         v = speed_mps
+        self.travelled_m += v * dt
+        # yielding to a crossing pedestrian is a commitment: stop before their line, go once stopped and clear
+        if obstacle is not None and obstacle.kind == "pedestrian":
+            stop_at = self.travelled_m + obstacle.gap_m - self.ped_margin
+            self.stop_at_m = stop_at if self.stop_at_m is None else min(self.stop_at_m, stop_at)
+        elif self.stop_at_m is not None and v < 0.3:
+            self.stop_at_m = None
         # cruise: first-order approach to the set speed
         a = (self.set_speed - v) / self.Tv
         if obstacle is not None:
@@ -110,6 +122,10 @@ class PrivilegedLongitudinal(Controller):
                     a = min(a, -1.3 * a_req)
             if room < 0.5 and v < 1.0:
                 a = min(a, -8.0)  # hold the car at a standstill
+        if self.stop_at_m is not None:
+            # a = -v^2 / (2 s) stops the car in the remaining distance s
+            room = self.stop_at_m - self.travelled_m
+            a = min(a, -8.0 if room < 0.2 else -v * v / (2 * room))
         if v <= 0.05:
             a = max(a, 0.0) if a > -1e-3 else a
         return float(np.clip(a, -8.0, 2.5))

@@ -142,7 +142,7 @@ def build_crossing(env, rng) -> Road:
     x = 20.0
     first_side = int(rng.integers(2))
     for k in range(3):
-        x += float(rng.uniform(110.0, 160.0))
+        x += float(rng.uniform(80.0, 110.0))
         from_left = bool((k + first_side) % 2)  # alternate sides
         y0, heading = (left_kerb, np.pi / 2) if from_left else (right_kerb, -np.pi / 2)
         walk = 1.39  # 5 km/h
@@ -199,7 +199,7 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
     Scenario("lead-brake", "the lead brakes at -6 m/s^2 from 25 m/s to a stop", 20.0, build_lead_brake, 25.0),
     Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead", 20.0, build_cut_in, 25.0),
     Scenario("crossing", "pedestrians cross the ego lane at 5 km/h from both sides, others stay on the verge; "
-             "ego at 20-60 km/h", 40.0, build_crossing, 12.0),
+             "ego at 20-60 km/h", 70.0, build_crossing, 12.0),
     Scenario("loop", "a 3.6 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,
              22.0),
 ]}
