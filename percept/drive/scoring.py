@@ -64,6 +64,8 @@ class RunScorer:
             "centering_max_m": float(off.max()) if len(off) else None,
             "time_gap_mean_s": float(np.mean(self.gaps_s)) if self.gaps_s else None,
             "time_gap_min_s": float(np.min(self.gaps_s)) if self.gaps_s else None,
+            # steady state: the last quarter of the frames that had a lead
+            "time_gap_steady_s": float(np.mean(self.gaps_s[-max(len(self.gaps_s) // 4, 1):])) if self.gaps_s else None,
             "stops": stops if has_crossing else None,
             "false_stops": self.false_stops,
         }

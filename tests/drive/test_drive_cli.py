@@ -1,0 +1,66 @@
+"""`percept drive` through typer's CliRunner: contract, recording, bad input."""
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from percept.cli import app
+
+runner = CliRunner()
+KEYS = ["scenario", "condition", "seed", "duration_s", "frames", "realtime_factor", "collisions",
+        "pedestrian_collisions", "lane_departures", "lane", "longitudinal", "pedestrians", "odometry", "timing_ms"]
+
+
+def rerun_bin() -> str:
+    exe = Path(sys.executable).with_name("rerun")
+    return str(exe) if exe.exists() else shutil.which("rerun")
+
+
+def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
+    rrd, js = tmp_path / "run.rrd", tmp_path / "run.json"
+    r = runner.invoke(app, ["drive", "--duration", "1", "--record", str(rrd), "--json", str(js)])
+    assert r.exit_code == 0, r.output
+    d = json.loads(js.read_text())
+    for k in KEYS:
+        assert k in d
+    assert d["scenario"] == "highway" and d["frames"] == 15
+    assert d["timing_ms"]["render"] > 0
+    assert rrd.exists() and not (tmp_path / "run.rrd.part").exists()
+    v = subprocess.run([rerun_bin(), "rrd", "verify", str(rrd)], capture_output=True, text=True,
+                       env={"RERUN_ANALYTICS": "0", "PATH": ""})
+    assert v.returncode == 0, v.stdout + v.stderr
+
+
+def test_drive_default_recording_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, ["drive", "--scenario", "cut-in", "--seed", "2", "--duration", "0.2"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "runs" / "cut-in-clear-2.rrd").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--scenario", "motorway"], "unknown scenario 'motorway'"),
+    (["--condition", "snow"], "unknown condition 'snow'"),
+    (["--lateral", "magic"], "--lateral must be vision or privileged"),
+    (["--lateral", "vision"], "no vision implementation yet"),
+    (["--duration", "-3"], "--duration must be positive"),
+])
+def test_drive_bad_input_is_one_line_exit_2(tmp_path, args, message):
+    js, rrd = tmp_path / "r.json", tmp_path / "r.rrd"
+    r = runner.invoke(app, ["drive", *args, "--json", str(js), "--record", str(rrd)])
+    assert r.exit_code == 2
+    assert message in r.output and "Traceback" not in r.output
+    assert not js.exists() and not rrd.exists()
+
+
+def test_drive_unwritable_output(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    r = runner.invoke(app, ["drive", "--duration", "0.2", "--no-record", "--json", str(blocker / "r.json")])
+    assert r.exit_code == 2
+    assert "cannot write" in r.output
