@@ -1,7 +1,6 @@
 """Privileged implementations of the task slots: they read ground truth. Baselines for the vision modules.
 
-Lateral: lane centring with curvature feed-forward; ``y'' + 2 w y' + w^2 y = 0`` with w = 1/T (critically
-damped, T = ``time_constant_s``). Longitudinal: constant time-gap following (ACC) under a set speed, and
+Lateral: lane centring (percept.control.LaneKeeping) on the true lane. Longitudinal: constant time-gap following (ACC) under a set speed, and
 emergency braking (AEB) for vehicles and for pedestrians in or entering the ego's path.
 """
 
@@ -12,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from percept.control import Controller, sideslip_for_curvature, steering_for_curvature
+from percept.control import Controller, LaneKeeping
 
 EGO_HALF_LENGTH_M = 2.5
 EGO_HALF_WIDTH_M = 1.0
@@ -22,18 +21,10 @@ class PrivilegedLateral(Controller):
     """Steering from the true lane geometry."""
 
     def __init__(self, time_constant_s: float = 0.8):
-        if time_constant_s <= 0:
-            raise ValueError(f"time_constant_s must be positive, got {time_constant_s}")
-        self.T = time_constant_s
+        self.law = LaneKeeping(time_constant_s)
 
     def update(self, lane, speed_mps: float) -> float:
-        v = max(speed_mps, 3.0)
-        w = 1.0 / self.T
-        # path heading relative to the lane: body heading plus the sideslip of the steady turn
-        theta = lane.heading_rad + sideslip_for_curvature(lane.curvature_1pm)
-        # kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2 (lateral error dynamics y = offset)
-        kappa = lane.curvature_1pm - 2 * w * math.sin(theta) / v - w * w * lane.offset_m / (v * v)
-        return steering_for_curvature(kappa)
+        return self.law.update(lane.offset_m, lane.heading_rad, lane.curvature_1pm, speed_mps)
 
 
 @dataclass(frozen=True)

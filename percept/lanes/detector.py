@@ -1,0 +1,60 @@
+"""LaneDetector: one camera image (and the car's motion) in, a tracked LaneEstimate out."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from percept.sensors import StereoRig
+
+from .evidence import EvidenceConfig, MarkingExtractor
+from .fit import FitConfig, fit_lane
+from .tracker import LaneTracker
+from .types import LaneEstimate, LaneFit, MarkingEvidence
+
+
+@dataclass(frozen=True)
+class LaneDebug:
+    """What the detector saw: evidence (None for a dropped frame), the frame's fit (None when too thin)."""
+
+    evidence: MarkingEvidence | None
+    fit: LaneFit | None
+
+
+@dataclass(frozen=True)
+class LaneConfig:
+    evidence: EvidenceConfig = field(default_factory=EvidenceConfig)
+    fit: FitConfig = field(default_factory=FitConfig)
+
+
+class LaneDetector:
+    """Marking evidence -> robust joint fit -> Kalman tracking. Works on the left camera of ``rig``."""
+
+    def __init__(self, rig: StereoRig, cfg: LaneConfig = LaneConfig()):
+        self.rig, self.cfg = rig, cfg
+        self.extractor = MarkingExtractor(rig, cfg.evidence)
+        self.tracker = LaneTracker(cfg.fit.width_prior_m)
+
+    def reset(self) -> None:
+        self.tracker.reset()
+
+    def process(self, image: np.ndarray | None, speed_mps: float = 0.0, yaw_rate_rps: float = 0.0,
+                dt: float = 1.0 / 15) -> tuple[LaneEstimate, LaneDebug]:
+        """Track the lane through one frame; ``image`` None (dropped frame) only predicts."""
+        if self.tracker.initialised:
+            self.tracker.predict(speed_mps, yaw_rate_rps, dt)
+        if image is None:
+            return self.tracker.estimate, LaneDebug(None, None)
+        ev = self.extractor.extract(image)
+        prior = self.tracker.estimate if self.tracker.initialised and self.tracker.confidence > 0.05 else None
+        fit = fit_lane(ev, prior, self.cfg.fit)
+        if prior is not None and (fit is None or fit.estimate.confidence < 0.3):
+            # lost the lane around the prediction: search afresh
+            fresh = fit_lane(ev, None, self.cfg.fit)
+            if fresh is not None and (fit is None or fresh.estimate.confidence > fit.estimate.confidence):
+                fit = fresh
+                self.tracker.reset()
+        if fit is not None:
+            self.tracker.update(fit)
+        return self.tracker.estimate, LaneDebug(ev, fit)

@@ -1,0 +1,127 @@
+"""Both lane boundaries fitted jointly in the vehicle frame, robustly, with a lane-width prior.
+
+Model (vehicle frame, y left): y = a0 + a1 x + a2 x^2 + s w/2, s = +1 on the left boundary, -1 on the right,
+so the lane centre is y_c = a0 + a1 x + a2 x^2, i.e. offset = -a0, heading = atan(-a1), curvature = 2 a2.
+It is linear in (a0, a1, a2, w): iteratively reweighted least squares with Huber weights (Huber 1964;
+Zhang, "Parameter estimation techniques", IVC 1997), points assigned to a side by gating around the
+prediction, pseudo-observations for the priors (width, zero curvature) so that one visible side suffices.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .types import LaneEstimate, LaneFit, MarkingEvidence
+
+
+@dataclass(frozen=True)
+class FitConfig:
+    """width_prior_m, width_sigma_m: lane width prior; curvature_sigma_1pm: prior spread of curvature around 0;
+    curvature_rate_sigma_1pm2: prior spread of the curvature's change along the road;
+    gate_m: side-assignment gate around a prediction [m]; huber_m: Huber threshold [m]; min_points: per fit."""
+
+    width_prior_m: float = 3.7
+    width_sigma_m: float = 0.4
+    curvature_sigma_1pm: float = 0.01
+    curvature_rate_sigma_1pm2: float = 5e-5
+    gate_m: float = 0.7
+    huber_m: float = 0.08
+    min_points: int = 12
+
+
+def _initial_sides(pts: np.ndarray, cfg: FitConfig) -> np.ndarray:
+    """Without a prediction: the strongest pair of near-range lateral clusters straddling the car, ~a lane apart."""
+    near = pts[:, 0] < 22.0
+    if near.sum() < 4:
+        return np.zeros(len(pts), dtype=int)
+    bins = np.arange(-6.0, 6.05, 0.2)
+    hist, _ = np.histogram(pts[near, 1], bins=bins)
+    hist = np.convolve(hist, [1, 2, 1], mode="same")
+    centres = (bins[:-1] + bins[1:]) / 2
+    best, pair = 0.0, None
+    for i in np.flatnonzero((centres > 0) & (hist > 0)):
+        for j in np.flatnonzero((centres < 0) & (hist > 0)):
+            w = centres[i] - centres[j]
+            if 2.6 <= w <= 4.8:
+                score = min(hist[i], hist[j]) + 0.1 * (hist[i] + hist[j]) - 2.0 * abs(w - cfg.width_prior_m)
+                if score > best:
+                    best, pair = score, (centres[i], centres[j])
+    sides = np.zeros(len(pts), dtype=int)
+    if pair is None:
+        return sides
+    # straight-line seed through each cluster, gated generously: the fit then refines with all points
+    sides[np.abs(pts[:, 1] - pair[0]) < 2 * cfg.gate_m * (1 + pts[:, 0] / 40)] = 1
+    sides[np.abs(pts[:, 1] - pair[1]) < 2 * cfg.gate_m * (1 + pts[:, 0] / 40)] = -1
+    return sides
+
+
+def _solve(pts, sides, strength, cfg: FitConfig):
+    m = sides != 0
+    x, y, s = pts[m, 0], pts[m, 1], sides[m].astype(float)
+    # columns: a0, a1, a2, w, and a3 (x^3) that absorbs curvature changing ahead (a clothoid: a3 = dkappa/ds / 6)
+    A = np.column_stack([np.ones_like(x), x, x * x, s / 2, x ** 3])
+    wts = np.sqrt(np.clip(strength[m], 1, None))
+    wts /= wts.mean() if len(wts) else 1
+    params = None
+    for _ in range(4):
+        sig = cfg.huber_m
+        # priors as pseudo-observations: w = w0 (sigma_w), a2 = 0 (sigma_kappa / 2), a3 = 0 (sigma_dkappa / 6)
+        P = np.array([[0, 0, 0, 1.0 / cfg.width_sigma_m, 0], [0, 0, 2.0 / cfg.curvature_sigma_1pm, 0, 0],
+                      [0, 0, 0, 0, 6.0 / cfg.curvature_rate_sigma_1pm2]]) * sig
+        q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0]) * sig
+        Aw = np.vstack([A * wts[:, None], P])
+        yw = np.concatenate([y * wts, q])
+        # column scaling keeps the powers of x well conditioned
+        scale = np.sqrt(np.mean(Aw * Aw, axis=0)) + 1e-12
+        sol, *_ = np.linalg.lstsq(Aw / scale, yw, rcond=None)
+        params = sol / scale
+        normal = Aw.T @ Aw
+        r = A @ params - y
+        # Huber weights: 1 inside the threshold, threshold/|r| outside
+        hub = np.where(np.abs(r) <= sig, 1.0, sig / np.maximum(np.abs(r), 1e-9))
+        wts = np.sqrt(np.clip(strength[m], 1, None)) * np.sqrt(hub)
+        wts /= wts.mean()
+    r = A @ params - y
+    # parameter covariance: sigma^2 (A^T W A)^-1 with the residual scale of the weighted fit
+    sigma2 = max(float(np.mean((r * wts) ** 2)), cfg.huber_m ** 2 / 4)
+    cov = sigma2 * np.linalg.pinv(normal)
+    return params, r, m, cov
+
+
+def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = FitConfig()) -> LaneFit | None:
+    """Fit both boundaries; ``prior`` (a prediction) gates the assignment. None when evidence is too thin."""
+    pts = ev.points_m
+    if len(pts) < cfg.min_points:
+        return None
+    if prior is not None and prior.valid:
+        sides = np.zeros(len(pts), dtype=int)
+        gate = cfg.gate_m * (1.5 - 0.5 * prior.confidence)
+        for s in (1, -1):
+            sides[np.abs(pts[:, 1] - prior.boundary_y(pts[:, 0], s)) < gate] = s
+    else:
+        sides = _initial_sides(pts, cfg)
+    if (sides != 0).sum() < cfg.min_points:
+        return None
+    for _ in range(2):
+        params, r, m, cov = _solve(pts, sides, ev.strength, cfg)
+        # re-gate around the fitted boundaries
+        pred = params[0] + params[1] * pts[:, 0] + params[2] * pts[:, 0] ** 2 + params[4] * pts[:, 0] ** 3
+        new = np.zeros(len(pts), dtype=int)
+        for s in (1, -1):
+            new[np.abs(pts[:, 1] - (pred + s * params[3] / 2)) < 3 * cfg.huber_m + 0.1] = s
+        if (new != 0).sum() < cfg.min_points:
+            break
+        sides = new
+    params, r, m, cov = _solve(pts, sides, ev.strength, cfg)
+    inl = np.abs(r) < 3 * cfg.huber_m
+    nl = int(((sides[m] == 1) & inl).sum())
+    nr = int(((sides[m] == -1) & inl).sum())
+    a0, a1, a2, w = params[:4]
+    support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6)
+    est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support))
+    res = float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan")
+    # (a0, a1, a2, w) -> (offset, heading, curvature, width): Jacobian diag(-1, -1/(1+a1^2), 2, 1)
+    J = np.diag([-1.0, -1.0 / (1 + a1 * a1), 2.0, 1.0])
+    return LaneFit(est, np.where(m, sides, 0), res, nl, nr, J @ cov[:4, :4] @ J.T)

@@ -1,0 +1,58 @@
+"""Records passed out of the lanes module."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class LaneEstimate:
+    """The ego lane in the vehicle frame (x forward, y left), as the lateral controller needs it.
+
+    offset_m: vehicle centre's lateral offset from the lane centre (+ left); heading_rad: vehicle heading relative
+    to the lane (+ CCW); curvature_1pm: lane curvature (+ turning left); width_m; confidence: 0..1 (0 = no
+    evidence, the values are a prediction); valid: False before the first fit. The lane centre in the vehicle
+    frame is y_c(x) = -offset - tan(heading) x + curvature x^2 / 2.
+    """
+
+    offset_m: float
+    heading_rad: float
+    curvature_1pm: float
+    width_m: float
+    confidence: float
+    valid: bool = True
+
+    def centre_y(self, x_m: np.ndarray) -> np.ndarray:
+        """Lateral position of the lane centre at distances x_m ahead [m]."""
+        x = np.asarray(x_m, dtype=float)
+        return -self.offset_m - np.tan(self.heading_rad) * x + 0.5 * self.curvature_1pm * x * x
+
+    def boundary_y(self, x_m: np.ndarray, side: int) -> np.ndarray:
+        """side +1: left boundary, -1: right boundary."""
+        return self.centre_y(x_m) + side * self.width_m / 2
+
+
+@dataclass(frozen=True)
+class MarkingEvidence:
+    """Marking pixels mapped to the ground. points_m: (N, 2) vehicle-frame (x, y) [m]; strength: (N,) top-hat
+    response; uv_px: (N, 2) where they are in the image (u, v)."""
+
+    points_m: np.ndarray
+    strength: np.ndarray
+    uv_px: np.ndarray
+
+
+@dataclass(frozen=True)
+class LaneFit:
+    """One frame's robust fit. estimate: the fitted lane (confidence from support); side: (N,) +1 left,
+    -1 right, 0 outlier, per evidence point; residual_m: RMS residual of the inliers [m]; cov: (4, 4)
+    covariance of (offset, heading, curvature, width) from the least-squares normal equations."""
+
+    estimate: LaneEstimate
+    side: np.ndarray
+    residual_m: float
+    inliers_left: int
+    inliers_right: int
+    cov: np.ndarray
