@@ -8,6 +8,10 @@ from enum import Enum
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
+
+from percept.control import LaneKeeping
+from percept.lanes import LaneDetector
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.actors import Pedestrian
 
@@ -21,6 +25,7 @@ class Mode(str, Enum):
 
 
 SLOTS = ("lateral", "longitudinal", "pedestrians", "odometry")
+VISION_SLOTS = ("lateral",)
 
 
 @dataclass(frozen=True)
@@ -43,7 +48,7 @@ class DriveConfig:
             except ValueError:
                 raise ValueError(f"--{slot} must be vision or privileged, got '{getattr(self, slot)}'") from None
             object.__setattr__(self, slot, mode)
-            if mode is Mode.VISION:
+            if mode is Mode.VISION and slot not in VISION_SLOTS:
                 raise ValueError(f"the {slot} slot has no vision implementation yet; use --{slot} privileged")
 
 
@@ -59,6 +64,12 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     duration = cfg.duration_s if cfg.duration_s is not None else world.scenario.duration_s
     n = max(int(round(duration / world.dt)), 1)
     lateral = PrivilegedLateral()
+    vision_lateral = cfg.lateral is Mode.VISION
+    if vision_lateral and not render:
+        raise ValueError("the vision lateral slot needs the cameras (render=True)")
+    lanes = LaneDetector(world.cfg.rig) if vision_lateral else None
+    keeping = LaneKeeping()
+    lane_err, lanes_ms = [], 0.0
     longitudinal = PrivilegedLongitudinal(world.cruise_speed_mps)
     scorer = RunScorer()
     has_crossing = any(isinstance(o, Pedestrian) and o.crossing for o in world.env.road.objects)
@@ -70,7 +81,16 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         frame, gt = world.observe(render=render)
         render_ms += (time.perf_counter() - t0) * 1e3
         obstacle = in_path_obstacle(gt)
-        steer = lateral.update(gt.lane, gt.speed_mps)
+        if lanes is not None:
+            t0 = time.perf_counter()
+            est, _ = lanes.process(frame.left, frame.wheel_speed_mps, frame.imu.yaw_rate_rps, world.dt)
+            lanes_ms += (time.perf_counter() - t0) * 1e3
+            steer = keeping.update(est.offset_m, est.heading_rad, est.curvature_1pm, frame.wheel_speed_mps)
+            if est.valid:
+                lane_err.append([est.offset_m - gt.lane.offset_m, est.heading_rad - gt.lane.heading_rad,
+                                 est.curvature_1pm - gt.lane.curvature_1pm])
+        else:
+            steer = lateral.update(gt.lane, gt.speed_mps)
         accel = longitudinal.update(obstacle, gt.speed_mps)
         hit = [world.ids(p) for p in world.env.road.objects if isinstance(p, Pedestrian) and (p.crashed or p.hit)]
         scorer.update(gt, obstacle, hit)
@@ -82,6 +102,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
             progress(i + 1, n)
     wall = time.perf_counter() - t_start
     s = scorer.result(has_crossing)
+    lanes_per_frame = lanes_ms / max(frames, 1) if lanes is not None else None
     sim_s = frames * world.dt
     return {
         "scenario": cfg.world.scenario,
@@ -94,7 +115,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         "collisions": s["collisions"],
         "pedestrian_collisions": s["pedestrian_collisions"],
         "lane_departures": s["lane_departures"],
-        "lane": {"offset_rmse_m": None, "heading_rmse_rad": None, "curvature_rmse_1pm": None,
+        "lane": {**_rmse(lane_err, ("offset_rmse_m", "heading_rmse_rad", "curvature_rmse_1pm")),
                  "centering_rms_m": s["centering_rms_m"], "centering_max_m": s["centering_max_m"]},
         "longitudinal": {"range_abs_rel_err": None, "range_abs_rel_err_by_bin": None, "ttc_abs_err_s": None,
                          "time_gap_mean_s": s["time_gap_mean_s"], "time_gap_min_s": s["time_gap_min_s"],
@@ -104,6 +125,15 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
                         "stops": s["stops"], "false_stops": s["false_stops"]},
         "odometry": {"drift_pct_vo": None, "drift_pct_fused": None, "ate_rmse_vo_m": None, "ate_rmse_fused_m": None,
                      "landmark_fixes": None},
-        "timing_ms": {"render": render_ms / max(frames, 1) if render else None, "lanes": None, "longitudinal": None, "pedestrians": None,
-                      "odometry": None, "perception_total": None},
+        "timing_ms": {"render": render_ms / max(frames, 1) if render else None, "lanes": lanes_per_frame,
+                      "longitudinal": None, "pedestrians": None, "odometry": None,
+                      "perception_total": lanes_per_frame},
     }
+
+
+def _rmse(errors: list, keys: tuple) -> dict:
+    """RMS of each column of the per-frame errors; None (does not apply) without estimates."""
+    if not errors:
+        return {k: None for k in keys}
+    e = np.asarray(errors, dtype=float)
+    return {k: float(v) for k, v in zip(keys, np.sqrt(np.mean(e * e, axis=0)))}

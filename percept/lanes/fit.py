@@ -31,30 +31,32 @@ class FitConfig:
     min_points: int = 12
 
 
-def _initial_sides(pts: np.ndarray, cfg: FitConfig) -> np.ndarray:
-    """Without a prediction: the strongest pair of near-range lateral clusters straddling the car, ~a lane apart."""
-    near = pts[:, 0] < 22.0
+def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list[np.ndarray]:
+    """Without a prediction: side assignments seeded by the strongest pairs of near-range lateral clusters that
+    straddle the car about a lane apart (each is fitted; the best-supported fit wins)."""
+    near = pts[:, 0] < 16.0
     if near.sum() < 4:
-        return np.zeros(len(pts), dtype=int)
-    bins = np.arange(-6.0, 6.05, 0.2)
+        return []
+    bins = np.arange(-6.0, 6.05, 0.15)
     hist, _ = np.histogram(pts[near, 1], bins=bins)
     hist = np.convolve(hist, [1, 2, 1], mode="same")
     centres = (bins[:-1] + bins[1:]) / 2
-    best, pair = 0.0, None
+    pairs = []
     for i in np.flatnonzero((centres > 0) & (hist > 0)):
         for j in np.flatnonzero((centres < 0) & (hist > 0)):
             w = centres[i] - centres[j]
             if 2.6 <= w <= 4.8:
                 score = min(hist[i], hist[j]) + 0.1 * (hist[i] + hist[j]) - 2.0 * abs(w - cfg.width_prior_m)
-                if score > best:
-                    best, pair = score, (centres[i], centres[j])
-    sides = np.zeros(len(pts), dtype=int)
-    if pair is None:
-        return sides
-    # straight-line seed through each cluster, gated generously: the fit then refines with all points
-    sides[np.abs(pts[:, 1] - pair[0]) < 2 * cfg.gate_m * (1 + pts[:, 0] / 40)] = 1
-    sides[np.abs(pts[:, 1] - pair[1]) < 2 * cfg.gate_m * (1 + pts[:, 0] / 40)] = -1
-    return sides
+                pairs.append((score, centres[i], centres[j]))
+    pairs.sort(reverse=True)
+    out = []
+    for _, yl, yr in pairs[:candidates]:
+        # straight-line seeds over the near range only; the fit then grows along each boundary
+        sides = np.zeros(len(pts), dtype=int)
+        sides[near & (np.abs(pts[:, 1] - yl) < cfg.gate_m)] = 1
+        sides[near & (np.abs(pts[:, 1] - yr) < cfg.gate_m)] = -1
+        out.append(sides)
+    return out
 
 
 def _solve(pts, sides, strength, cfg: FitConfig):
@@ -90,6 +92,31 @@ def _solve(pts, sides, strength, cfg: FitConfig):
     return params, r, m, cov
 
 
+def _grow(pts, sides, strength, cfg: FitConfig):
+    """Fit, re-gate every point around the fitted boundaries, refit; (support, params, sides, r, m, cov, nl, nr)."""
+    if (sides != 0).sum() < cfg.min_points:
+        return None
+    for _ in range(3):
+        params, r, m, cov = _solve(pts, sides, strength, cfg)
+        x = pts[:, 0]
+        pred = params[0] + params[1] * x + params[2] * x ** 2 + params[4] * x ** 3
+        new = np.zeros(len(pts), dtype=int)
+        for s in (1, -1):
+            new[np.abs(pts[:, 1] - (pred + s * params[3] / 2)) < 3 * cfg.huber_m + 0.1] = s
+        if (new != 0).sum() < cfg.min_points:
+            break
+        sides = new
+    params, r, m, cov = _solve(pts, sides, strength, cfg)
+    if not 2.4 <= params[3] <= 5.2:
+        return None
+    inl = np.abs(r) < 3 * cfg.huber_m
+    nl = int(((sides[m] == 1) & inl).sum())
+    nr = int(((sides[m] == -1) & inl).sum())
+    # support favours both sides seen
+    support = nl + nr + 2 * min(nl, nr)
+    return support, params, sides, r, m, cov, nl, nr
+
+
 def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = FitConfig()) -> LaneFit | None:
     """Fit both boundaries; ``prior`` (a prediction) gates the assignment. None when evidence is too thin."""
     pts = ev.points_m
@@ -100,24 +127,18 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
         gate = cfg.gate_m * (1.5 - 0.5 * prior.confidence)
         for s in (1, -1):
             sides[np.abs(pts[:, 1] - prior.boundary_y(pts[:, 0], s)) < gate] = s
+        seeds = [sides]
     else:
-        sides = _initial_sides(pts, cfg)
-    if (sides != 0).sum() < cfg.min_points:
+        seeds = _initial_sides(pts, cfg)
+    best = None
+    for sides in seeds:
+        result = _grow(pts, sides, ev.strength, cfg)
+        if result is not None and (best is None or result[0] > best[0]):
+            best = result
+    if best is None:
         return None
-    for _ in range(2):
-        params, r, m, cov = _solve(pts, sides, ev.strength, cfg)
-        # re-gate around the fitted boundaries
-        pred = params[0] + params[1] * pts[:, 0] + params[2] * pts[:, 0] ** 2 + params[4] * pts[:, 0] ** 3
-        new = np.zeros(len(pts), dtype=int)
-        for s in (1, -1):
-            new[np.abs(pts[:, 1] - (pred + s * params[3] / 2)) < 3 * cfg.huber_m + 0.1] = s
-        if (new != 0).sum() < cfg.min_points:
-            break
-        sides = new
-    params, r, m, cov = _solve(pts, sides, ev.strength, cfg)
+    _, params, sides, r, m, cov, nl, nr = best
     inl = np.abs(r) < 3 * cfg.huber_m
-    nl = int(((sides[m] == 1) & inl).sum())
-    nr = int(((sides[m] == -1) & inl).sum())
     a0, a1, a2, w = params[:4]
     support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6)
     est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support))

@@ -47,7 +47,7 @@ def test_drive_default_recording_path(tmp_path, monkeypatch):
     (["--scenario", "motorway"], "unknown scenario 'motorway'"),
     (["--condition", "snow"], "unknown condition 'snow'"),
     (["--lateral", "magic"], "--lateral must be vision or privileged"),
-    (["--lateral", "vision"], "no vision implementation yet"),
+    (["--longitudinal", "vision"], "no vision implementation yet"),
     (["--duration", "-3"], "--duration must be positive"),
 ])
 def test_drive_bad_input_is_one_line_exit_2(tmp_path, args, message):

@@ -1,0 +1,102 @@
+"""Lanes: analytic fit on synthetic evidence, evidence on a synthetic image, tracking in the simulator."""
+
+import numpy as np
+import pytest
+
+from percept.lanes import FitConfig, LaneDetector, LaneEstimate, MarkingEvidence, MarkingExtractor, fit_lane
+from percept.sensors import StereoRig
+
+
+def synthetic_evidence(truth: LaneEstimate, rng, outliers: int = 0, dashed: bool = True) -> MarkingEvidence:
+    x = np.arange(6.0, 50.0, 0.25)
+    pts = []
+    for side in (1, -1):
+        keep = ((x % 12.0) < 3.0) if (dashed and side == 1) else np.ones_like(x, bool)
+        xs = x[keep]
+        pts.append(np.column_stack([xs, truth.boundary_y(xs, side) + rng.normal(0, 0.03, len(xs))]))
+    if outliers:
+        pts.append(np.column_stack([rng.uniform(6, 50, outliers), rng.uniform(-8, 8, outliers)]))
+    p = np.concatenate(pts)
+    return MarkingEvidence(p, np.full(len(p), 40.0), np.zeros((len(p), 2)))
+
+
+@pytest.mark.parametrize("offset, heading, curvature", [(0.0, 0.0, 0.0), (0.4, -0.02, 0.004), (-0.6, 0.03, -0.006)])
+def test_fit_recovers_a_known_lane(offset, heading, curvature):
+    truth = LaneEstimate(offset, heading, curvature, 3.6, 1.0)
+    rng = np.random.default_rng(0)
+    fit = fit_lane(synthetic_evidence(truth, rng, outliers=60), prior=None)
+    assert fit is not None
+    e = fit.estimate
+    assert e.offset_m == pytest.approx(offset, abs=0.03)
+    assert e.heading_rad == pytest.approx(heading, abs=0.003)
+    assert e.curvature_1pm == pytest.approx(curvature, abs=3e-4)
+    assert e.width_m == pytest.approx(3.6, abs=0.05)
+    assert fit.inliers_left > 20 and fit.inliers_right > 20
+
+
+def test_fit_with_one_side_only_uses_the_width_prior():
+    truth = LaneEstimate(0.2, 0.0, 0.0, 3.7, 1.0)
+    ev = synthetic_evidence(truth, np.random.default_rng(1))
+    left_only = ev.points_m[:, 1] > 0
+    ev1 = MarkingEvidence(ev.points_m[left_only], ev.strength[left_only], ev.uv_px[left_only])
+    fit = fit_lane(ev1, prior=truth)
+    assert fit is not None and fit.inliers_right == 0
+    assert fit.estimate.offset_m == pytest.approx(0.2, abs=0.1)
+    assert fit.estimate.confidence < 1.0
+
+
+def test_too_little_evidence_gives_no_fit():
+    ev = MarkingEvidence(np.zeros((3, 2)), np.ones(3), np.zeros((3, 2)))
+    assert fit_lane(ev, None, FitConfig()) is None
+
+
+def test_extractor_finds_painted_stripes_and_ignores_wide_bright_areas():
+    rig = StereoRig()
+    ex = MarkingExtractor(rig)
+    img = np.full((480, 640, 3), 90, np.uint8)
+    H = rig.ground_homography()
+    def paint(y0, y1, x0=6.0, x1=40.0, val=230):
+        quad = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], float)
+        p = np.column_stack([quad, np.ones(4)]) @ H.T
+        import cv2
+        cv2.fillPoly(img, [np.round(p[:, :2] / p[:, 2:]).astype(np.int32)], (val, val, val))
+    paint(1.8, 1.95)  # a 15 cm marking 1.9 m to the left
+    paint(-3.0, -5.0)  # a 2 m wide bright slab (a white car's side), not a marking
+    ev = ex.extract(img)
+    assert len(ev.points_m) > 50
+    y = ev.points_m[:, 1]
+    assert np.mean(np.abs(y - 1.875) < 0.15) > 0.9
+
+
+def test_detector_rejects_a_wrong_image_size():
+    det = LaneDetector(StereoRig())
+    with pytest.raises(ValueError, match="the rig expects 640x480"):
+        det.process(np.zeros((100, 100, 3), np.uint8))
+
+
+def test_black_frame_and_dropped_frame_degrade_gracefully():
+    det = LaneDetector(StereoRig())
+    est, dbg = det.process(np.zeros((480, 640, 3), np.uint8), 20.0, 0.0)
+    assert not est.valid and dbg.fit is None
+    est, dbg = det.process(None, float("nan"), float("nan"))
+    assert dbg.evidence is None and not est.valid
+
+
+def test_tracking_on_the_simulated_highway():
+    from percept.drive import PrivilegedLateral, PrivilegedLongitudinal, in_path_obstacle
+    from percept.sims import SimWorld, WorldConfig
+
+    w = SimWorld(WorldConfig("highway", 1, scenery=False))
+    det = LaneDetector(w.cfg.rig)
+    lat, lon = PrivilegedLateral(), PrivilegedLongitudinal(w.cruise_speed_mps)
+    err = []
+    for i in range(60):
+        f, gt = w.observe()
+        est, _ = det.process(f.left, f.wheel_speed_mps, f.imu.yaw_rate_rps, w.dt)
+        if i >= 5:
+            assert est.valid and est.confidence > 0.5
+            err.append([est.offset_m - gt.lane.offset_m, est.heading_rad - gt.lane.heading_rad])
+        # a gentle weave so that offset and heading are not trivially zero
+        w.step(lon.update(in_path_obstacle(gt), gt.speed_mps), lat.update(gt.lane, gt.speed_mps) + 0.01 * np.sin(i / 8))
+    rmse = np.sqrt(np.mean(np.square(err), axis=0))
+    assert rmse[0] < 0.05 and rmse[1] < 0.005
