@@ -193,3 +193,17 @@ def bench(
 
 def main() -> None:
     app()
+
+
+def _register_plugins() -> None:
+    """Commands that live in their own modules register themselves on ``app``."""
+    try:
+        from . import lanes_cmd
+    except ImportError as e:  # only while the module is absent from a checkout
+        if "lanes_cmd" not in str(e):
+            raise
+        return
+    lanes_cmd.register(app)
+
+
+_register_plugins()

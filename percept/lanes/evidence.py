@@ -74,8 +74,7 @@ class MarkingExtractor:
         b = self.birdseye(image)
         w = self.w_px
         # top-hat: centre mean minus the brighter of the two flank means at 1.5 widths
-        centre = cv2.blur(b, (w, 1))
-        flank = cv2.blur(b, (w, 1))
+        centre = flank = cv2.blur(b, (w, 1))
         s = int(round(1.5 * w)) + 1
         left = np.empty_like(flank)
         right = np.empty_like(flank)

@@ -59,36 +59,37 @@ def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list
     return out
 
 
-def _solve(pts, sides, strength, cfg: FitConfig):
+def _solve(pts, sides, strength, cfg: FitConfig, iterations: int = 3):
+    """IRLS on the normal equations (5 unknowns); returns params, residuals, mask of used points, covariance."""
     m = sides != 0
     x, y, s = pts[m, 0], pts[m, 1], sides[m].astype(float)
-    # columns: a0, a1, a2, w, and a3 (x^3) that absorbs curvature changing ahead (a clothoid: a3 = dkappa/ds / 6)
-    A = np.column_stack([np.ones_like(x), x, x * x, s / 2, x ** 3])
-    wts = np.sqrt(np.clip(strength[m], 1, None))
-    wts /= wts.mean() if len(wts) else 1
-    params = None
-    for _ in range(4):
-        sig = cfg.huber_m
-        # priors as pseudo-observations: w = w0 (sigma_w), a2 = 0 (sigma_kappa / 2), a3 = 0 (sigma_dkappa / 6)
-        P = np.array([[0, 0, 0, 1.0 / cfg.width_sigma_m, 0], [0, 0, 2.0 / cfg.curvature_sigma_1pm, 0, 0],
-                      [0, 0, 0, 0, 6.0 / cfg.curvature_rate_sigma_1pm2]]) * sig
-        q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0]) * sig
-        Aw = np.vstack([A * wts[:, None], P])
-        yw = np.concatenate([y * wts, q])
-        # column scaling keeps the powers of x well conditioned
-        scale = np.sqrt(np.mean(Aw * Aw, axis=0)) + 1e-12
-        sol, *_ = np.linalg.lstsq(Aw / scale, yw, rcond=None)
-        params = sol / scale
-        normal = Aw.T @ Aw
-        r = A @ params - y
+    # columns: a0, a1, a2, w, and a3 (x^3) that absorbs curvature changing ahead (a clothoid: a3 = dkappa/ds / 6);
+    # x in units of 10 m keeps the powers well conditioned (undone on the parameters below)
+    xs = x / 10.0
+    A = np.column_stack([np.ones_like(xs), xs, xs * xs, s / 2, xs ** 3])
+    unscale = np.array([1.0, 0.1, 0.01, 1.0, 0.001])
+    sig = cfg.huber_m
+    # priors as pseudo-observations on the scaled parameters: w = w0, a2 = 0, a3 = 0
+    P = np.array([[0, 0, 0, 1.0 / cfg.width_sigma_m, 0],
+                  [0, 0, 2.0 * 0.01 / cfg.curvature_sigma_1pm, 0, 0],
+                  [0, 0, 0, 0, 6.0 * 0.001 / cfg.curvature_rate_sigma_1pm2]]) * sig
+    q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0]) * sig
+    base = np.clip(strength[m], 1, None)
+    w2 = base / base.mean()
+    for _ in range(iterations):
+        # weighted normal equations (A^T W A + P^T P) p = A^T W y + P^T q
+        Aw = A * w2[:, None]
+        normal = A.T @ Aw + P.T @ P
+        sol = np.linalg.solve(normal, Aw.T @ y + P.T @ q)
+        r = A @ sol - y
         # Huber weights: 1 inside the threshold, threshold/|r| outside
         hub = np.where(np.abs(r) <= sig, 1.0, sig / np.maximum(np.abs(r), 1e-9))
-        wts = np.sqrt(np.clip(strength[m], 1, None)) * np.sqrt(hub)
-        wts /= wts.mean()
-    r = A @ params - y
-    # parameter covariance: sigma^2 (A^T W A)^-1 with the residual scale of the weighted fit
-    sigma2 = max(float(np.mean((r * wts) ** 2)), cfg.huber_m ** 2 / 4)
-    cov = sigma2 * np.linalg.pinv(normal)
+        w2 = base * hub
+        w2 /= w2.mean()
+    params = sol * unscale
+    # parameter covariance: sigma^2 (A^T W A)^-1 with the weighted residual scale, back in unscaled units
+    sigma2 = max(float(np.sum(w2 * r * r) / max(len(r) - 5, 1)), sig * sig / 4)
+    cov = sigma2 * np.linalg.inv(normal) * np.outer(unscale, unscale)
     return params, r, m, cov
 
 
@@ -96,7 +97,7 @@ def _grow(pts, sides, strength, cfg: FitConfig):
     """Fit, re-gate every point around the fitted boundaries, refit; (support, params, sides, r, m, cov, nl, nr)."""
     if (sides != 0).sum() < cfg.min_points:
         return None
-    for _ in range(3):
+    for _ in range(2):
         params, r, m, cov = _solve(pts, sides, strength, cfg)
         x = pts[:, 0]
         pred = params[0] + params[1] * x + params[2] * x ** 2 + params[4] * x ** 3
