@@ -175,18 +175,19 @@ def bench(
     frames: int = typer.Option(30, help="Timed calls per stage (median is reported)."),
 ):
     """Per-stage cost on one thread, against the named peers measured in the same run (ratio = ours / peer)."""
-    from percept.drive.bench import bench_render
+    from percept.drive.bench import bench_lanes, bench_render
 
     if frames < 1:
         fail(f"--frames must be at least 1, got {frames}")
     with progress_bar() as bar:
-        task = bar.add_task("benchmarking", total=2 * (frames + 2))
-        results = [bench_render(frames, progress=lambda: bar.advance(task))]
+        task = bar.add_task("benchmarking", total=3 * (frames + 2))
+        tick = lambda: bar.advance(task)  # noqa: E731
+        results = [bench_render(frames, progress=tick), bench_lanes(frames, progress=tick)]
     t = Table(title="percept bench (one thread, median ms per call)")
-    for col in ("stage", "ms", "peer", "peer ms", "ratio"):
-        t.add_column(col, justify="right" if col in ("ms", "peer ms", "ratio") else "left")
+    for col in ("stage", "ms", "target ms", "peer", "peer ms", "ratio"):
+        t.add_column(col, justify="left" if col in ("stage", "peer") else "right")
     for r in results:
-        t.add_row(r.stage, f"{r.ms:.2f}", r.peer, f"{r.peer_ms:.2f}", f"{r.ratio:.2f}")
+        t.add_row(r.stage, f"{r.ms:.2f}", _num(r.target_ms), r.peer or "-", _num(r.peer_ms), _num(r.ratio))
     console.print(t)
     write_json(json_path, {"stages": [r.to_dict() for r in results]})
 

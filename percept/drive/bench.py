@@ -16,20 +16,24 @@ import numpy as np
 
 @dataclass(frozen=True)
 class StageCost:
-    """stage: what was timed; ms: median milliseconds per call; peer: the peer's name; peer_ms; ratio = ms / peer_ms."""
+    """stage: what was timed; ms: median milliseconds per call; peer: the peer's name and peer_ms its cost in the
+    same run (None where no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any."""
 
     stage: str
     ms: float
-    peer: str
-    peer_ms: float
+    peer: str | None = None
+    peer_ms: float | None = None
+    target_ms: float | None = None
 
     @property
-    def ratio(self) -> float:
-        return self.ms / self.peer_ms
+    def ratio(self) -> float | None:
+        return self.ms / self.peer_ms if self.peer_ms else None
 
     def to_dict(self) -> dict:
-        return {"stage": self.stage, "ms": round(self.ms, 3), "peer": self.peer, "peer_ms": round(self.peer_ms, 3),
-                "ratio": round(self.ratio, 3)}
+        r = self.ratio
+        return {"stage": self.stage, "ms": round(self.ms, 3), "peer": self.peer,
+                "peer_ms": None if self.peer_ms is None else round(self.peer_ms, 3),
+                "ratio": None if r is None else round(r, 3), "target_ms": self.target_ms}
 
 
 def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2) -> float:
@@ -74,4 +78,28 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
     ms = median_ms(ours, frames)
     peer_ms = median_ms(peer, frames)
     world.env.close()
-    return StageCost("render stereo pair 640x480", ms, "highway-env top-down render()", peer_ms)
+    return StageCost("render stereo pair 640x480", ms, "highway-env top-down render()", peer_ms, None)
+
+
+def bench_lanes(frames: int = 30, seed: int = 0, progress: Callable[[], None] | None = None) -> StageCost:
+    """The lanes stage (evidence, fit, tracking) on rendered ``curves`` frames, 640x480, one thread."""
+    from percept.lanes import LaneDetector
+    from percept.sims import SimWorld, WorldConfig
+
+    cv2.setNumThreads(1)
+    world = SimWorld(WorldConfig("curves", seed=seed, autopilot=True))
+    shots = []
+    for _ in range(frames):
+        frame, _ = world.observe()
+        shots.append(frame)
+        world.step()
+    det = LaneDetector(world.cfg.rig)
+    it = iter(range(10**9))
+
+    def ours():
+        f = shots[next(it) % len(shots)]
+        det.process(f.left, f.wheel_speed_mps, f.imu.yaw_rate_rps, world.dt)
+        if progress:
+            progress()
+
+    return StageCost("lanes (640x480 frame)", median_ms(ours, frames), target_ms=3.0)

@@ -82,7 +82,10 @@ def test_bench_prints_the_render_ratio(tmp_path):
     out = tmp_path / "bench.json"
     r = runner.invoke(app, ["bench", "--frames", "2", "--json", str(out)])
     assert r.exit_code == 0, r.output
-    stage = json.loads(out.read_text())["stages"][0]
+    stages = {s["stage"].split()[0]: s for s in json.loads(out.read_text())["stages"]}
+    stage = stages["render"]
     assert stage["peer"].startswith("highway-env")
     assert stage["ms"] > 0 and stage["peer_ms"] > 0
     assert stage["ratio"] == pytest.approx(stage["ms"] / stage["peer_ms"], rel=1e-2)
+    lanes = stages["lanes"]
+    assert lanes["ms"] > 0 and lanes["peer"] is None and lanes["ratio"] is None and lanes["target_ms"] == 3.0
