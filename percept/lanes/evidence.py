@@ -62,13 +62,18 @@ class MarkingExtractor:
                       & (self.uv[..., 1] <= cam.height - 1))
         self.w_px = max(int(round(cfg.marking_width_m / cfg.dy_m)), 1)
         self.size = (cam.width, cam.height)
+        self.first_row = max(int(np.floor(self.uv[..., 1][self.valid].min())) - 1, 0) if self.valid.any() else 0
 
     def birdseye(self, image: np.ndarray) -> np.ndarray:
         """Top-down marking brightness max(R, G) (rows, cols) float32; rows go from near to far."""
         if image.shape[1::-1] != self.size:
             raise ValueError(f"image is {image.shape[1]}x{image.shape[0]}, the rig expects {self.size[0]}x{self.size[1]}")
-        top = cv2.warpPerspective(image, self.M, (self.cols, self.rows), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
-        return np.maximum(top[..., 1], top[..., 2]).astype(np.float32)
+        # max(R, G) on the road rows only, then one single-channel warp
+        r0 = self.first_row
+        bright = np.zeros(image.shape[:2], np.uint8)
+        cv2.max(image[r0:, :, 1], image[r0:, :, 2], dst=bright[r0:])
+        top = cv2.warpPerspective(bright, self.M, (self.cols, self.rows), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
+        return top.astype(np.float32)
 
     def extract(self, image: np.ndarray) -> MarkingEvidence:
         b = self.birdseye(image)
