@@ -130,9 +130,6 @@ def test_racetrack_paints_its_own_line_types(racetrack_full):
     assert _paint_grey(racetrack_full, arc, 1.0, 9.0, 2.5) > _paint_grey(racetrack_full, arc, 1.0, 9.0, 0.0) + 60
 
 
-@pytest.mark.xfail(strict=True, reason="render/ground.py paint(): all marking polygons of one colour go to one "
-                   "cv2.fillPoly call, which fills overlaps even-odd; racetrack's lanes both declare their shared "
-                   "striped line, so the duplicated dashes cancel and show as hollow outlines")
 def test_racetrack_shared_dashed_line_is_painted(racetrack_full):
     # the dash from s = 12 m to 15 m of the line between lanes ("a", "b", 0) and ("a", "b", 1)
     dash = _paint_grey(racetrack_full, ("a", "b", 0), 2.0, 13.5, 2.5)

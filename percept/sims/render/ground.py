@@ -5,6 +5,10 @@ ground plane: the ground depth map is computed once, and the world-locked grain 
 warp per distance band of a mip-mapped tile (the band's level follows the pixel footprint, so the far
 field is pre-filtered and does not shimmer). Road surfaces and markings are polygons on the ground
 plane, projected with the ground homography (Hartley & Zisserman, sec. 8.1) and filled by OpenCV.
+
+Cost per frame: one warp per band from a pre-tiled mip level (texture coordinates stay inside the
+image, OpenCV's fast path), the road surface as a mask OR-ed into the grain (grain values 0..127 are
+grass, 128..255 asphalt), one colour-map lookup, the paint polygons, and haze on the few far rows.
 """
 
 from __future__ import annotations
@@ -17,14 +21,15 @@ import numpy as np
 
 from percept.sensors import Pose2D, Side, StereoRig
 
-from ..road_geometry import YELLOW, RoadGeometry
-from .raster import NEAR_M
+from ..road_geometry import RoadGeometry
+from .paint import GroundPaint, RoadIndex, ground_paint
 from .textures import ground_tile, mip_chain
 
 TILE_M = 8.0
-FAR_M = 220.0
-"""Road paint and surfaces are drawn up to this distance ahead [m]."""
-MIP_LEVELS = 6
+TILE_PX = 1024
+MIP_LEVELS = 8
+"""Grain mip levels 0..7 (1024 px down to 8 px per 8 m tile); rows needing a coarser level get the mean."""
+HAZE_START_M, HAZE_RANGE_M, HAZE_MAX = 60.0, 400.0, 0.85
 
 
 @dataclass(frozen=True)
@@ -41,10 +46,25 @@ class Palette:
 
 
 def _lut(color: tuple, contrast: float) -> np.ndarray:
-    """256-entry colour table: albedo a -> colour * (1 + contrast (a - 128)/128)."""
-    a = (np.arange(256, dtype=np.float32) - 128.0) / 128.0
+    """128-entry colour table for 7-bit albedo g (albedo a = 2g + 1): colour * (1 + contrast (a - 128)/128)."""
+    a = (2.0 * np.arange(128, dtype=np.float32) + 1.0 - 128.0) / 128.0
     table = np.asarray(color, np.float32)[None, :] * (1.0 + contrast * a[:, None])
-    return np.clip(table, 0, 255).astype(np.uint8).reshape(1, 256, 3)
+    return np.clip(np.round(table), 0, 255).astype(np.uint8)
+
+
+@dataclass(frozen=True)
+class _Band:
+    """Image rows r0..r1 drawn from mip ``level``: ``tiled`` holds n x n copies of the level's tile so that
+    the band's texture coordinates, shifted by whole tiles, stay inside it. centre_m: band footprint centre
+    (vehicle frame), radius_m: its radius; texel_per_m: the level's scale."""
+
+    r0: int
+    r1: int
+    level: int
+    tiled: np.ndarray
+    centre_m: np.ndarray
+    radius_m: float
+    texel_per_m: float
 
 
 class GroundLayer:
@@ -66,120 +86,139 @@ class GroundLayer:
             z = d / denom
         self.ground_mask = (denom < -1e-6) & (z > 0)
         self.ground_depth = np.where(self.ground_mask, z, np.inf).astype(np.float32)
-        self.first_row = int(np.argmax(self.ground_mask.any(axis=1))) if self.ground_mask.any() else H
-        # sky gradient, top to horizon
+        # 1/Z of the ground (0 for sky): the z-buffer the rasteriser starts from
+        self.ground_inv_depth = np.where(self.ground_mask, 1.0 / np.where(self.ground_mask, z, 1.0), 0.0)
+        self.ground_inv_depth = self.ground_inv_depth.astype(np.float32)
+        # the rig only pitches, so the horizon is a row: every row is all sky or all ground
+        rows_ground = self.ground_mask.any(axis=1)
+        self.first_row = int(np.argmax(rows_ground)) if rows_ground.any() else H
+        if not self.ground_mask[self.first_row:].all():
+            raise ValueError("GroundLayer needs a level horizon (a rig without roll)")
         rows = np.arange(H, dtype=np.float32)
         a = np.clip(rows / max(rig.horizon_row, 1.0), 0, 1)[:, None]
         sky = (1 - a) * np.asarray(palette.sky_top, np.float32) + a * np.asarray(palette.sky_horizon, np.float32)
-        self.sky = np.repeat(sky[:, None, :], W, axis=1).astype(np.uint8)
-        # mip bands by pixel footprint: level = log2(texels per pixel), geometric mean of both directions
-        ppm = 1024 / TILE_M
+        self.sky = np.ascontiguousarray(np.repeat(sky[:, None, :], W, axis=1).astype(np.uint8))
+        self._init_bands(seed)
+        # colour map of the combined grain: 0..127 grass, 128..255 asphalt
+        self.cmap = np.concatenate([_lut(palette.grass, 0.55), _lut(palette.asphalt, 0.35)]).reshape(256, 1, 3)
+        self._init_haze()
+        self._ids = np.where(self.ground_mask, 0, -1).astype(np.int32)
+        self._mask = np.zeros((H, W), np.uint8)
+        self._index: tuple[RoadGeometry, RoadIndex] | None = None
+
+    def _init_bands(self, seed: int) -> None:
+        cam, rig = self.rig.camera, self.rig
+        H, W = cam.height, cam.width
+        r0 = self.first_row
+        ppm = TILE_PX / TILE_M
         zc = self.ground_depth[:, W // 2].astype(np.float64)
-        dist = np.where(np.isfinite(zc), zc * math.cos(rig.pitch_rad), 1e6)
+        # horizontal distance along the ground of each row's centre pixel
+        self.row_dist_m = np.where(np.isfinite(zc), zc * math.cos(rig.pitch_rad), np.inf)
+        dist = np.where(np.isfinite(self.row_dist_m), self.row_dist_m, 1e9)
+        # mip level = log2(texels per pixel), geometric mean of the lateral and longitudinal footprints
         lat = dist / cam.fx
         lon = np.abs(np.gradient(dist))
         with np.errstate(invalid="ignore", divide="ignore"):
-            lvl = np.clip(np.round(np.log2(np.sqrt(lat * np.maximum(lon, 1e-9)) * ppm)), 0, MIP_LEVELS - 1)
-        self.bands: list[tuple[int, int, int]] = []
-        r = self.first_row
+            lvl = np.clip(np.round(np.log2(np.sqrt(lat * np.maximum(lon, 1e-9)) * ppm)), 0, MIP_LEVELS)
+        lvl = lvl.astype(int)
+        # vehicle-frame ground point of every ground pixel, for the band footprints
+        mips = mip_chain(ground_tile(seed, TILE_PX), MIP_LEVELS - 1)
+        self.bands: list[_Band] = []
+        r = r0
         while r < H:
-            k = int(lvl[r]) if np.isfinite(lvl[r]) else MIP_LEVELS - 1
+            k = int(lvl[r])
             r1 = r
-            while r1 < H and (int(lvl[r1]) if np.isfinite(lvl[r1]) else MIP_LEVELS - 1) == k:
+            while r1 < H and int(lvl[r1]) == k:
                 r1 += 1
-            self.bands.append((r, r1, k))
+            if k < MIP_LEVELS:
+                # the ground homography maps the band's pixel rectangle to a quadrilateral: its corners bound it
+                pts = self.rig.image_to_ground(np.array([[0, r], [W - 1, r], [0, r1 - 1], [W - 1, r1 - 1]]), self.side)
+                centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
+                radius = float(np.linalg.norm(pts - centre, axis=1).max())
+                scale = ppm / 2 ** k
+                tile = mips[k] // 2  # 7-bit albedo
+                # the band spans 2 radius scale texels, plus up to one tile of alignment slack and 2 for bilinear
+                n = int(math.ceil((2 * radius * scale + 2) / tile.shape[0])) + 1
+                self.bands.append(_Band(r, r1, k, np.tile(tile, (n, n)), centre, radius, scale))
             r = r1
-        self.mips = mip_chain(ground_tile(seed), MIP_LEVELS - 1)
-        self.ppm = ppm
-        # distance haze on the ground, per row
-        haze = np.clip((dist - 60.0) / 400.0, 0, 0.85)
-        haze[~np.isfinite(haze)] = 0.85
-        self.haze_alpha = haze.astype(np.float32)
-        self.lut_grass = _lut(palette.grass, 0.55)
-        self.lut_asphalt = _lut(palette.asphalt, 0.35)
+
+    def _init_haze(self) -> None:
+        # aerial perspective on the ground: colour <- colour (1 - a) + haze a, a = clip((dist - 60) / 400, 0, 0.85)
+        H = self.rig.camera.height
+        a = np.clip((self.row_dist_m - HAZE_START_M) / HAZE_RANGE_M, 0, HAZE_MAX)
+        a[~np.isfinite(a)] = HAZE_MAX
+        a[:self.first_row] = 0
+        rows = np.flatnonzero(a > 0)
+        self.haze_rows = (int(rows.min()), int(rows.max()) + 1) if len(rows) else (H, H)
+        h0, h1 = self.haze_rows
+        # fixed point with 8 fractional bits: out = (img (256 - A) + A haze) >> 8
+        A = np.round(a[h0:h1] * 256).astype(np.uint16)
+        self._haze_keep = (256 - A)[:, None, None]
+        haze = np.asarray(self.palette.haze, np.uint16)[None, None, :]
+        self._haze_add = (A[:, None, None] * haze + 128).astype(np.uint16)
 
     def grain(self, pose: Pose2D) -> np.ndarray:
-        """World-locked ground albedo (H, W) uint8 for the vehicle at ``pose`` (rows above the ground are 128)."""
+        """World-locked 7-bit ground albedo (H - first_row, W) uint8 for the vehicle at ``pose``."""
         cam = self.rig.camera
-        out = np.full((cam.height, cam.width), 128, np.uint8)
-        # world position modulo the tile, so texture coordinates stay small
-        ox = pose.x_m - TILE_M * math.floor(pose.x_m / TILE_M)
-        oy = pose.y_m - TILE_M * math.floor(pose.y_m / TILE_M)
+        r0 = self.first_row
+        out = np.full((cam.height - r0, cam.width), 64, np.uint8)
         c, s = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
-        world_from_veh = np.array([[c, -s, ox], [s, c, oy], [0, 0, 1.0]])
-        for r0, r1, k in self.bands:
-            scale = self.ppm / (2 ** k)
-            tex_from_world = np.array([[scale, 0, 0], [0, scale, 0], [0, 0, 1.0]])
-            shift = np.array([[1, 0, 0], [0, 1, r0], [0, 0, 1.0]])
-            M = tex_from_world @ world_from_veh @ self.Hg_inv @ shift
-            cv2.warpPerspective(self.mips[k], M, (cam.width, r1 - r0), dst=out[r0:r1],
-                                flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_WRAP)
+        Rz = np.array([[c, -s], [s, c]])
+        # world position modulo the tile, so texture coordinates stay small
+        o = np.array([pose.x_m % TILE_M, pose.y_m % TILE_M])
+        for b in self.bands:
+            tile_px = TILE_PX >> b.level
+            # texel of the band centre; shift by whole tiles so that the band's lowest texel is >= 0
+            tc = b.texel_per_m * (Rz @ b.centre_m + o)
+            shift = np.floor((tc - b.texel_per_m * b.radius_m - 1) / tile_px) * tile_px
+            # pixel (u, v - r0) -> ground (vehicle) -> world mod tile -> texel
+            tex_from_veh = np.array([[b.texel_per_m * c, -b.texel_per_m * s, b.texel_per_m * o[0] - shift[0]],
+                                     [b.texel_per_m * s, b.texel_per_m * c, b.texel_per_m * o[1] - shift[1]],
+                                     [0.0, 0.0, 1.0]])
+            rowshift = np.array([[1, 0, 0], [0, 1, b.r0], [0, 0, 1.0]])
+            M = tex_from_veh @ self.Hg_inv @ rowshift
+            cv2.warpPerspective(b.tiled, M, (cam.width, b.r1 - b.r0), dst=out[b.r0 - r0:b.r1 - r0],
+                                flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE)
         return out
 
-    def paint(self, pose: Pose2D, road: RoadGeometry) -> tuple[np.ndarray, np.ndarray]:
-        """Sky, grass, road surface and markings: image (H, W, 3) uint8 and depth (H, W) float32 [m]."""
+    def ground_ids(self) -> np.ndarray:
+        """Fresh id map of the background: 0 on the ground, -1 in the sky."""
+        return self._ids.copy()
+
+    def road_index(self, road: RoadGeometry) -> RoadIndex:
+        if self._index is None or self._index[0] is not road:
+            self._index = (road, RoadIndex(road))
+        return self._index[1]
+
+    def paint(self, pose: Pose2D, road: RoadGeometry, prepared: GroundPaint | None = None, depth: bool = True
+              ) -> tuple[np.ndarray, np.ndarray | None]:
+        """Sky, grass, road surface and markings: image (H, W, 3) uint8 and depth (H, W) float32 [m] (a fresh
+        copy, or None when not ``depth``).
+
+        prepared: the road's polygons near ``pose`` (``ground_paint``), shared by the two cameras."""
         cam = self.rig.camera
         H, W = cam.height, cam.width
-        grain = self.grain(pose)
-        g3 = cv2.merge([grain, grain, grain])
-        img = cv2.LUT(g3, self.lut_grass)
-        road_mask = np.zeros((H, W), np.uint8)
-        polys = self._surface_polygons(pose, road)
-        if polys:
-            cv2.fillPoly(road_mask, polys, 255, lineType=cv2.LINE_8, shift=4)
-            asphalt = cv2.LUT(g3, self.lut_asphalt)
-            cv2.copyTo(asphalt, road_mask, img)
-        self._paint_markings(img, pose, road)
         r0 = self.first_row
-        # aerial perspective: blend towards the haze colour with distance
-        a = self.haze_alpha[r0:, None, None]
-        img[r0:] = (img[r0:] * (1 - a) + a * np.asarray(self.palette.haze, np.float32)).astype(np.uint8)
+        img = np.empty((H, W, 3), np.uint8)
         img[:r0] = self.sky[:r0]
-        sky_rows = ~self.ground_mask
-        img[sky_rows] = self.sky[sky_rows]
-        return img, self.ground_depth.copy()
-
-    def _to_image(self, xy_v: np.ndarray) -> np.ndarray:
-        """Vehicle-frame ground points (..., 2) -> pixel coordinates (..., 2), fixed-point with 4 fractional bits."""
-        p = xy_v @ self.Hg[:, :2].T + self.Hg[:, 2]
-        uv = p[..., :2] / p[..., 2:3]
-        return np.clip(np.round(uv * 16), -2**24, 2**24).astype(np.int32)
-
-    def _surface_polygons(self, pose: Pose2D, road: RoadGeometry) -> list[np.ndarray]:
-        polys = []
-        near = self.rig.mount_x_m + NEAR_M
-        for strip in road.strips:
-            lv = pose.to_vehicle_xy(strip.left)
-            rv = pose.to_vehicle_xy(strip.right)
-            ok = (lv[:, 0] > near) & (rv[:, 0] > near) & (lv[:, 0] < FAR_M) & (np.abs(lv[:, 1]) < FAR_M)
-            if ok.sum() < 2:
-                continue
-            # contiguous runs of visible samples, one polygon each
-            idx = np.flatnonzero(ok)
-            splits = np.flatnonzero(np.diff(idx) > 1) + 1
-            for run in np.split(idx, splits):
-                if len(run) < 2:
-                    continue
-                pts = np.concatenate([lv[run], rv[run][::-1]])
-                polys.append(self._to_image(pts))
-        return polys
-
-    def _paint_markings(self, img: np.ndarray, pose: Pose2D, road: RoadGeometry) -> None:
-        q = road.marking_quads
-        if not len(q):
-            return
-        c = q.mean(axis=1)
-        d = c - np.array([pose.x_m, pose.y_m])
-        close = (np.abs(d[:, 0]) < FAR_M) & (np.abs(d[:, 1]) < FAR_M)
-        qv = pose.to_vehicle_xy(q[close])
-        near = self.rig.mount_x_m + NEAR_M
-        ok = (qv[..., 0].min(axis=1) > near) & (qv[..., 0].max(axis=1) < FAR_M)
-        qv = qv[ok]
-        colors = road.marking_color[close][ok]
-        if not len(qv):
-            return
-        pix = self._to_image(qv)
-        for col_id, col in ((0, self.palette.white_paint), (YELLOW, self.palette.yellow_paint)):
-            sel = colors == col_id
-            if sel.any():
-                cv2.fillPoly(img, list(pix[sel]), col, lineType=cv2.LINE_AA, shift=4)
+        if r0 >= H:
+            return img, self.ground_depth.copy() if depth else None
+        grain = self.grain(pose)
+        if prepared is None:
+            prepared = ground_paint(self.road_index(road), pose, self.rig, self.palette)
+        surfaces, marks = prepared.project(self.Hg)
+        if surfaces:
+            mask = self._mask
+            mask[r0:] = 0
+            # one call per strip: fillPoly fills overlapping polygons of one call even-odd
+            for polys in surfaces:
+                cv2.fillPoly(mask, polys, 128, lineType=cv2.LINE_8, shift=4)
+            cv2.bitwise_or(grain, mask[r0:], dst=grain)
+        cv2.applyColorMap(grain, self.cmap, dst=img[r0:])
+        for polys, color in marks:
+            cv2.fillPoly(img, polys, color, lineType=cv2.LINE_AA, shift=4)
+        h0, h1 = self.haze_rows
+        if h1 > h0:
+            rows = img[h0:h1].astype(np.uint16)
+            img[h0:h1] = ((rows * self._haze_keep + self._haze_add) >> 8).astype(np.uint8)
+        return img, self.ground_depth.copy() if depth else None

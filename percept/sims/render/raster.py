@@ -1,228 +1,247 @@
 """Z-buffered rasterisation of planar patches for the stereo renderer.
 
 A patch is a planar polygon ``{o + s e1 + t e2 : (s, t) in outline}`` with ``(s, t)`` in the unit
-square (a quad, an ellipse, …). Depth is exact per pixel: for the plane ``n·X = d`` (camera frame)
-and the pixel ray ``r = K^-1 (u, v, 1)``, the depth is ``Z = d / (n·r)``. Textures are mapped with
-the plane homography ``H = K [e1/w, e2/h, o]`` (Hartley & Zisserman, sec. 8.1).
+square (a quad or the ellipse inscribed in it). With the camera-frame matrix ``A = K [e1 e2 o]``
+(the plane homography, Hartley & Zisserman, sec. 8.1), a pixel ``(u, v)`` sees the plane point
+
+    (s/Z, t/Z, 1/Z) = A^-1 (u, v, 1)
+
+so the inverse depth ``1/Z`` and the texture coordinates are affine in ``(u, v)`` up to one division.
+Depth is exact per pixel, the inside test is exact at pixel centres (quad: ``0 <= s, t <= 1``; ellipse:
+``(s - 1/2)^2 + (t - 1/2)^2 <= 1/4``), and the nearest plane wins (largest ``1/Z``).
+
+Patches are culled and prepared in one vectorised pass (back faces, near plane, image bounds, level of
+detail, texture mip level); ``fragments.py`` then fills them row span by row span: large patches one by
+one over their bounding box with OpenCV texture warps, small ones all at once as per-pixel fragments
+shaded from a mip-mapped texture atlas.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import cv2
 import numpy as np
 
 from percept.sensors import PinholeCamera, Transform
 
+from .fragments import PreparedPatches, rasterize_prepared
+from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
+from .textures import TextureAtlas
+
+__all__ = ["ELLIPSE", "LOD_PX", "NEAR_M", "OUTLINES", "QUAD", "PatchBatch", "PatchBuilder", "RenderTarget",
+           "prepare", "rasterize"]
+
 NEAR_M = 0.3
 """Near clipping plane [m]: geometry closer to the camera than this is cut away."""
-
-QUAD = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-_phi = np.linspace(0.0, 2 * np.pi, 20, endpoint=False)
-ELLIPSE = np.column_stack([0.5 + 0.5 * np.cos(_phi), 0.5 + 0.5 * np.sin(_phi)])
-OUTLINES = [QUAD, ELLIPSE]
-"""Outline index 0: quad, 1: ellipse inscribed in the quad."""
-
-
-@dataclass
-class PatchBatch:
-    """Planar patches in the world frame, struct-of-arrays. P patches.
-
-    origin, e1, e2: (P, 3) [m]; color: (P, 3) BGR 0..255 before shading; texture: (P,) index into the
-    renderer's texture bank, -1 for none; outline: (P,) index into OUTLINES; obj_id: (P,) object id
-    (0 for scenery); two_sided: (P,) bool, False = culled when seen from the back (e1 x e2 points out);
-    shade: (P,) bool, False = emissive (lights, sign faces keep their colour).
-    """
-
-    origin: np.ndarray
-    e1: np.ndarray
-    e2: np.ndarray
-    color: np.ndarray
-    texture: np.ndarray
-    outline: np.ndarray
-    obj_id: np.ndarray
-    two_sided: np.ndarray
-    shade: np.ndarray
-
-    @staticmethod
-    def empty() -> "PatchBatch":
-        z3 = np.zeros((0, 3))
-        zi = np.zeros(0, dtype=np.int32)
-        zb = np.zeros(0, dtype=bool)
-        return PatchBatch(z3, z3, z3, z3, zi, zi, zi, zb, zb)
-
-    def __len__(self) -> int:
-        return len(self.origin)
-
-    @staticmethod
-    def concat(batches: list["PatchBatch"]) -> "PatchBatch":
-        batches = [b for b in batches if len(b)]
-        if not batches:
-            return PatchBatch.empty()
-        return PatchBatch(*[np.concatenate([getattr(b, f) for b in batches]) for f in PatchBatch.__dataclass_fields__])
-
-
-class PatchBuilder:
-    """Accumulates patches one by one (readable model code), then packs them into a PatchBatch."""
-
-    def __init__(self) -> None:
-        self._rows: list[tuple] = []
-
-    def add(self, origin, e1, e2, color, *, texture: int = -1, outline: int = 0, obj_id: int = 0,
-            two_sided: bool = False, shade: bool = True) -> None:
-        self._rows.append((origin, e1, e2, color, texture, outline, obj_id, two_sided, shade))
-
-    def box(self, center, axes, size, color, *, texture: int = -1, obj_id: int = 0, bottom: bool = False,
-            shade: bool = True) -> None:
-        """Axis-aligned box in its own frame: center (3,), axes (3, 3) rows = unit x, y, z, size (3,) [m].
-
-        Faces are oriented so that e1 x e2 points outwards (for back-face culling).
-        """
-        c = np.asarray(center, dtype=np.float64)
-        ax = np.asarray(axes, dtype=np.float64)
-        hx, hy, hz = (np.asarray(size, dtype=np.float64) / 2)[:, None] * ax
-        faces = [
-            (c + hx - hy - hz, 2 * hy, 2 * hz),  # front (+x)
-            (c - hx + hy - hz, -2 * hy, 2 * hz),  # back (-x)
-            (c + hx + hy - hz, -2 * hx, 2 * hz),  # left (+y)
-            (c - hx - hy - hz, 2 * hx, 2 * hz),  # right (-y)
-            (c - hx - hy + hz, 2 * hx, 2 * hy),  # top (+z)
-        ]
-        if bottom:
-            faces.append((c - hx + hy - hz, 2 * hx, -2 * hy))
-        for o, a, b in faces:
-            self.add(o, a, b, color, texture=texture, obj_id=obj_id, shade=shade)
-
-    def build(self) -> PatchBatch:
-        if not self._rows:
-            return PatchBatch.empty()
-        cols = list(zip(*self._rows))
-        return PatchBatch(
-            np.asarray(cols[0], dtype=np.float64).reshape(-1, 3),
-            np.asarray(cols[1], dtype=np.float64).reshape(-1, 3),
-            np.asarray(cols[2], dtype=np.float64).reshape(-1, 3),
-            np.asarray(cols[3], dtype=np.float64).reshape(-1, 3),
-            np.asarray(cols[4], dtype=np.int32),
-            np.asarray(cols[5], dtype=np.int32),
-            np.asarray(cols[6], dtype=np.int32),
-            np.asarray(cols[7], dtype=bool),
-            np.asarray(cols[8], dtype=bool),
-        )
+LOD_PX = 0.5
+"""Scenery patches narrower than this on screen [px] are skipped."""
+_NEXT = np.array([1, 2, 3, 0])
+"""Index of the next corner around a patch."""
 
 
 @dataclass
 class RenderTarget:
     """What one camera's rasteriser writes. image: (H, W, 3) uint8 BGR; depth: (H, W) float32 camera z [m]
-    (inf where nothing is); ids: (H, W) int32 object id per pixel (0 = road or scenery, -1 = sky)."""
+    (inf where nothing is) or None to skip; ids: (H, W) int32 object id per pixel (0 = road or scenery,
+    -1 = sky) or None to skip; inv_depth: (H, W) float32 1/z, the z-buffer (None: derived from depth);
+    base_inv_depth: what inv_depth held before any patch (None: a copy is taken), to find the pixels
+    patches were drawn on."""
 
     image: np.ndarray
-    depth: np.ndarray
-    ids: np.ndarray
-    pieces: dict[int, list] = field(default_factory=dict)
-    """Per object id, its patches' masks (x0, y0, mask) before the z-test: the silhouette without occluders."""
+    depth: np.ndarray | None
+    ids: np.ndarray | None
+    inv_depth: np.ndarray | None = None
+    base_inv_depth: np.ndarray | None = None
+    silhouettes: dict[int, list[np.ndarray]] = field(default_factory=dict)
+    """Per object id, flat pixel indices (row * W + col) its patches cover before the z-test: the
+    silhouette without occluders (may repeat pixels)."""
+
+    def __post_init__(self) -> None:
+        if self.inv_depth is None:
+            if self.depth is None:
+                raise ValueError("RenderTarget needs inv_depth or depth (the z-buffer to start from)")
+            with np.errstate(divide="ignore"):
+                self.inv_depth = np.where(np.isfinite(self.depth), 1.0 / self.depth, 0.0).astype(np.float32)
+        if self.base_inv_depth is None:
+            self.base_inv_depth = self.inv_depth.copy()
+
+    def silhouette(self, obj_id: int) -> tuple[tuple[int, int, int, int], int, int] | None:
+        """The object's unoccluded silhouette: its tight box (u0, v0, u1, v1) (u1, v1 exclusive), its pixel
+        count, and how many of those pixels show the object (``ids``; 0 without ids). None if it has none."""
+        parts = self.silhouettes.get(obj_id)
+        if not parts:
+            return None
+        pix = np.concatenate(parts)
+        if not len(pix):
+            return None
+        W = self.image.shape[1]
+        v0, v1 = int(pix.min()) // W, int(pix.max()) // W + 1
+        # union of the parts on the rows they span
+        mark = np.zeros((v1 - v0, W), bool)
+        mark.reshape(-1)[pix - v0 * W] = True
+        rows = np.flatnonzero(mark.any(axis=1))
+        cols = np.flatnonzero(mark.any(axis=0))
+        seen = int(np.count_nonzero(mark & (self.ids[v0:v1] == obj_id))) if self.ids is not None else 0
+        box = (int(cols[0]), v0 + int(rows[0]), int(cols[-1]) + 1, v0 + int(rows[-1]) + 1)
+        return box, int(np.count_nonzero(mark)), seen
 
     def silhouette_px(self, obj_id: int) -> int:
         """Pixels the object would cover inside the image if nothing occluded it."""
-        parts = self.pieces.get(obj_id)
-        if not parts:
-            return 0
-        x0 = min(p[0] for p in parts)
-        y0 = min(p[1] for p in parts)
-        x1 = max(p[0] + p[2].shape[1] for p in parts)
-        y1 = max(p[1] + p[2].shape[0] for p in parts)
-        union = np.zeros((y1 - y0, x1 - x0), bool)
-        for px, py, m in parts:
-            union[py - y0:py - y0 + m.shape[0], px - x0:px - x0 + m.shape[1]] |= m
-        return int(union.sum())
-
-
-def clip_near(points: np.ndarray, near: float = NEAR_M) -> np.ndarray:
-    """Sutherland–Hodgman clip of a polygon (M, 3), camera frame, against the plane z = near."""
-    out = []
-    n = len(points)
-    for i in range(n):
-        a, b = points[i], points[(i + 1) % n]
-        ina, inb = a[2] >= near, b[2] >= near
-        if ina:
-            out.append(a)
-        if ina != inb:
-            # point on segment a + t (b - a) where z = near
-            t = (near - a[2]) / (b[2] - a[2])
-            out.append(a + t * (b - a))
-    return np.asarray(out).reshape(-1, 3)
+        s = self.silhouette(obj_id)
+        return s[1] if s else 0
 
 
 def rasterize(target: RenderTarget, batch: PatchBatch, cam: PinholeCamera, cam_from_world: Transform,
-              textures: list[np.ndarray], sun_dir_world: np.ndarray, ambient: float = 0.55) -> None:
-    """Draw ``batch`` into ``target`` with a z-test; camera pose ``cam_from_world``."""
+              textures: TextureAtlas | list[np.ndarray], sun_dir_world: np.ndarray, ambient: float = 0.55,
+              silhouettes: bool = True, lod_px: float = LOD_PX) -> None:
+    """Draw ``batch`` into ``target`` with a z-test; camera pose ``cam_from_world``.
+
+    silhouettes: record each object's unoccluded pixels in ``target.silhouettes``; lod_px: scenery
+    (obj_id 0) narrower than this on screen is skipped."""
+    atlas = textures if isinstance(textures, TextureAtlas) else TextureAtlas(list(textures))
+    prep = prepare(batch, cam, [cam_from_world], atlas, sun_dir_world, ambient, lod_px)[0]
+    if prep is not None:
+        rasterize_prepared(target, prep, atlas, silhouettes)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of (N, 3) arrays."""
+    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    return np.column_stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
+
+
+def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transform], atlas: TextureAtlas,
+            sun_dir_world: np.ndarray, ambient: float = 0.55, lod_px: float = LOD_PX) -> list[PreparedPatches | None]:
+    """Cull the batch for each camera and compute, per kept patch, its pixel box and inverse-homography rows.
+
+    The cameras must share their orientation (a rectified rig). Shading, level of detail and texture mip
+    levels are decided once for all cameras (by the first one that sees a patch), so that both images of
+    a stereo pair show the same things."""
     if not len(batch):
-        return
-    R, t = cam_from_world.R, cam_from_world.t
-    O = batch.origin @ R.T + t
+        return [None] * len(cams_from_world)
+    R = cams_from_world[0].R
+    if not all(np.allclose(T.R, R) for T in cams_from_world):
+        raise ValueError("prepare() needs cameras with one orientation (a rectified rig); render them one by one")
+    # shading in the world frame: ambient + diffuse |n·sun| (two-sided lighting)
+    nw = _cross(batch.e1, batch.e2)
+    lam = np.abs(nw @ sun_dir_world) / (np.sqrt(_dot(nw, nw)) + 1e-12)
+    shade = np.where(batch.shade, ambient + (1.0 - ambient) * lam, 1.0)
+    colors = np.clip(batch.color * shade[:, None], 0, 255).astype(np.float32)
     E1 = batch.e1 @ R.T
     E2 = batch.e2 @ R.T
-    N = np.cross(E1, E2)
-    # back-face test: a face is seen from the front when n·(o - camera) < 0, the camera being the origin
-    front = np.einsum("ij,ij->i", N, O) < 0
-    keep = front | batch.two_sided
-    # coarse frustum test on the parallelogram corners
-    corners = np.stack([O, O + E1, O + E2, O + E1 + E2], axis=1)  # (P, 4, 3)
-    zmax = corners[..., 2].max(axis=1)
-    keep &= zmax > NEAR_M
-    # shading in the world frame: ambient + diffuse * max(0, n·sun)
-    nw = np.cross(batch.e1, batch.e2)
-    nw /= np.linalg.norm(nw, axis=1, keepdims=True) + 1e-12
-    lam = np.abs(nw @ sun_dir_world)
-    shade = np.where(batch.shade, ambient + (1.0 - ambient) * lam, 1.0)
-    colors = np.clip(batch.color * shade[:, None], 0, 255)
-    # draw far to near so that the z-test rejects as early as possible is not needed; any order is exact
-    H, W = target.depth.shape
+    N = _cross(E1, E2)
+    O0 = batch.origin @ R.T
+    views = [_project(batch, cam, O0 + T.t, E1, E2, N) for T in cams_from_world]
+    # projected area and width per patch, from the first camera that sees it fully in front
+    area = np.full(len(batch), np.nan)
+    width = np.full(len(batch), np.nan)
+    for v in reversed(views):
+        if v is not None:
+            area[v["idx"]], width[v["idx"]] = v["area"], v["width"]
+    # level of detail: scenery (obj_id 0) narrower than lod_px, or smaller than lod_px^2, is skipped
+    with np.errstate(invalid="ignore"):
+        tiny = ((width < lod_px) | (area < lod_px * lod_px)) & (batch.obj_id == 0)
+    level = _mip_levels(batch, atlas, area)
+    return [None if v is None else _finish(batch, cam, v, tiny, level, colors, atlas) for v in views]
+
+
+def _project(batch: PatchBatch, cam: PinholeCamera, O: np.ndarray, E1: np.ndarray, E2: np.ndarray,
+             N: np.ndarray) -> dict | None:
+    """Per camera (patches in its frame: O, E1, E2, normals N): back faces and patches behind the near plane
+    culled, the rest with their pixel box (x0, x1, y0, y1), nearest depth, crossing flag, area, width."""
+    W, H = cam.width, cam.height
     fx, fy, cx, cy = cam.fx, cam.fy, cam.cx, cam.cy
-    K = cam.K
-    for i in np.flatnonzero(keep):
-        st = OUTLINES[batch.outline[i]]
-        pts = O[i] + st[:, :1] * E1[i] + st[:, 1:] * E2[i]
-        if pts[:, 2].min() < NEAR_M:
-            pts = clip_near(pts)
-            if len(pts) < 3:
-                continue
-        u = fx * pts[:, 0] / pts[:, 2] + cx
-        v = fy * pts[:, 1] / pts[:, 2] + cy
-        x0, x1 = max(int(np.floor(u.min())), 0), min(int(np.ceil(u.max())) + 1, W)
-        y0, y1 = max(int(np.floor(v.min())), 0), min(int(np.ceil(v.max())) + 1, H)
-        if x1 <= x0 or y1 <= y0:
-            continue
-        bw, bh = x1 - x0, y1 - y0
-        mask = np.zeros((bh, bw), np.uint8)
-        poly = np.round(np.column_stack([u - x0, v - y0]) * 16).astype(np.int32)
-        cv2.fillPoly(mask, [poly], 1, lineType=cv2.LINE_8, shift=4)
-        n = N[i]
-        d = float(n @ O[i])
-        # Z(u, v) = d / (n · ((u - cx)/fx, (v - cy)/fy, 1))
-        denom = (n[0] / fx) * (np.arange(x0, x1) - cx)[None, :] + ((n[1] / fy) * (np.arange(y0, y1) - cy) + n[2])[:, None]
+    # back-face test: a face is seen from the front when n·(o - camera) < 0, the camera being the origin
+    keep = (_dot(N, O) < 0) | batch.two_sided
+    # corners in order o, o + e1, o + e1 + e2, o + e2: depths first, for the near-plane test
+    z = np.column_stack([O[:, 2], O[:, 2] + E1[:, 2], O[:, 2] + E1[:, 2] + E2[:, 2], O[:, 2] + E2[:, 2]])
+    keep &= z.max(axis=1) > NEAR_M
+    idx = np.flatnonzero(keep)
+    if not len(idx):
+        return None
+    o, e1, e2, z = O[idx], E1[idx], E2[idx], z[idx]
+    C = np.stack([o, o + e1, o + e1 + e2, o + e2], axis=1)  # (P, 4, 3)
+    zmin = z.min(axis=1)
+    crossing = zmin < NEAR_M
+    if crossing.any():
+        # polygon clipped at z = NEAR: corners in front plus the edge crossings a + (near - z_a)/(z_b - z_a) (b - a)
+        Cn, zn = C[:, _NEXT], z[:, _NEXT]
+        cross = (z - NEAR_M) * (zn - NEAR_M) < 0
+        f = np.where(cross, NEAR_M - z, 0.0) / np.where(cross, zn - z, 1.0)
+        X = np.where(cross[..., None], C + f[..., None] * (Cn - C), np.nan)
+        P8 = np.concatenate([np.where((z >= NEAR_M)[..., None], C, np.nan), X], axis=1)
+    else:
+        P8 = C
+    with np.errstate(invalid="ignore"):
+        # u = fx x / z + cx, v = fy y / z + cy
+        u = fx * P8[..., 0] / P8[..., 2] + cx
+        v = fy * P8[..., 1] / P8[..., 2] + cy
+        # pixel centres k with umin <= k <= umax (fmin and fmax skip the NaNs of corners behind the near plane)
+        x0 = np.clip(np.ceil(np.fmin.reduce(u, axis=1)), 0, W).astype(int)
+        x1 = np.clip(np.floor(np.fmax.reduce(u, axis=1)) + 1, 0, W).astype(int)
+        y0 = np.clip(np.ceil(np.fmin.reduce(v, axis=1)), 0, H).astype(int)
+        y1 = np.clip(np.floor(np.fmax.reduce(v, axis=1)) + 1, 0, H).astype(int)
+        # projected size of patches fully in front: area (shoelace) and width = area / longest side
+        uc, vc = u[:, :4], v[:, :4]
+        ur, vr = uc[:, _NEXT], vc[:, _NEXT]
+        area = 0.5 * np.abs(np.sum(uc * vr - ur * vc, axis=1))
+        width = area / np.sqrt(((uc - ur) ** 2 + (vc - vr) ** 2).max(axis=1))
+    area[crossing] = np.nan
+    width[crossing] = np.nan
+    return dict(idx=idx, o=o, e1=e1, e2=e2, x0=x0, x1=x1, y0=y0, y1=y1, zmin=zmin, crossing=crossing, area=area,
+                width=width)
+
+
+def _mip_levels(batch: PatchBatch, atlas: TextureAtlas, area: np.ndarray) -> np.ndarray:
+    """Texture mip level per patch: log2 of texels per pixel over its projected area (0 where unknown)."""
+    level = np.zeros(len(batch), int)
+    has = np.flatnonzero(batch.texture >= 0)
+    if len(has):
+        tex = batch.texture[has]
+        rep = batch.repeat[has]
+        tsz = atlas.sizes[tex]
+        texels = tsz[:, 0] * tsz[:, 1] * rep[:, 0] * rep[:, 1]
         with np.errstate(divide="ignore", invalid="ignore"):
-            Z = (d / denom).astype(np.float32)
-        zpatch = target.depth[y0:y1, x0:x1]
-        inside = mask.view(bool) & (Z > NEAR_M * 0.5)
-        oid = int(batch.obj_id[i])
-        if oid > 0:
-            target.pieces.setdefault(oid, []).append((x0, y0, inside))
-        vis = inside & (Z < zpatch)
-        if not vis.any():
-            continue
-        tex_id = batch.texture[i]
-        ipatch = target.image[y0:y1, x0:x1]
-        if tex_id >= 0:
-            tex = textures[tex_id]
-            th, tw = tex.shape[:2]
-            # texture pixel (i, j) -> point o + (i/w) e1 + (j/h) e2 -> image; then shift to the bbox
-            Ht = K @ np.column_stack([E1[i] / tw, E2[i] / th, O[i]])
-            Ht = np.array([[1, 0, -x0], [0, 1, -y0], [0, 0, 1.0]]) @ Ht
-            warped = cv2.warpPerspective(tex, Ht, (bw, bh), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_WRAP)
-            col = (warped[vis].astype(np.float32)[:, None] * (colors[i] / 255.0)).astype(np.uint8)
-            ipatch[vis] = col
-        else:
-            ipatch[vis] = colors[i].astype(np.uint8)
-        zpatch[vis] = Z[vis]
-        target.ids[y0:y1, x0:x1][vis] = oid
+            lvl = np.floor(0.5 * np.log2(texels / np.maximum(area[has], 1e-6)) + 0.25)
+        level[has] = np.clip(np.nan_to_num(lvl, nan=0.0, posinf=0.0, neginf=0.0), 0, atlas.levels[tex] - 1)
+    return level
+
+
+def _finish(batch: PatchBatch, cam: PinholeCamera, v: dict, tiny: np.ndarray, level: np.ndarray, colors: np.ndarray,
+            atlas: TextureAtlas) -> PreparedPatches | None:
+    """The camera's drawable patches and their affine rows a', b', c (see fragments.py)."""
+    idx, o, e1, e2 = v["idx"], v["o"], v["e1"], v["e2"]
+    fx, fy, cx, cy = cam.fx, cam.fy, cam.cx, cam.cy
+    ok = (v["x1"] > v["x0"]) & (v["y1"] > v["y0"]) & ~(tiny[idx] & ~v["crossing"])
+    # A = K [e1 e2 o]; A^-1 rows are (a2 x a3, a3 x a1, a1 x a2) / det
+    a1 = np.column_stack([fx * e1[:, 0] + cx * e1[:, 2], fy * e1[:, 1] + cy * e1[:, 2], e1[:, 2]])
+    a2 = np.column_stack([fx * e2[:, 0] + cx * e2[:, 2], fy * e2[:, 1] + cy * e2[:, 2], e2[:, 2]])
+    a3 = np.column_stack([fx * o[:, 0] + cx * o[:, 2], fy * o[:, 1] + cy * o[:, 2], o[:, 2]])
+    r0, r1, r2 = _cross(a2, a3), _cross(a3, a1), _cross(a1, a2)
+    det = _dot(a1, r0)
+    scale = np.sqrt(_dot(a1, a1) * _dot(a2, a2) * _dot(a3, a3))
+    ok &= np.abs(det) > 1e-9 * scale
+    sel = np.flatnonzero(ok)
+    if not len(sel):
+        return None
+    det = det[sel, None]
+    m0, m1, m2 = r0[sel] / det, r1[sel] / det, r2[sel] / det
+    pi = idx[sel]
+    tex = batch.texture[pi]
+    has = tex >= 0
+    entry = np.where(has, atlas.first[np.maximum(tex, 0)] + level[pi], -1)
+    # texels across the patch at that level: the entry's size times the repeat count
+    texsize = np.where(has[:, None], atlas.rects[np.maximum(entry, 0), 2:4] * batch.repeat[pi], 0.0)
+    crossing = v["crossing"][sel]
+    return PreparedPatches(
+        x0=v["x0"][sel], x1=v["x1"][sel], y0=v["y0"][sel], y1=v["y1"][sel],
+        # affine rows of a' = 2 s/Z - 1/Z, b' = 2 t/Z - 1/Z, c = 1/Z: inside a quad iff max(|a'|, |b'|) <= c
+        ma=2 * m0 - m2, mb=2 * m1 - m2, mc=m2,
+        ellipse=batch.outline[pi] == 1, crossing=crossing, zmin=np.maximum(v["zmin"][sel], NEAR_M),
+        area=v["area"][sel], obj_id=batch.obj_id[pi].astype(np.int32), color=colors[pi], entry=entry,
+        texsize=texsize)

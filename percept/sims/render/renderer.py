@@ -2,36 +2,47 @@
 
 Each camera is rendered on its own from the same 3D scene, so disparities are exact: a fronto-
 parallel surface at depth Z appears shifted by f·b/Z between the two images.
+
+Per frame: the scenery patches within the view cone and within their level-of-detail reach are
+selected, vehicles and signs are moved from cached templates (pedestrians are built), the road's paint
+polygons are selected once for both cameras, and patches are culled and prepared once for both
+(shading, level of detail and texture mip levels are shared, so both images show the same things).
+Each camera then paints its ground layer and rasterises (``raster.py``, ``fragments.py``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from percept.sensors import Side, StereoRig
+from percept.sensors import Pose2D, Side, StereoRig
 
 from ..road_geometry import RoadGeometry
 from .ground import GroundLayer, Palette
+from .fragments import PreparedPatches, rasterize_prepared
+from .paint import GroundPaint, ground_paint
+from .patches import PatchBatch, PatchBuilder
 from .pedestrian import pedestrian_patches
-from .raster import PatchBatch, PatchBuilder, RenderTarget, rasterize
-from .scene import ObjectKind, Scene
+from .raster import LOD_PX, RenderTarget, prepare
+from .scene import ObjectKind, ObjectState, Scene
 from .scenery import SceneryTextures, build_scenery
 from .signs import sign_patches
-from .textures import building_texture, foliage_texture, marker_texture, panel_texture
+from .textures import TextureAtlas, building_texture, foliage_texture, marker_texture, panel_texture
 from .vehicles import vehicle_patches
 
 SCENERY_RANGE_M = 260.0
 SUN_DIR = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
+_TEMPLATE_CACHE = 1024
 
 
 @dataclass(frozen=True)
 class StereoImages:
     """left, right: (H, W, 3) uint8 BGR; depth_m: (H, W) float32 left-camera z [m], inf for sky;
     ids: (H, W) int32 object id per left pixel (0 road/scenery, -1 sky);
-    boxes_px: obj id -> (u0, v0, u1, v1) tight box of the object's unoccluded silhouette in the left image [px];
-    visible: obj id -> fraction 0..1 of that silhouette not hidden by nearer things."""
+    boxes_px: obj id -> (u0, v0, u1, v1) tight box of the object's unoccluded silhouette in the left image [px],
+    u1 and v1 exclusive; visible: obj id -> fraction 0..1 of that silhouette not hidden by nearer things."""
 
     left: np.ndarray
     right: np.ndarray
@@ -49,15 +60,32 @@ class StereoRenderer:
         self.rig = rig
         self.road = road
         self.layers = {s: GroundLayer(rig, s, seed, palette) for s in (Side.LEFT, Side.RIGHT)}
+        self.road_index = self.layers[Side.LEFT].road_index(road)
+        self.layers[Side.RIGHT]._index = (road, self.road_index)  # one road index for both cameras
         self.textures: list[np.ndarray] = [panel_texture(seed + 1), foliage_texture(seed + 2)]
         facades = []
         for k in range(4):
             facades.append(len(self.textures))
             self.textures.append(building_texture(seed + 10 + k))
         self._markers: dict[int, int] = {}
+        self._atlas = TextureAtlas(self.textures)
         self.tex = SceneryTextures(panel=0, foliage=1, facades=tuple(facades))
         self.scenery = build_scenery(road, seed, self.tex) if scenery else PatchBatch.empty()
-        self._scenery_centre = (self.scenery.origin + (self.scenery.e1 + self.scenery.e2) / 2)[:, :2]
+        s = self.scenery
+        self._scenery_packed = s.pack()
+        # bounding circle of each scenery patch on the ground, for the per-frame view-cone test
+        self._scenery_centre = (s.origin + (s.e1 + s.e2) / 2)[:, :2]
+        l1, l2 = np.linalg.norm(s.e1, axis=1), np.linalg.norm(s.e2, axis=1)
+        self._scenery_radius = (l1 + l2) / 2
+        # beyond f min(|e1|, |e2|) / LOD_PX a patch is narrower than LOD_PX on screen, so the rasteriser skips it
+        self._scenery_reach = rig.camera.fx * np.minimum(l1, l2) / LOD_PX
+        self._templates: dict[tuple, np.ndarray] = {}
+
+    @property
+    def atlas(self) -> TextureAtlas:
+        if self._atlas.count != len(self.textures):
+            self._atlas = TextureAtlas(self.textures)
+        return self._atlas
 
     def _marker(self, marker_id: int) -> int:
         if marker_id not in self._markers:
@@ -65,63 +93,113 @@ class StereoRenderer:
             self.textures.append(marker_texture(marker_id))
         return self._markers[marker_id]
 
-    def object_patches(self, scene: Scene) -> PatchBatch:
-        """Patches of every object in the scene, built once for both cameras."""
+    def _template(self, obj: ObjectState) -> np.ndarray:
+        """The object's packed patches at the origin facing +x (cached by kind, size and style)."""
+        if obj.kind is ObjectKind.VEHICLE:
+            key = ("v", obj.length_m, obj.width_m, obj.height_m, obj.style)
+        else:
+            key = ("s", obj.length_m, obj.width_m, obj.height_m, obj.marker_id)
+        t = self._templates.get(key)
+        if t is None:
+            b = PatchBuilder()
+            at_origin = replace(obj, pose=Pose2D(0.0, 0.0, 0.0), obj_id=1)
+            if obj.kind is ObjectKind.VEHICLE:
+                vehicle_patches(b, at_origin, self.tex.panel)
+            else:
+                sign_patches(b, at_origin, self._marker(obj.marker_id if obj.marker_id is not None else 0))
+            t = b.build().pack()
+            if len(self._templates) >= _TEMPLATE_CACHE:
+                self._templates.clear()
+            self._templates[key] = t
+        return t
+
+    def _object_packed(self, scene: Scene) -> list[np.ndarray]:
+        """Packed patches of the objects in range: rigid templates moved to their poses, pedestrians built."""
         b = PatchBuilder()
-        view = scene.ego.world_from_vehicle().apply(self.rig.camera_position(Side.LEFT) - [0, self.rig.baseline_m / 2, 0])
+        # the rig centre, between the two cameras: pedestrians' limbs face it, so both cameras see one geometry
+        rig_centre = self.rig.camera_position(Side.LEFT) - [0, self.rig.baseline_m / 2, 0]
+        view = scene.ego.world_from_vehicle().apply(rig_centre)
         ex, ey = scene.ego.x_m, scene.ego.y_m
+        parts, poses = [], []
         for obj in scene.objects:
             if abs(obj.pose.x_m - ex) > SCENERY_RANGE_M or abs(obj.pose.y_m - ey) > SCENERY_RANGE_M:
                 continue
-            if obj.kind is ObjectKind.VEHICLE:
-                vehicle_patches(b, obj, self.tex.panel)
-            elif obj.kind is ObjectKind.PEDESTRIAN:
+            if obj.kind is ObjectKind.PEDESTRIAN:
                 pedestrian_patches(b, obj, view)
-            elif obj.kind is ObjectKind.LANDMARK:
-                sign_patches(b, obj, self._marker(obj.marker_id if obj.marker_id is not None else 0))
-        return b.build()
+                continue
+            t = self._template(obj)
+            parts.append(t)
+            poses.append((obj.pose.x_m, obj.pose.y_m, obj.pose.yaw_rad, obj.obj_id, len(t)))
+        out = []
+        if parts:
+            m = np.concatenate(parts)
+            x, y, yaw, oid, _ = (np.repeat(np.asarray(a, float), [q[4] for q in poses]) for a in zip(*poses))
+            c, s_ = np.cos(yaw), np.sin(yaw)
+            # rigid move about z: points p -> R(yaw) p + (x, y, 0), directions e -> R(yaw) e
+            for k in (0, 3, 6):
+                px, py = m[:, k].copy(), m[:, k + 1].copy()
+                m[:, k], m[:, k + 1] = c * px - s_ * py, s_ * px + c * py
+            m[:, 0] += x
+            m[:, 1] += y
+            m[:, 14] = oid
+            out.append(m)
+        if b._rows:
+            out.append(b.build().pack())
+        return out
 
-    def _visible_scenery(self, scene: Scene) -> PatchBatch:
-        if not len(self.scenery):
-            return self.scenery
+    def object_patches(self, scene: Scene) -> PatchBatch:
+        """Patches of every object in the scene, built once for both cameras."""
+        parts = self._object_packed(scene)
+        return PatchBatch.unpack(np.concatenate(parts)) if parts else PatchBatch.empty()
+
+    def _scenery_in_view(self, scene: Scene) -> np.ndarray:
+        """Indices of scenery whose bounding circle meets the rig's horizontal view cone, within range and
+        within its level-of-detail reach."""
         d = scene.ego.to_vehicle_xy(self._scenery_centre)
-        keep = (d[:, 0] > -40.0) & (d[:, 0] < SCENERY_RANGE_M) & (np.abs(d[:, 1]) < SCENERY_RANGE_M)
-        s = self.scenery
-        return PatchBatch(*[getattr(s, f)[keep] for f in PatchBatch.__dataclass_fields__])
+        r = self._scenery_radius
+        x = d[:, 0] - self.rig.mount_x_m
+        # |y| <= (x + r) tan(hfov/2 + margin) + r + baseline
+        slope = math.tan(self.rig.camera.hfov_rad / 2 + 0.05)
+        return np.flatnonzero((x + r > 0) & (x - r < np.minimum(SCENERY_RANGE_M, self._scenery_reach))
+                              & (np.abs(d[:, 1]) - r < (x + r) * slope + self.rig.baseline_m))
 
-    def render_side(self, scene: Scene, side: Side, patches: PatchBatch) -> RenderTarget:
-        img, depth = self.layers[side].paint(scene.ego, self.road)
-        ids = np.where(np.isfinite(depth), 0, -1).astype(np.int32)
-        target = RenderTarget(img, depth, ids)
-        cam_from_world = self.rig.cam_from_vehicle(side).compose(scene.ego.vehicle_from_world())
-        rasterize(target, patches, self.rig.camera, cam_from_world, self.textures, SUN_DIR)
+    def scene_patches(self, scene: Scene) -> PatchBatch:
+        """Scenery in view and every object, as one batch for both cameras."""
+        parts = self._object_packed(scene)
+        if len(self.scenery):
+            parts.insert(0, self._scenery_packed[self._scenery_in_view(scene)])
+        return PatchBatch.unpack(np.concatenate(parts)) if parts else PatchBatch.empty()
+
+    def _cam_from_world(self, scene: Scene, side: Side):
+        return self.rig.cam_from_vehicle(side).compose(scene.ego.vehicle_from_world())
+
+    def render_side(self, scene: Scene, side: Side, patches: PatchBatch | None = None,
+                    prepared_ground: GroundPaint | None = None, ids: bool = True,
+                    prepared: PreparedPatches | None = None, depth: bool = True) -> RenderTarget:
+        """One camera's image and, if asked, its depth, object ids and silhouettes (``ids``)."""
+        layer = self.layers[side]
+        img, depth = layer.paint(scene.ego, self.road, prepared_ground, depth=depth)
+        target = RenderTarget(img, depth, layer.ground_ids() if ids else None, layer.ground_inv_depth.copy(),
+                              layer.ground_inv_depth)
+        if prepared is None:
+            patches = self.scene_patches(scene) if patches is None else patches
+            prepared = prepare(patches, self.rig.camera, [self._cam_from_world(scene, side)], self.atlas, SUN_DIR)[0]
+        if prepared is not None:
+            rasterize_prepared(target, prepared, self.atlas, ids)
         return target
 
     def render(self, scene: Scene) -> StereoImages:
-        patches = PatchBatch.concat([self._visible_scenery(scene), self.object_patches(scene)])
-        left = self.render_side(scene, Side.LEFT, patches)
-        right = self.render_side(scene, Side.RIGHT, patches)
+        patches = self.scene_patches(scene)
+        ground = ground_paint(self.road_index, scene.ego, self.rig, self.layers[Side.LEFT].palette)
+        sides = (Side.LEFT, Side.RIGHT)
+        prep = prepare(patches, self.rig.camera, [self._cam_from_world(scene, s) for s in sides], self.atlas, SUN_DIR)
+        left = self.render_side(scene, Side.LEFT, prepared_ground=ground, prepared=prep[0])
+        right = self.render_side(scene, Side.RIGHT, prepared_ground=ground, ids=False, prepared=prep[1], depth=False)
         boxes, visible = {}, {}
-        counts = np.bincount(left.ids[left.ids > 0].ravel()) if (left.ids > 0).any() else np.zeros(1, int)
-        for oid in left.pieces:
-            sil = left.silhouette_px(oid)
-            if sil == 0:
+        for oid in sorted(left.silhouettes):
+            sil = left.silhouette(oid)
+            if sil is None:
                 continue
-            boxes[oid] = _silhouette_box(left.pieces[oid])
-            seen = int(counts[oid]) if oid < len(counts) else 0
-            visible[oid] = min(1.0, seen / sil)
+            boxes[oid] = sil[0]
+            visible[oid] = min(1.0, sil[2] / sil[1])
         return StereoImages(left.image, right.image, left.depth, left.ids, boxes, visible)
-
-
-def _silhouette_box(parts: list) -> tuple[int, int, int, int]:
-    """Tight (u0, v0, u1, v1) of the union of an object's patch masks; u1, v1 exclusive."""
-    u0 = v0 = 10**9
-    u1 = v1 = -1
-    for x0, y0, m in parts:
-        rows = np.flatnonzero(m.any(axis=1))
-        cols = np.flatnonzero(m.any(axis=0))
-        if not len(rows):
-            continue
-        u0, u1 = min(u0, x0 + cols[0]), max(u1, x0 + cols[-1] + 1)
-        v0, v1 = min(v0, y0 + rows[0]), max(v1, y0 + rows[-1] + 1)
-    return int(u0), int(v0), int(u1), int(v1)

@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from ..road_geometry import RoadGeometry
-from .raster import PatchBatch, PatchBuilder
+from .patches import PatchBatch, PatchBuilder
 
 RAIL = (175, 178, 180)
 POLE = (140, 140, 145)
@@ -34,7 +34,8 @@ class _RoadGrid:
     """Paved area rasterised on a 1 m grid, to keep props off the road."""
 
     def __init__(self, road: RoadGeometry, margin_m: float = 1.5):
-        pts = np.concatenate([np.concatenate([s.left, s.right]) for s in road.strips]) if road.strips else np.zeros((1, 2))
+        edges = [np.concatenate([s.left, s.right]) for s in road.strips]
+        pts = np.concatenate(edges) if edges else np.zeros((1, 2))
         self.lo = pts.min(axis=0) - 80.0
         hi = pts.max(axis=0) + 80.0
         w, h = (hi - self.lo).astype(int) + 1
@@ -60,6 +61,48 @@ def _frame(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
     return np.array([d, [-d[1], d[0], 0.0], [0.0, 0.0, 1.0]])
 
 
+def straight_runs(line: np.ndarray, step: int = 4, tol_m: float = 0.015,
+                  max_len_m: float = 64.0) -> list[tuple[int, int]]:
+    """Split a polyline (N, 2) into pieces (i, j) of whole ``step`` sample runs, each as long as it stays
+    within ``tol_m`` of its chord (so a straight road's guard rail is a few long patches, a curve's many)."""
+    n = len(line)
+    out = []
+    i = 0
+    while i + step <= n - 1:
+        j = i + step
+        while j + step <= n - 1:
+            k = j + step
+            a, b = line[i], line[k]
+            d = b - a
+            L = float(np.hypot(*d))
+            if L > max_len_m:
+                break
+            # distance of the samples between a and b from the chord: |cross(d, p - a)| / |d|
+            p = line[i:k + 1] - a
+            if np.abs(d[0] * p[:, 1] - d[1] * p[:, 0]).max() / (L + 1e-12) > tol_m:
+                break
+            j = k
+        out.append((i, j))
+        i = j
+    return out
+
+
+def _tree(b: PatchBuilder, rng: np.random.Generator, c: np.ndarray, r: float, ax: np.ndarray,
+          tex: SceneryTextures) -> None:
+    """A trunk (four sides) under two crossed, two-sided elliptical canopies."""
+    trunk_h = float(rng.uniform(1.5, 3.0))
+    col = CANOPIES[int(rng.integers(len(CANOPIES)))]
+    canopy_h = float(rng.uniform(2.5, 5.0))
+    top = trunk_h + 0.35 * canopy_h
+    b.box(np.append(c, top / 2), ax, (0.35, 0.35, top), TRUNK, texture=tex.panel, faces="fblr")
+    centre = np.append(c, trunk_h + canopy_h / 2)
+    up = np.array([0.0, 0.0, canopy_h])
+    for k in (0, 1):
+        e1 = 2 * r * ax[k]
+        b.add(centre - e1 / 2 - up / 2, e1, up, col, texture=tex.foliage, outline=1, two_sided=True,
+              repeat=(max(1.0, r / 1.5), max(1.0, canopy_h / 3.0)))
+
+
 def build_scenery(road: RoadGeometry, seed: int, tex: SceneryTextures) -> PatchBatch:
     rng = np.random.default_rng(seed + 7919)
     grid = _RoadGrid(road)
@@ -72,19 +115,21 @@ def build_scenery(road: RoadGeometry, seed: int, tex: SceneryTextures) -> PatchB
         normal = np.column_stack([-seg[:, 1], seg[:, 0]]) * outward
         normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-12
         normal = np.vstack([normal, normal[-1:]])
-        # guard rail: 0.3 m tall beam on posts, 0.6 m outside the paved edge, in 4 m pieces
+        # guard rail: 0.32 m tall beam, 0.6 m outside the paved edge, merged where the edge is straight
         rail = edge + 0.6 * normal
-        for i in range(0, n - 4, 4):
-            p0, p1 = rail[i], rail[i + 4]
+        for i, j in straight_runs(rail):
+            p0, p1 = rail[i], rail[j]
+            length = float(np.hypot(*(p1 - p0)))
             b.add(np.append(p0, 0.45), np.append(p1 - p0, 0.0), np.array([0, 0, 0.32]), RAIL, texture=tex.panel,
-                  two_sided=True)
-            ax = _frame(p0, p1)
-            b.box(np.append(p0, 0.3), ax, (0.1, 0.1, 0.6), POLE)
+                  two_sided=True, repeat=(max(1.0, round(length / 4.0)), 1.0))
+        # rail posts every 4 m
+        for i in range(0, n - 4, 4):
+            b.box(np.append(rail[i], 0.3), _frame(rail[i], rail[i + 4]), (0.1, 0.1, 0.6), POLE, faces="fblr")
         # lamp poles every 40 m, 2.5 m out
         for i in range(int(rng.integers(0, 40)), n, 40):
             c = edge[i] + 2.5 * normal[i]
             b.box(np.append(c, 4.0), _frame(edge[max(i - 1, 0)], edge[min(i + 1, n - 1)]), (0.18, 0.18, 8.0), POLE,
-                  texture=tex.panel)
+                  texture=tex.panel, faces="fblr")
         # trees: clusters 6-25 m out
         i = int(rng.integers(0, 10))
         while i < n:
@@ -92,13 +137,7 @@ def build_scenery(road: RoadGeometry, seed: int, tex: SceneryTextures) -> PatchB
             c = edge[i] + off * normal[i] + rng.normal(0, 1.0, 2)
             r = float(rng.uniform(1.5, 3.0))
             if grid.free(c, r + 1):
-                ax = _frame(edge[max(i - 1, 0)], edge[min(i + 1, n - 1)])
-                trunk_h = float(rng.uniform(1.5, 3.0))
-                b.box(np.append(c, trunk_h / 2), ax, (0.35, 0.35, trunk_h), TRUNK, texture=tex.panel)
-                col = CANOPIES[int(rng.integers(len(CANOPIES)))]
-                canopy_h = float(rng.uniform(2.5, 5.0))
-                b.box(np.append(c, trunk_h + canopy_h / 2), ax, (2 * r, 2 * r, canopy_h), col, texture=tex.foliage,
-                      bottom=True)
+                _tree(b, rng, c, r, _frame(edge[max(i - 1, 0)], edge[min(i + 1, n - 1)]), tex)
             i += int(rng.integers(6, 18))
         # buildings: 30-70 m out, every 35-80 m
         i = int(rng.integers(0, 30))

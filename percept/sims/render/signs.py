@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .raster import PatchBuilder
+from .patches import PatchBuilder
 from .scene import ObjectState
 
 POST = (120, 120, 125)

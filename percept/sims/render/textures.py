@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import cv2
 import numpy as np
 
@@ -34,10 +36,15 @@ def to_albedo(noise: np.ndarray, mean: float, spread: float) -> np.ndarray:
     return np.clip(mean + spread * noise, 0, 255).astype(np.uint8)
 
 
+@functools.lru_cache(maxsize=8)
 def ground_tile(seed: int, size: int = 1024) -> np.ndarray:
-    """Seamless asphalt/grass grain: fine grit, pebbles and metre-scale blotches (8 m tile at 128 px/m)."""
+    """Seamless asphalt/grass grain: fine grit, pebbles and metre-scale blotches (8 m tile at 128 px/m).
+
+    Cached per seed (both cameras and every renderer of a process share it); read-only."""
     n = fractal_noise(size, [(1, 0.9), (3, 0.7), (12, 0.6), (60, 0.5)], seed)
-    return to_albedo(n, 128, 42)
+    out = to_albedo(n, 128, 42)
+    out.flags.writeable = False
+    return out
 
 
 def mip_chain(tile: np.ndarray, levels: int) -> list[np.ndarray]:
@@ -80,3 +87,58 @@ def marker_texture(marker_id: int, size: int = 96) -> np.ndarray:
     o = (size - inner) // 2
     out[o:o + inner, o:o + inner] = np.maximum(m, 20)
     return out
+
+
+class TextureAtlas:
+    """Every texture of the renderer and its mip levels packed in one image, for vectorised sampling.
+
+    Each entry keeps a one-texel wrapped border, so bilinear sampling across a tile's edge wraps.
+    rects: (E, 4) int (x0, y0, w, h) of each entry's interior in ``image``; first: (T,) entry of each
+    texture's level 0; levels: (T,) number of levels of each texture (down to MIN_MIP_PX).
+    """
+
+    MIN_MIP_PX = 4
+
+    def __init__(self, textures: list[np.ndarray], width: int = 1024):
+        self.count = len(textures)
+        entries, first, levels = [], [], []
+        for t in textures:
+            chain = [np.ascontiguousarray(t, np.uint8)]
+            while min(chain[-1].shape[:2]) >= 2 * self.MIN_MIP_PX:
+                # wrap-pad, halve, crop: the tile stays seamless at every level
+                p = cv2.pyrDown(np.pad(chain[-1], 4, mode="wrap"))
+                chain.append(np.ascontiguousarray(p[2:-2, 2:-2]))
+            first.append(len(entries))
+            levels.append(len(chain))
+            entries.extend(chain)
+        # shelf packing, tallest first
+        order = sorted(range(len(entries)), key=lambda i: (-entries[i].shape[0], i))
+        rects = np.zeros((len(entries), 4), int)
+        x = y = shelf = 0
+        for i in order:
+            h, w = entries[i].shape[0] + 2, entries[i].shape[1] + 2
+            if x + w > width:
+                x, y, shelf = 0, y + shelf, 0
+            rects[i] = (x + 1, y + 1, w - 2, h - 2)
+            x, shelf = x + w, max(shelf, h)
+        self.image = np.zeros((max(y + shelf, 1), width), np.uint8)
+        for i, e in enumerate(entries):
+            x0, y0, w, h = rects[i]
+            self.image[y0 - 1:y0 + h + 1, x0 - 1:x0 + w + 1] = np.pad(e, 1, mode="wrap")
+        self.rects = rects
+        self.first = np.asarray(first, int)
+        self.levels = np.asarray(levels, int)
+        self.sizes = np.array([t.shape[1::-1] for t in textures], float).reshape(-1, 2)
+        """(T, 2) level-0 width and height of each texture [texels]."""
+        self._tiled: dict[tuple[int, int, int], np.ndarray] = {}
+
+    def tiled(self, entry: int, nx: int, ny: int) -> np.ndarray:
+        """Entry ``entry`` repeated nx x ny times with a one-texel wrapped border (for OpenCV warps that stay
+        inside the image: texel (x, y) of the repeat is at (x + 1, y + 1))."""
+        key = (entry, max(nx, 1), max(ny, 1))
+        t = self._tiled.get(key)
+        if t is None:
+            x0, y0, w, h = self.rects[entry]
+            t = np.pad(np.tile(self.image[y0:y0 + h, x0:x0 + w], (key[2], key[1])), 1, mode="wrap")
+            self._tiled[key] = t
+        return t

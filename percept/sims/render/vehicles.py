@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .raster import PatchBuilder
+from .patches import PatchBuilder
 from .scene import ObjectState
 
 BODY_COLORS = [(40, 40, 160), (170, 170, 170), (30, 30, 30), (230, 230, 230), (140, 80, 30),
