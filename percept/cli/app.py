@@ -196,15 +196,7 @@ def main() -> None:
     app()
 
 
-def _register_plugins() -> None:
-    """Commands that live in their own modules register themselves on ``app``."""
-    try:
-        from . import lanes_cmd
-    except ImportError as e:  # only while the module is absent from a checkout
-        if "lanes_cmd" not in str(e):
-            raise
-        return
-    lanes_cmd.register(app)
+# commands that live in their own modules register themselves on ``app``
+from . import lanes_cmd  # noqa: E402
 
-
-_register_plugins()
+lanes_cmd.register(app)

@@ -11,6 +11,7 @@ Yellow and white both score high on max(R, G).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import cv2
 import numpy as np
@@ -20,11 +21,27 @@ from percept.sensors import Side, StereoRig
 from .types import MarkingEvidence
 
 
+class Brightness(str, Enum):
+    """How bright a pixel is as paint: MAX_RG = max(R, G) (white and yellow on dark asphalt); MAX_RG_YELLOW also
+    lifts yellow above pale concrete, where max(R, G) barely differs."""
+
+    MAX_RG = "max_rg"
+    MAX_RG_YELLOW = "max_rg_yellow"
+
+
+def marking_brightness(image: np.ndarray) -> np.ndarray:
+    """MAX_RG_YELLOW of a BGR image (same shape without channels), float32 [grey levels]:
+    max(max(R, G), B + 2 ((R + G) / 2 - B)); the yellowness term (R + G) / 2 - B lifts a yellow line."""
+    b, g, r = (image[..., k].astype(np.float32) for k in range(3))
+    return np.maximum(np.maximum(r, g), b + 2.0 * np.clip((r + g) / 2 - b, 0, None))
+
+
 @dataclass(frozen=True)
 class EvidenceConfig:
     """x_near_m, x_far_m: ground range ahead of the vehicle centre [m]; half_width_m: lateral half range [m];
     dx_m, dy_m: grid steps [m]; marking_width_m: expected stripe width [m]; min_contrast: absolute top-hat
-    threshold [grey levels]; rel_contrast: threshold relative to the frame's strong responses."""
+    threshold [grey levels]; rel_contrast: threshold relative to the frame's strong responses; brightness: the paint
+    measure; max_row_px: image rows below this are not road (a car's hood), None = all rows."""
 
     x_near_m: float = 6.0
     x_far_m: float = 50.0
@@ -34,6 +51,8 @@ class EvidenceConfig:
     marking_width_m: float = 0.15
     min_contrast: float = 10.0
     rel_contrast: float = 0.3
+    brightness: Brightness = Brightness.MAX_RG
+    max_row_px: float | None = None
 
     def __post_init__(self) -> None:
         if not 0 < self.x_near_m < self.x_far_m:
@@ -58,20 +77,25 @@ class MarkingExtractor:
                                 np.ones(self.rows * self.cols)])
         self.uv = (uv[:2] / uv[2]).T.reshape(self.rows, self.cols, 2)
         cam = rig.camera
+        bottom = cam.height - 1 if cfg.max_row_px is None else min(cfg.max_row_px, cam.height - 1)
         self.valid = ((self.uv[..., 0] >= 0) & (self.uv[..., 0] <= cam.width - 1) & (self.uv[..., 1] >= 0)
-                      & (self.uv[..., 1] <= cam.height - 1))
+                      & (self.uv[..., 1] <= bottom))
         self.w_px = max(int(round(cfg.marking_width_m / cfg.dy_m)), 1)
         self.size = (cam.width, cam.height)
         self.first_row = max(int(np.floor(self.uv[..., 1][self.valid].min())) - 1, 0) if self.valid.any() else 0
 
     def birdseye(self, image: np.ndarray) -> np.ndarray:
-        """Top-down marking brightness max(R, G) (rows, cols) float32; rows go from near to far."""
+        """Top-down marking brightness (rows, cols) float32; rows go from near to far."""
         if image.shape[1::-1] != self.size:
             raise ValueError(f"image is {image.shape[1]}x{image.shape[0]}, the rig expects {self.size[0]}x{self.size[1]}")
-        # max(R, G) on the road rows only, then one single-channel warp
+        # the paint measure on the road rows only, then one single-channel warp
         r0 = self.first_row
-        bright = np.zeros(image.shape[:2], np.uint8)
-        cv2.max(image[r0:, :, 1], image[r0:, :, 2], dst=bright[r0:])
+        if self.cfg.brightness is Brightness.MAX_RG:
+            bright = np.zeros(image.shape[:2], np.uint8)
+            cv2.max(image[r0:, :, 1], image[r0:, :, 2], dst=bright[r0:])
+        else:
+            bright = np.zeros(image.shape[:2], np.float32)
+            bright[r0:] = marking_brightness(image[r0:])
         top = cv2.warpPerspective(bright, self.M, (self.cols, self.rows), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
         return top.astype(np.float32)
 
