@@ -1,10 +1,20 @@
-"""Articulated walking pedestrians: limbs as view-facing capsules on a skeleton with a walking gait.
+"""Articulated walking pedestrians: tapered view-facing limbs on a skeleton with a walking gait.
 
-Proportions follow the usual anthropometric canon (heights as fractions of stature: knee 0.285,
-hip 0.53, shoulder 0.82, head 0.13; Winter, *Biomechanics and Motor Control of Human Movement*,
-table 4.1). The gait is a sinusoidal hip swing with knee flexion in the swing phase and counter-
-swinging arms. Limb quads are turned towards the viewer (the rig centre) so that both cameras see
-the same 3D geometry.
+Proportions follow the anthropometric canon (segment lengths and joint heights as fractions of
+stature: hip 0.53, knee 0.285, ankle 0.039, shoulder 0.818, chin 0.87, upper arm 0.186, forearm
+0.146, foot 0.152, shoulder width 0.259; Winter, *Biomechanics and Motor Control of Human Movement*,
+fig. 4.1). Trunk widths and depths are those of a clothed adult (chest 0.18-0.23 h deep, from a shirt
+to a padded jacket): a thinner side-view trunk makes crossing pedestrians much harder to recognise for a HOG
+people detector (Dalal & Triggs 2005), as it would be for real people. The gait follows normative
+sagittal joint angles over the cycle (hip, knee, shoe pitch: heel-off late in stance, toe up at heel
+strike) with counter-swinging arms; the whole figure is then lowered or raised so that its lowest
+shoe point rests on the ground (z = 0), which gives the pelvis its natural bob.
+
+Limbs and trunk are flat tapered quads turned towards the viewer (the rig centre), so both cameras
+see the same 3D geometry. Each is split lengthwise into a lit and a shadowed half (a cheap cylinder
+shading under the renderer's sun); shoes are small boxes. Parts that touch at the same depth get a
+few millimetres of bias towards the viewer so that the z-test orders them deterministically (arms
+over trunk, shirt over trousers, face over hair), never by rounding noise.
 """
 
 from __future__ import annotations
@@ -16,106 +26,245 @@ import numpy as np
 from .raster import PatchBuilder
 from .scene import ObjectState
 
-SHIRTS = [(40, 40, 170), (150, 60, 30), (40, 120, 40), (30, 30, 30), (200, 200, 200), (40, 150, 210),
-          (120, 40, 120), (20, 80, 160), (90, 90, 90), (170, 130, 60)]
-PANTS = [(60, 40, 30), (30, 30, 30), (110, 80, 50), (80, 80, 80), (120, 60, 30), (40, 40, 60)]
-SKINS = [(150, 180, 225), (110, 145, 195), (70, 100, 150), (60, 80, 110)]
-HAIR = [(20, 20, 25), (30, 50, 80), (60, 90, 140), (140, 140, 140)]
-SHOES = (25, 25, 25)
+# BGR colours. Clothing keeps some luminance or hue contrast against the grey asphalt (~100, 97, 95).
+SHIRTS = [(40, 40, 175), (95, 45, 20), (35, 90, 30), (28, 28, 30), (225, 225, 222), (205, 140, 80),
+          (115, 40, 110), (35, 115, 215), (30, 160, 210), (45, 30, 125), (125, 115, 25), (150, 100, 210),
+          (55, 55, 60), (90, 130, 160), (30, 70, 150), (140, 70, 40)]
+PANTS = [(120, 75, 40), (85, 55, 35), (30, 30, 32), (70, 105, 135), (50, 50, 55), (40, 60, 95),
+         (75, 45, 30), (115, 75, 45)]
+SKINS = [(150, 180, 225), (125, 160, 210), (95, 130, 185), (70, 100, 150), (50, 70, 105)]
+HAIR = [(20, 20, 25), (25, 40, 65), (45, 75, 120), (80, 150, 190), (150, 150, 155), (30, 30, 90)]
+SHOES = [(25, 25, 28), (30, 50, 80), (215, 215, 215), (40, 40, 40)]
+
+SUN = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
+"""Light direction (world) for the lit/shadowed halves; matches the renderer's sun."""
+UP = np.array([0.0, 0.0, 1.0])
+
+# Normal walking over one gait cycle (fraction 0 = heel strike of that leg), degrees; after Winter's
+# normative sagittal kinematics. HIP: thigh forwards of the vertical; KNEE: flexion; FOOT: shoe pitch
+# relative to the ground, toe down positive (heel-off late in stance, toe up at heel strike).
+GAIT_C = np.linspace(0.0, 1.0, 11)
+HIP = np.array([22.0, 19.0, 12.0, 5.0, -2.0, -8.0, -7.0, 8.0, 20.0, 25.0, 22.0])
+KNEE = np.array([2.0, 10.0, 15.0, 10.0, 8.0, 25.0, 42.0, 60.0, 45.0, 15.0, 2.0])
+FOOT = np.array([-10.0, 0.0, 0.0, 0.0, 5.0, 14.0, 34.0, 25.0, 5.0, -8.0, -10.0])
 
 
-def _limb(b: PatchBuilder, p0: np.ndarray, p1: np.ndarray, radius: float, view: np.ndarray, color, oid: int) -> None:
-    """A capsule-like quad of width 2·radius from p0 to p1, facing the viewer position ``view``."""
-    axis = p1 - p0
-    mid = (p0 + p1) / 2
-    side = np.cross(axis, view - mid)
-    n = np.linalg.norm(side)
-    if n < 1e-9:
-        return
-    side *= radius / n
-    # e1 along the width, e2 along the limb; e1 x e2 must face the viewer for the back-face test
-    o, e1, e2 = p0 - side, 2 * side, axis
-    if np.dot(np.cross(e1, e2), view - mid) < 0:
-        o, e1 = p0 + side, -2 * side
-    b.add(o, e1, e2, color, obj_id=oid, two_sided=True)
-    # rounded ends: a disc at each joint
-    for p in (p0, p1):
-        _disc(b, p, radius, view, color, oid)
+class _Figure:
+    """Collects one pedestrian's patches, then drops them all so that the lowest point is at z = 0."""
+
+    def __init__(self, view: np.ndarray, oid: int):
+        self.view = view
+        self.oid = oid
+        self.rows: list[tuple] = []  # (origin, e1, e2, colour, outline, box-or-None)
+
+    def _toward_view(self, p: np.ndarray, bias: float) -> np.ndarray:
+        d = self.view - p
+        d[2] = 0.0
+        return p + bias * d / (np.linalg.norm(d) + 1e-12)
+
+    def limb(self, p0, p1, r0: float, r1: float, color, bias: float = 0.0, caps: tuple = (True, True)) -> None:
+        """A tapered view-facing quad from p0 (half-width r0) to p1 (half-width r1) with round caps.
+
+        Each half (either side of the axis) is a rectangle plus a parallelogram for the taper; the half
+        facing the sun is a little brighter than the other.
+        """
+        p0 = self._toward_view(np.asarray(p0, float), bias)
+        p1 = self._toward_view(np.asarray(p1, float), bias)
+        axis = p1 - p0
+        side = np.cross(axis, self.view - (p0 + p1) / 2)
+        n = np.linalg.norm(side)
+        if n < 1e-9:
+            return
+        side /= n
+        if r0 < r1:  # build from the wide end
+            p0, p1, r0, r1, axis, caps = p1, p0, r1, r0, -axis, caps[::-1]
+        if r0 > 1.9 * r1:  # too steep a taper for one rectangle + parallelogram per half: split it
+            rm = r0 / 1.8
+            pm = p0 + (r0 - rm) / (r0 - r1) * axis
+            self.limb(p0, pm, r0, rm, color, caps=(caps[0], False))
+            self.limb(pm, p1, rm, r1, color, caps=(False, caps[1]))
+            return
+        lit = 1.0 if side @ SUN >= 0 else -1.0
+        for sgn in (lit, -lit):
+            s = sgn * side
+            k = 1.0 + (0.13 * abs(float(side @ SUN)) + 0.04) * (1 if sgn == lit else -1)
+            col = tuple(min(255.0, c * k) for c in color)
+            # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
+            over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
+            q0 = self._toward_view(p0, nb) - over * s
+            self.rows.append((q0, (r1 + over) * s, axis, col, 0, None))
+            if r0 - r1 > 1e-6:
+                w = min(r0 - r1 + 0.1 * r1, r1)
+                e2 = axis + (r1 - r0) * s
+                self.rows.append((self._toward_view(p0, nb) + r0 * s, -w * s, e2, col, 0, None))
+        for p, r, c in ((p0, r0, caps[0]), (p1, r1, caps[1])):
+            if c:
+                self.disc(p, r, r, color)
+
+    def disc(self, c, ry: float, rx: float, color, bias: float = 0.0) -> None:
+        """A view-facing ellipse centred at c: half-height ry, half-width rx."""
+        c = self._toward_view(np.asarray(c, float), bias)
+        d = self.view - c
+        d /= np.linalg.norm(d) + 1e-12
+        right = np.cross(UP, d)
+        right /= np.linalg.norm(right) + 1e-12
+        upv = np.cross(d, right)
+        self.rows.append((c - rx * right - ry * upv, 2 * rx * right, 2 * ry * upv, tuple(color), 1, None))
+
+    def box(self, center, axes, size, color) -> None:
+        """A box (see PatchBuilder.box): center (3,), axes (3, 3) rows = unit x, y, z, size (3,) [m]."""
+        self.rows.append((np.asarray(center, float), np.asarray(axes, float), np.asarray(size, float), color, -1,
+                          "box"))
+
+    def lowest_z(self) -> float:
+        """Lowest z [m] of everything collected so far."""
+        z = np.inf
+        for o, e1, e2, _, outline, kind in self.rows:
+            if kind == "box":
+                half = (e2 / 2)[:, None] * e1  # rows: half extents along each axis
+                z = min(z, o[2] - np.abs(half[:, 2]).sum())
+            elif outline == 1:
+                z = min(z, o[2] + 0.5 * (e1[2] + e2[2]) - 0.5 * math.hypot(e1[2], e2[2]))
+            else:
+                z = min(z, o[2] + min(0.0, e1[2]) + min(0.0, e2[2]))
+        return float(z)
+
+    def emit(self, b: PatchBuilder) -> None:
+        dz = np.array([0.0, 0.0, -self.lowest_z()])
+        for o, e1, e2, color, outline, kind in self.rows:
+            if kind == "box":
+                b.box(o + dz, e1, e2, color, obj_id=self.oid, bottom=True)
+            else:
+                b.add(o + dz, e1, e2, color, outline=outline, obj_id=self.oid, two_sided=True)
 
 
-def _disc(b: PatchBuilder, c: np.ndarray, radius: float, view: np.ndarray, color, oid: int,
-          rx: float | None = None) -> None:
-    """A view-facing ellipse centred at c: half-height radius, half-width rx (default radius)."""
-    rx = radius if rx is None else rx
-    d = view - c
-    d /= np.linalg.norm(d) + 1e-12
-    up = np.array([0.0, 0.0, 1.0])
-    right = np.cross(up, d)
-    right /= np.linalg.norm(right) + 1e-12
-    upv = np.cross(d, right)
-    b.add(c - rx * right - radius * upv, 2 * rx * right, 2 * radius * upv, color, outline=1, obj_id=oid, two_sided=True)
+def _scaled(color, k: float) -> tuple:
+    return tuple(min(255.0, c * k) for c in color)
 
 
 def pedestrian_patches(b: PatchBuilder, obj: ObjectState, view_world: np.ndarray) -> None:
-    """Add one pedestrian. The pose's yaw is the walking direction; ``obj.height_m`` its stature."""
+    """Add one pedestrian seen from ``view_world`` (3,) [m, world frame]. The pose's yaw is the walking (facing)
+    direction; ``obj.height_m`` its stature; ``obj.style`` seeds clothing, skin, hair and build; ``obj.gait_phase``
+    [rad] the walking cycle (0 = left heel strike), used when ``obj.speed_mps`` > 0.05. The lowest shoe point
+    touches the ground (z = 0) at the pose position; every patch carries ``obj.obj_id``."""
     h = obj.height_m
-    rng = np.random.default_rng(obj.style)
+    rng = np.random.default_rng(int(obj.style) & 0xFFFFFFFF)
     shirt = SHIRTS[int(rng.integers(len(SHIRTS)))]
     pants = PANTS[int(rng.integers(len(PANTS)))]
     skin = SKINS[int(rng.integers(len(SKINS)))]
     hair = HAIR[int(rng.integers(len(HAIR)))]
-    build = float(rng.uniform(0.9, 1.15))
+    shoes = SHOES[int(rng.integers(len(SHOES)))]
+    build = float(rng.uniform(0.92, 1.12))
+    long_sleeves = bool(rng.random() < 0.5)
+    shorts = bool(rng.random() < 0.12)
+    long_hair = bool(rng.random() < 0.3)
+    bulk = float(rng.uniform(1.0, 1.3))  # clothing on the upper body, from a shirt to a padded jacket
+    sleeve = _scaled(shirt, 0.93)
+
     p = obj.pose
     fwd = np.array([math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0])
     left = np.array([-fwd[1], fwd[0], 0.0])
-    up = np.array([0.0, 0.0, 1.0])
     base = np.array([p.x_m, p.y_m, 0.0])
-    oid = obj.obj_id
+    view = np.asarray(view_world, dtype=np.float64)
+    fig = _Figure(view, obj.obj_id)
     walking = obj.speed_mps > 0.05
-    ph = obj.gait_phase
-    swing = 0.42 if walking else 0.0  # hip swing amplitude [rad]
+    c = (obj.gait_phase / (2 * math.pi)) % 1.0  # gait cycle fraction of the left leg, 0 = heel strike
 
     def pt(x, y, z):
-        return base + x * fwd + y * left + z * up
+        return base + x * fwd + y * left + z * UP
 
-    hip_z, knee_l, shin_l = 0.53 * h, 0.245 * h, 0.245 * h
-    sh_z = 0.82 * h
-    hip_w, sh_w = 0.09 * h * build, 0.115 * h * build
-    # view direction decides how wide the torso looks: frontal shoulders vs side depth
-    vdir = view_world - base
-    vdir[2] = 0
+    def seg(ang):
+        """Unit vector at angle ``ang`` from straight down, rotated forwards (sagittal plane)."""
+        return math.sin(ang) * fwd - math.cos(ang) * UP
+
+    # how wide a trunk part looks: an elliptic cross-section of width w (across) and depth d (front to back),
+    # fractions of h; the clothing adds to the depth, more on the upper body than on the hips
+    vdir = view - base
+    vdir[2] = 0.0
     vdir /= np.linalg.norm(vdir) + 1e-12
-    frontal = abs(float(vdir @ fwd))  # 1 = seen from front/back, 0 = from the side
-    torso_half = (0.115 * frontal + 0.07 * (1 - frontal)) * h * build
+    cf = abs(float(vdir @ fwd))  # 1 = seen from the front or back, 0 = from the side
+    cs = math.sqrt(max(0.0, 1.0 - cf * cf))
 
-    # legs: far leg first so the near one is drawn over it (the z-test sorts it anyway)
-    for sgn, phase in ((+1, ph), (-1, ph + math.pi)):
-        a = swing * math.sin(phase)
-        # knee flexes during the forward swing
-        flex = (0.5 * swing * max(0.0, math.sin(phase + 0.9)) + 0.05) if walking else 0.03
-        hip = pt(0.0, sgn * hip_w * 0.6, hip_z)
-        knee = hip + knee_l * (math.sin(a) * fwd - math.cos(a) * up)
-        b2 = a - 1.4 * flex
-        ankle = knee + shin_l * (math.sin(b2) * fwd - math.cos(b2) * up)
-        _limb(b, hip, knee, 0.06 * h * build, view_world, pants, oid)
-        _limb(b, knee, ankle, 0.045 * h * build, view_world, pants, oid)
-        toe = ankle + 0.13 * h * fwd
-        toe[2] = max(toe[2], 0.02)
-        _limb(b, ankle, toe, 0.03 * h, view_world, SHOES, oid)
-    # torso and head
-    pelvis = pt(0, 0, hip_z - 0.02 * h)
-    neck = pt(0.01 * h, 0, sh_z + 0.01 * h)
-    _limb(b, pelvis, neck, torso_half, view_world, shirt, oid)
-    _limb(b, pt(0, 0, sh_z), pt(0, 0, 0.87 * h), 0.03 * h, view_world, skin, oid)
-    head_c = pt(0.01 * h, 0, 0.93 * h)
-    _disc(b, head_c, 0.066 * h, view_world, skin, oid, rx=0.055 * h)
-    _disc(b, head_c + 0.025 * h * up - 0.012 * h * fwd, 0.045 * h, view_world, hair, oid, rx=0.058 * h)
-    # arms swing against the legs
-    for sgn, phase in ((+1, ph + math.pi), (-1, ph)):
-        a = 0.6 * swing * math.sin(phase)
-        sh = pt(0, sgn * sh_w, sh_z - 0.02 * h)
-        elbow = sh + 0.17 * h * (math.sin(a) * fwd - math.cos(a) * up)
-        a2 = a + (0.35 if walking else 0.1)
-        wrist = elbow + 0.15 * h * (math.sin(a2) * fwd - math.cos(a2) * up)
-        _limb(b, sh, elbow, 0.035 * h * build, view_world, shirt, oid)
-        _limb(b, elbow, wrist, 0.028 * h, view_world, skin, oid)
+    hips = 1.0 + 0.5 * (bulk - 1.0)
+
+    def across(w, d, bk=bulk):
+        return math.hypot(w * cf, d * cs * bk) * h * build
+
+    lean = 0.06 if walking else 0.0  # trunk leans forwards a little when walking [rad]
+
+    def trunk(z, x=0.0):
+        """A point on the trunk's mid-line at height z [fraction of h], leaning forwards about the hips."""
+        return pt(x * h + (z - 0.53) * h * math.sin(lean), 0.0, z * h)
+
+    # ---- legs: thigh, shank, shoe
+    hip_z, thigh, shank = 0.53 * h, 0.245 * h, 0.246 * h
+    foot_l, ankle_h = 0.155 * h, 0.039 * h
+    for sgn, cl in ((+1, c), (-1, (c + 0.5) % 1.0)):
+        if walking:
+            a, knee_flex, toe_down = (math.radians(float(np.interp(cl, GAIT_C, t))) for t in (HIP, KNEE, FOOT))
+            stance_y = 0.05 * h
+        else:
+            a, knee_flex, toe_down, stance_y = 0.02 * sgn, 0.03, 0.0, 0.055 * h
+        b_ang = a - knee_flex
+        hip = pt(0.0, sgn * stance_y, hip_z)
+        knee = hip + thigh * seg(a)
+        ankle = knee + shank * seg(b_ang)
+        if shorts:
+            mid = hip + 0.55 * thigh * seg(a)
+            fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, pants, bias=0.005)
+            fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, skin, bias=0.004, caps=(False, True))
+            fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, skin, bias=0.005)
+        else:
+            fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, pants, bias=0.005)
+            fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, pants, bias=0.005)
+        # the shoe, pitched toe-down at heel-off and toe-up at heel strike
+        f_dir = math.cos(toe_down) * fwd - math.sin(toe_down) * UP
+        f_up = math.sin(toe_down) * fwd + math.cos(toe_down) * UP
+        shoe_h = 0.06 * h
+        centre = ankle + 0.28 * foot_l * f_dir + (shoe_h / 2 - ankle_h) * f_up
+        fig.box(centre, np.stack([f_dir, left, f_up]), [foot_l, 0.058 * h * build, shoe_h], shoes)
+
+    # ---- trunk: pelvis (trousers), torso (shirt) with a lighter chest, shoulders sloping to the neck
+    fig.limb(trunk(0.465, -0.004), trunk(0.6), across(0.098, 0.086, hips), across(0.086, 0.079, hips), pants,
+             caps=(False, False))
+    fig.limb(trunk(0.54), trunk(0.67, 0.006), across(0.09, 0.082, hips), across(0.086, 0.082, hips),
+             _scaled(shirt, 0.95), bias=0.01, caps=(False, False))
+    fig.limb(trunk(0.665, 0.006), trunk(0.785, 0.004), across(0.087, 0.084), across(0.104, 0.09),
+             shirt, bias=0.01, caps=(False, False))
+    fig.limb(trunk(0.78, 0.004), trunk(0.845), across(0.125, 0.086), across(0.055, 0.058),
+             shirt, bias=0.011, caps=(False, False))
+    # ---- neck and head (face, hair cap, hair at the back)
+    fig.limb(trunk(0.82, 0.005), trunk(0.885, 0.01), 0.028 * h, 0.028 * h, _scaled(skin, 0.9),
+             bias=0.0, caps=(False, False))
+    head_c = trunk(0.935, 0.012)
+    head_w = (0.048 * cf + 0.055 * cs) * h
+    front = float(vdir @ fwd)
+    face_bias, hair_bias = (0.02, 0.015) if front > -0.3 else (0.012, 0.02)
+    fig.disc(head_c, 0.065 * h, head_w, skin, bias=face_bias)
+    fig.disc(head_c + 0.022 * h * UP - 0.012 * h * fwd, 0.046 * h, head_w * 1.08, hair, bias=hair_bias)
+    fig.disc(head_c + 0.006 * h * UP - 0.02 * h * fwd, 0.058 * h, head_w * 1.02, hair, bias=hair_bias - 0.004)
+    if front > -0.2:  # eyes on the front of the head; hidden by the face or hair from behind
+        for s in (+1, -1):
+            fig.disc(head_c + 0.046 * h * fwd + 0.018 * h * s * left + 0.004 * h * UP, 0.0055 * h, 0.008 * h,
+                     (40, 35, 35), bias=0.01)
+    if long_hair:
+        fig.limb(head_c - 0.025 * h * fwd, head_c - 0.03 * h * fwd - 0.13 * h * UP, 0.05 * h, 0.045 * h, hair,
+                 bias=0.012 * cs, caps=(True, False))
+
+    # ---- arms swing against the legs: upper arm, forearm, hand
+    for sgn, cl in ((+1, c), (-1, (c + 0.5) % 1.0)):
+        if walking:
+            hip_a = math.radians(float(np.interp(cl, GAIT_C, HIP)))
+            a = -0.8 * (hip_a - math.radians(9.0))
+            a2 = a + 0.3 + 0.8 * max(0.0, a)
+        else:
+            a, a2 = 0.0, 0.12
+        sh = trunk(0.795) + sgn * 0.113 * h * build * left
+        out = 0.07 * sgn * left  # slight abduction so that the arm hangs clear of the waist
+        elbow = sh + 0.186 * h * (seg(a) + out)
+        wrist = elbow + 0.146 * h * (seg(a2) + 0.5 * out)
+        fore = sleeve if long_sleeves else skin
+        fig.limb(sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, bias=0.025)
+        fig.limb(elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, bias=0.025, caps=(False, True))
+        fig.disc(wrist + 0.045 * h * seg(a2), 0.042 * h, 0.024 * h, skin, bias=0.03)
+    fig.emit(b)
