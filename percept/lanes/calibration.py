@@ -75,14 +75,11 @@ class CameraCalibration:
     pattern: tuple[int, int] = (9, 6)
 
     def __post_init__(self) -> None:
-        if not (self.fx > 0 and self.fy > 0):
-            raise ValueError(f"focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
-        if self.width < 16 or self.height < 16:
-            raise ValueError(f"image size {self.width}x{self.height} is too small")
+        self.camera()  # PinholeCamera validates focal lengths and size
 
     @property
     def K(self) -> np.ndarray:
-        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+        return self.camera().K
 
     def camera(self) -> PinholeCamera:
         """The pinhole camera of the undistorted images (same K, no distortion)."""

@@ -3,25 +3,13 @@
 import cv2
 import numpy as np
 import pytest
-from highway_env.road.road import RoadNetwork
 
-from percept.sensors import Pose2D, Side, StereoRig
-from percept.sims.road_geometry import build_road_geometry
+from percept.sensors import Pose2D, Side
 from percept.sims.render import ObjectKind, ObjectState, PatchBuilder, Scene, StereoRenderer
 from percept.sims.render.vehicles import vehicle_patches
 
 EGO = Pose2D(100.0, -4.0, 0.0)
 """Ego in lane 1 of highway-env's straight 4-lane road (world y = -4), looking along +x."""
-
-
-@pytest.fixture(scope="module")
-def rig():
-    return StereoRig()
-
-
-@pytest.fixture(scope="module")
-def road():
-    return build_road_geometry(RoadNetwork.straight_road_network(4, length=400))
 
 
 @pytest.fixture(scope="module")

@@ -4,25 +4,13 @@ between the two images, and OpenCV's semi-global matcher recovers the ground-tru
 import cv2
 import numpy as np
 import pytest
-from highway_env.road.road import RoadNetwork
 
 from percept.sensors import Pose2D, StereoRig
-from percept.sims.road_geometry import build_road_geometry
 from percept.sims.render import ObjectKind, ObjectState, Scene, StereoRenderer
 
 EGO = Pose2D(100.0, -4.0, 0.0)
 """Ego in lane 1 of highway-env's straight 4-lane road (world y = -4), looking along +x."""
 SEED = 3
-
-
-@pytest.fixture(scope="module")
-def rig():
-    return StereoRig()
-
-
-@pytest.fixture(scope="module")
-def road():
-    return build_road_geometry(RoadNetwork.straight_road_network(4, length=400))
 
 
 def car(oid: int, x_m: float, y_m: float = EGO.y_m, style: int = 1, yaw: float = 0.0) -> ObjectState:
