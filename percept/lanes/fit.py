@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .breaks import find_break
 from .types import LaneEstimate, LaneFit, MarkingEvidence
 
 
@@ -142,19 +141,9 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
     _, params, sides, r, m, cov, nl, nr = best
     inl = np.abs(r) < 3 * cfg.huber_m
     a0, a1, a2, w = params[:4]
-    cov4 = cov[:4, :4]
-    # a curvature change ahead: keep the near lane's parameters clean and report the change
-    used = np.flatnonzero(m)[inl]
-    brk = find_break(pts[used, 0], pts[used, 1], sides[used].astype(float), np.clip(ev.strength[used], 1, None),
-                     cfg.width_prior_m, cfg.width_sigma_m, cfg.huber_m)
-    if brk is not None:
-        a0, a1, a2, w = brk.near_params
-        sigma2 = max(float(np.mean(r[inl] ** 2)), cfg.huber_m ** 2 / 4) * np.mean(np.clip(ev.strength[used], 1, None))
-        cov4 = sigma2 * np.linalg.inv(brk.normal)
     support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6)
     est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support))
     res = float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan")
     # (a0, a1, a2, w) -> (offset, heading, curvature, width): Jacobian diag(-1, -1/(1+a1^2), 2, 1)
     J = np.diag([-1.0, -1.0 / (1 + a1 * a1), 2.0, 1.0])
-    return LaneFit(est, np.where(m, sides, 0), res, nl, nr, J @ cov4 @ J.T,
-                   None if brk is None else brk.distance_m, None if brk is None else brk.curvature_far_1pm)
+    return LaneFit(est, np.where(m, sides, 0), res, nl, nr, J @ cov[:4, :4] @ J.T)

@@ -31,7 +31,6 @@ class LaneTracker:
         self.kf = kf
         self.initialised = False
         self.confidence = 0.0
-        self.pending_break: tuple[float, float] | None = None  # (distance still to go [m], curvature after it)
 
     def predict(self, speed_mps: float, yaw_rate_rps: float, dt: float) -> None:
         v = speed_mps if math.isfinite(speed_mps) else 0.0
@@ -42,18 +41,9 @@ class LaneTracker:
         Q = np.diag([0.02 ** 2, 0.004 ** 2, (2e-4 + 2e-5 * v) ** 2, 0.01 ** 2]) * max(dt, 1e-3) * 15
         self.kf.predict(u=np.array([r]), B=B, F=F, Q=Q)
         self.confidence *= 0.85
-        if self.pending_break is not None:
-            # the car reaches the curvature change the fit saw ahead: switch to the curvature after it
-            togo, kappa_far = self.pending_break[0] - v * dt, self.pending_break[1]
-            self.pending_break = (togo, kappa_far)
-            if togo <= 0:
-                self.kf.x[2] = kappa_far
-                self.kf.P[2, 2] = max(self.kf.P[2, 2], (2e-4) ** 2)
-                self.pending_break = None
 
     def update(self, fit: LaneFit) -> None:
         e = fit.estimate
-        self.pending_break = None if fit.break_m is None else (fit.break_m, fit.curvature_far_1pm)
         z = np.array([e.offset_m, e.heading_rad, e.curvature_1pm, e.width_m])
         # the fit's covariance, inflated for correlated pixel errors, with a floor per parameter
         R = 4.0 * fit.cov + np.diag([0.01 ** 2, 0.001 ** 2, 2e-5 ** 2, 0.02 ** 2])

@@ -48,8 +48,7 @@ class MarkingEvidence:
 class LaneFit:
     """One frame's robust fit. estimate: the fitted lane (confidence from support); side: (N,) +1 left,
     -1 right, 0 outlier, per evidence point; residual_m: RMS residual of the inliers [m]; cov: (4, 4)
-    covariance of (offset, heading, curvature, width) from the least-squares normal equations; break_m,
-    curvature_far_1pm: a curvature change ahead, if the points show one."""
+    covariance of (offset, heading, curvature, width) from the least-squares normal equations."""
 
     estimate: LaneEstimate
     side: np.ndarray
@@ -57,6 +56,3 @@ class LaneFit:
     inliers_left: int
     inliers_right: int
     cov: np.ndarray
-    break_m: float | None = None
-    curvature_far_1pm: float | None = None
-    """A curvature change ahead (see breaks.py): where it starts [m] and the curvature after it."""
