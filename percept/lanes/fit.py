@@ -19,13 +19,15 @@ from .types import LaneEstimate, LaneFit, MarkingEvidence
 @dataclass(frozen=True)
 class FitConfig:
     """width_prior_m, width_sigma_m: lane width prior; curvature_sigma_1pm: prior spread of curvature around 0;
-    curvature_rate_sigma_1pm2: prior spread of the curvature's change along the road;
+    curvature_rate_sigma_1pm2: prior spread of the curvature's change along the road; heading_sigma_rad: prior
+    spread of the car's heading relative to its lane;
     gate_m: side-assignment gate around a prediction [m]; huber_m: Huber threshold [m]; min_points: per fit."""
 
     width_prior_m: float = 3.7
     width_sigma_m: float = 0.4
     curvature_sigma_1pm: float = 0.01
     curvature_rate_sigma_1pm2: float = 5e-5
+    heading_sigma_rad: float = 0.05
     gate_m: float = 0.7
     huber_m: float = 0.08
     min_points: int = 12
@@ -70,10 +72,12 @@ def _solve(pts, sides, strength, cfg: FitConfig, iterations: int = 3):
     unscale = np.array([1.0, 0.1, 0.01, 1.0, 0.001])
     sig = cfg.huber_m
     # priors as pseudo-observations on the scaled parameters: w = w0, a2 = 0, a3 = 0
+    # and heading ~ 0 (a car drives roughly along its lane): a1 = 0 with sigma_heading
     P = np.array([[0, 0, 0, 1.0 / cfg.width_sigma_m, 0],
                   [0, 0, 2.0 * 0.01 / cfg.curvature_sigma_1pm, 0, 0],
-                  [0, 0, 0, 0, 6.0 * 0.001 / cfg.curvature_rate_sigma_1pm2]]) * sig
-    q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0]) * sig
+                  [0, 0, 0, 0, 6.0 * 0.001 / cfg.curvature_rate_sigma_1pm2],
+                  [0, 0.1 / cfg.heading_sigma_rad, 0, 0, 0]]) * sig
+    q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0, 0.0]) * sig
     base = np.clip(strength[m], 1, None)
     w2 = base / base.mean()
     for _ in range(iterations):
