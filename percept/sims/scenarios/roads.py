@@ -1,4 +1,5 @@
-"""Road networks built from highway-env's own lane classes (StraightLane, CircularLane).
+"""Road networks built from highway-env's own lane classes (StraightLane, CircularLane) and its AbstractLane
+(ClothoidLane: the transition curves between them).
 
 All coordinates here are highway-env's (x along travel, y to the right). Lane 0 is the leftmost;
 its left line is the solid road edge, the rightmost lane's right line too, lines between lanes dashed.
@@ -10,7 +11,12 @@ import numpy as np
 from highway_env.road.lane import CircularLane, LineType, StraightLane
 from highway_env.road.road import RoadNetwork
 
+from .clothoid import ClothoidLane
+
 C, S, N = LineType.CONTINUOUS_LINE, LineType.STRIPED, LineType.NONE
+
+SPIRAL_TIME_S = 2.0
+"""Transition curve length as travel time at the speed limit (AASHTO Green Book 2018, 3.3.8.2)."""
 
 
 def line_types(i: int, lanes: int) -> list:
@@ -25,6 +31,7 @@ class _Builder:
         self.lanes, self.w, self.v = lanes, width_m, speed_limit
         self.pos = np.zeros(2)  # centre of lane 0 at the current node
         self.heading = 0.0
+        self.kappa = 0.0  # curvature of the reference lane at the current node [1/m], + turning right
         self.k = 0
 
     def _node(self) -> str:
@@ -57,7 +64,28 @@ class _Builder:
                                                  line_types=line_types(i, self.lanes), speed_limit=self.v))
         self.pos = centre + radius_m * np.array([np.cos(phi1), np.sin(phi1)])
         self.heading += angle_rad
+        self.kappa = 1.0 / radius_m if cw else -1.0 / radius_m
         self.k += 1
+
+    def spiral(self, kappa_end_1pm: float, length_m: float) -> None:
+        """Clothoid of the reference lane from the current curvature to ``kappa_end_1pm`` (+ right) over length_m."""
+        a, b = self._node(), str(self.k + 1)
+        lanes = [ClothoidLane(self.pos, self.heading, length_m, self.kappa, kappa_end_1pm, offset_m=i * self.w,
+                              width=self.w, line_types=line_types(i, self.lanes), speed_limit=self.v)
+                 for i in range(self.lanes)]
+        for lane in lanes:
+            self.net.add_lane(a, b, lane)
+        self.pos = lanes[0].position(lanes[0].length, 0.0)
+        self.heading = lanes[0].heading_at(lanes[0].length)
+        self.kappa = kappa_end_1pm
+        self.k += 1
+
+    def transition(self, kappa_end_1pm: float) -> None:
+        """A spiral to the next curvature: 2 s of travel per half (straight to arc); a reverse curve gets both."""
+        halves = (abs(self.kappa) > 0) + (abs(kappa_end_1pm) > 0)
+        if halves and kappa_end_1pm != self.kappa:
+            length = SPIRAL_TIME_S * self.v * (2 if self.kappa * kappa_end_1pm < 0 else 1)
+            self.spiral(kappa_end_1pm, length)
 
 
 def straight_road(lanes: int, length_m: float, width_m: float = 4.0, speed_limit: float = 30.0) -> RoadNetwork:
@@ -69,7 +97,8 @@ def straight_road(lanes: int, length_m: float, width_m: float = 4.0, speed_limit
 
 def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 4000.0, width_m: float = 4.0,
                  speed_limit: float = 25.0) -> RoadNetwork:
-    """Straight lead-in, then arcs of radius 150–600 m turning alternately left and right."""
+    """Straight lead-in, then arcs of radius 150–600 m turning alternately left and right, each entered and left
+    through a clothoid (straight to arc, or arc to reversed arc)."""
     b = _Builder(lanes, width_m, speed_limit)
     b.straight(150.0)
     total, sign = 150.0, float(rng.choice([-1.0, 1.0]))
@@ -78,12 +107,15 @@ def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 400
         arc_len = float(rng.uniform(120.0, 280.0))
         # every lane's radius within [150, 600] m: right turns put lanes inside, left turns outside
         r = max(r, 150.0 + (lanes - 1) * width_m) if sign > 0 else min(r, 600.0 - (lanes - 1) * width_m)
+        b.transition(sign / r)
         b.arc(r, sign * arc_len / r)
         total += arc_len
         if rng.random() < 0.5:
+            b.transition(0.0)
             b.straight(float(rng.uniform(40.0, 120.0)))
             total += 60.0
         sign = -sign
+    b.transition(0.0)
     b.straight(300.0)
     return b.net
 
