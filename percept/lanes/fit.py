@@ -1,8 +1,8 @@
 """Both lane boundaries fitted jointly in the vehicle frame, robustly, with a lane-width prior.
 
-Model (vehicle frame, y left): y = a0 + a1 x + a2 x^2 + s w/2, s = +1 on the left boundary, -1 on the right,
-so the lane centre is y_c = a0 + a1 x + a2 x^2, i.e. offset = -a0, heading = atan(-a1), curvature = 2 a2.
-It is linear in (a0, a1, a2, w): iteratively reweighted least squares with Huber weights (Huber 1964;
+Model (vehicle frame, y left): y = a0 + a1 x + a2 x^2 + a3 x^3 + s w/2, s = +1 on the left boundary, -1 on the
+right, so the lane centre is y_c = a0 + a1 x + a2 x^2 + a3 x^3, i.e. offset = -a0, heading = atan(-a1),
+curvature = 2 a2, curvature rate (a clothoid) = 6 a3. It is linear in (a0, a1, a2, w, a3): iteratively reweighted least squares with Huber weights (Huber 1964;
 Zhang, "Parameter estimation techniques", IVC 1997), points assigned to a side by gating around the
 prediction, pseudo-observations for the priors (width, zero curvature) so that one visible side suffices.
 """
@@ -26,7 +26,7 @@ class FitConfig:
     width_prior_m: float = 3.7
     width_sigma_m: float = 0.4
     curvature_sigma_1pm: float = 0.01
-    curvature_rate_sigma_1pm2: float = 5e-5
+    curvature_rate_sigma_1pm2: float = 1e-4
     heading_sigma_rad: float = 0.05
     gate_m: float = 0.7
     huber_m: float = 0.08
@@ -144,10 +144,12 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
         return None
     _, params, sides, r, m, cov, nl, nr = best
     inl = np.abs(r) < 3 * cfg.huber_m
-    a0, a1, a2, w = params[:4]
+    a0, a1, a2, w, a3 = params
     support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6)
-    est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support))
+    est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support),
+                       curvature_rate_1pm2=float(6 * a3))
     res = float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan")
-    # (a0, a1, a2, w) -> (offset, heading, curvature, width): Jacobian diag(-1, -1/(1+a1^2), 2, 1)
-    J = np.diag([-1.0, -1.0 / (1 + a1 * a1), 2.0, 1.0])
-    return LaneFit(est, np.where(m, sides, 0), res, nl, nr, J @ cov[:4, :4] @ J.T)
+    # (a0, a1, a2, w, a3) -> (offset, heading, curvature, curvature_rate, width): rows of the Jacobian
+    J = np.zeros((5, 5))
+    J[0, 0], J[1, 1], J[2, 2], J[3, 4], J[4, 3] = -1.0, -1.0 / (1 + a1 * a1), 2.0, 6.0, 1.0
+    return LaneFit(est, np.where(m, sides, 0), res, nl, nr, J @ cov @ J.T)

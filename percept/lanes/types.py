@@ -13,8 +13,9 @@ class LaneEstimate:
 
     offset_m: vehicle centre's lateral offset from the lane centre (+ left); heading_rad: vehicle heading relative
     to the lane (+ CCW); curvature_1pm: lane curvature (+ turning left); width_m; confidence: 0..1 (0 = no
-    evidence, the values are a prediction); valid: False before the first fit. The lane centre in the vehicle
-    frame is y_c(x) = -offset - tan(heading) x + curvature x^2 / 2.
+    evidence, the values are a prediction); valid: False before the first fit; curvature_rate_1pm2: change of
+    the curvature per metre ahead (a clothoid). The lane centre in the vehicle frame is
+    y_c(x) = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6.
     """
 
     offset_m: float
@@ -23,11 +24,14 @@ class LaneEstimate:
     width_m: float
     confidence: float
     valid: bool = True
+    curvature_rate_1pm2: float = 0.0
 
     def centre_y(self, x_m: np.ndarray) -> np.ndarray:
         """Lateral position of the lane centre at distances x_m ahead [m]."""
         x = np.asarray(x_m, dtype=float)
-        return -self.offset_m - np.tan(self.heading_rad) * x + 0.5 * self.curvature_1pm * x * x
+        # y_c = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6
+        return (-self.offset_m - np.tan(self.heading_rad) * x + 0.5 * self.curvature_1pm * x * x
+                + self.curvature_rate_1pm2 * x ** 3 / 6)
 
     def boundary_y(self, x_m: np.ndarray, side: int) -> np.ndarray:
         """side +1: left boundary, -1: right boundary."""
@@ -47,8 +51,8 @@ class MarkingEvidence:
 @dataclass(frozen=True)
 class LaneFit:
     """One frame's robust fit. estimate: the fitted lane (confidence from support); side: (N,) +1 left,
-    -1 right, 0 outlier, per evidence point; residual_m: RMS residual of the inliers [m]; cov: (4, 4)
-    covariance of (offset, heading, curvature, width) from the least-squares normal equations."""
+    -1 right, 0 outlier, per evidence point; residual_m: RMS residual of the inliers [m]; cov: (5, 5)
+    covariance of (offset, heading, curvature, curvature_rate, width) from the least-squares normal equations."""
 
     estimate: LaneEstimate
     side: np.ndarray

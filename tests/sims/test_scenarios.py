@@ -12,6 +12,7 @@ from percept.sims.coords import world_to_hw_xy
 from percept.sims.env import PerceptEnv
 from percept.sims.ground_truth import lane_truth
 from percept.sims.road_geometry import SHOULDER_M
+from percept.sims.scenarios import ClothoidLane, winding_road
 from percept.sims.scenarios.catalog import CROSSING_LANE_W, _chain
 
 DT = 1 / 15
@@ -244,9 +245,47 @@ def test_curves_radii_and_curvature_sign_of_every_arc():
             probe = types.SimpleNamespace(lane=lane, position=lane.position(s, 0.0), heading=lane.heading_at(s),
                                           lane_index=("?", "?", 1))
             k = lane_truth(probe).curvature_1pm
-            expect = (-1.0 if lane.clockwise else 1.0) / lane.radius if isinstance(lane, CircularLane) else 0.0
+            if isinstance(lane, CircularLane):
+                expect = (-1.0 if lane.clockwise else 1.0) / lane.radius
+            elif isinstance(lane, ClothoidLane):
+                expect = -lane.curvature_at(s)
+            else:
+                expect = 0.0
             assert k == pytest.approx(expect, rel=1e-3, abs=1e-9)
         e.close()
+
+
+def test_curves_curvature_is_continuous_through_clothoid_transitions():
+    """No curvature steps: along the ego lane, the truth changes by at most the steepest spiral's rate x 1 m."""
+    e = env("curves", 0)
+    lanes = segments(e.road.network, 1)
+    assert any(isinstance(lane, ClothoidLane) for lane in lanes)
+    ks = []
+    for lane in lanes:
+        for s in np.arange(0.0, lane.length, 1.0):
+            probe = types.SimpleNamespace(lane=lane, position=lane.position(s, 0.0), heading=lane.heading_at(s),
+                                          lane_index=("?", "?", 1))
+            ks.append(lane_truth(probe).curvature_1pm)
+    # steepest spiral: 1/150 m over 50 m (reverse curves: 2/150 over 100 m); with 1 m steps and the ±1 m
+    # central difference, one sample may straddle a join
+    assert np.max(np.abs(np.diff(ks))) < 2.5 * (1 / 150) / 50
+    e.close()
+
+
+def test_clothoid_lane_round_trip_and_arc_length():
+    lane = ClothoidLane(np.array([10.0, -5.0]), 0.3, 60.0, 0.0, 1 / 150, offset_m=8.0, width=4.0)
+    rng = np.random.default_rng(0)
+    for s, r in zip(rng.uniform(-5, lane.length + 5, 50), rng.uniform(-3, 3, 50)):
+        s2, r2 = lane.local_coordinates(lane.position(s, r))
+        assert (s2, r2) == pytest.approx((s, r), abs=1e-5)
+    pts = np.array([lane.position(s, 0.0) for s in np.linspace(0, lane.length, 3001)])
+    assert np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)) == pytest.approx(lane.length, abs=1e-3)
+    # heading at the end: theta0 + (k0 + k1) L / 2, whatever the offset
+    assert lane.heading_at(lane.length) == pytest.approx(0.3 + 60.0 / 300.0, abs=1e-12)
+    # the offset lane inside the turn is shorter: ds = (1 - offset k) du
+    assert lane.length == pytest.approx(60.0 - 8.0 * 60.0 / 300.0, abs=1e-9)
+    with pytest.raises(ValueError, match="positive length"):
+        ClothoidLane(np.zeros(2), 0.0, 0.0, 0.0, 0.01)
 
 
 def test_curves_closed_loop_curvature_takes_both_signs_and_matches_yaw_rate():
@@ -295,3 +334,18 @@ def test_loop_is_a_closed_circuit_over_3_km_with_landmarks_off_the_road():
             s, lat = lane.local_coordinates(p)
             if -1.0 <= s <= lane.length + 1.0:  # beside this segment: off the paved surface
                 assert abs(lat) > lane.width / 2 + SHOULDER_M, (mid, lat)
+
+
+def test_indexed_network_answers_like_highway_env():
+    from highway_env.road.road import RoadNetwork
+
+    net = winding_road(np.random.default_rng(3), lanes=3, length_m=2600.0)
+    lanes = [lane for tos in net.graph.values() for ls in tos.values() for lane in ls]
+    rng = np.random.default_rng(0)
+    for _ in range(400):
+        lane = lanes[rng.integers(len(lanes))]
+        p = lane.position(rng.uniform(-5, lane.length + 5), rng.uniform(-6, 6))
+        if rng.random() < 0.1:
+            p = p + rng.normal(0, 100, 2)  # off the road: the full search answers
+        h = lane.heading_at(0.0) + rng.normal(0, 0.3)
+        assert net.get_closest_lane_index(p, h) == RoadNetwork.get_closest_lane_index(net, p, h)

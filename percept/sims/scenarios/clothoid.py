@@ -68,31 +68,43 @@ class ClothoidLane(AbstractLane):
         return self.theta0 + self.k0 * u + (self.k1 - self.k0) * u * u / (2 * self.length_ref)
 
     def _u_of_s(self, s: float) -> float:
+        # beyond either end the reference line continues as an arc of the end curvature: ds = (1 - offset k) du
         if s <= 0.0:
-            return s
+            return s / (1.0 - self.offset * self.k0)
         if s >= self.length:
-            return self.length_ref + (s - self.length)
+            return self.length_ref + (s - self.length) / (1.0 - self.offset * self.k1)
         # s = b u + a u^2 with b = 1 - offset k0, a = -offset (k1 - k0) / (2 L_ref): the stable root
         a = -self.offset * (self.k1 - self.k0) / (2 * self.length_ref)
         b = 1.0 - self.offset * self.k0
         return 2.0 * s / (b + math.sqrt(b * b + 4.0 * a * s))
 
     def _centre(self, longitudinal: float) -> tuple[float, float, float]:
-        """Lane centre (x, y) [m] and heading [rad] at a longitudinal coordinate (straight beyond the ends)."""
+        """Lane centre (x, y) [m] and heading [rad] at a longitudinal coordinate (arcs beyond the ends)."""
         u = self._u_of_s(longitudinal)
         uc = min(max(u, 0.0), self.length_ref)
-        th = self._theta_u(uc)
         g = uc / self._h
         i = min(int(g), self._n - 1)
         f = g - i
         x = self._rx[i] * (1 - f) + self._rx[i + 1] * f
         y = self._ry[i] * (1 - f) + self._ry[i + 1] * f
-        c, s = math.cos(th), math.sin(th)
-        e, d = u - uc, self.offset
-        return x + e * c - d * s, y + e * s + d * c, th
+        th_c = self._theta_u(uc)
+        e = u - uc
+        if e != 0.0:
+            # along an arc of curvature k for e metres: sin(k e)/k ahead, (1 - cos(k e))/k to the right
+            k = self.k0 if e < 0 else self.k1
+            ke = k * e
+            ahead = e if abs(ke) < 1e-9 else math.sin(ke) / k
+            right = 0.0 if abs(ke) < 1e-9 else (1.0 - math.cos(ke)) / k
+            c, s = math.cos(th_c), math.sin(th_c)
+            x, y = x + ahead * c - right * s, y + ahead * s + right * c
+            th_c += ke
+        c, s = math.cos(th_c), math.sin(th_c)
+        d = self.offset
+        return x - d * s, y + d * c, th_c
 
     def curvature_at(self, longitudinal: float) -> float:
-        """Curvature of the lane centre [1/m] (highway-env sign: + turning right): k / (1 - offset k)."""
+        """Curvature of the lane centre [1/m] (highway-env sign: + turning right): k / (1 - offset k); the end
+        values beyond the ends."""
         u = min(max(self._u_of_s(longitudinal), 0.0), self.length_ref)
         k = self.k0 + (self.k1 - self.k0) * u / self.length_ref
         return k / (1 - self.offset * k)
@@ -117,9 +129,12 @@ class ClothoidLane(AbstractLane):
         k = int(np.argmin((self._tab_c[:, 0] - px) ** 2 + (self._tab_c[:, 1] - py) ** 2))
         s = float(self._tab_s[k])
         for _ in range(2):
-            # Newton step along the tangent: s += (p - c(s)) . t(s)
+            # Newton step: s += (p - c(s)) . t / (1 - r k), r = (p - c(s)) . n, as a point r to the right of the
+            # centre line moves (1 - r k) metres per metre of s
             x, y, th = self._centre(s)
-            s += (px - x) * math.cos(th) + (py - y) * math.sin(th)
+            c, sn = math.cos(th), math.sin(th)
+            r = -(px - x) * sn + (py - y) * c
+            s += ((px - x) * c + (py - y) * sn) / max(1.0 - r * self.curvature_at(s), 0.1)
         x, y, th = self._centre(s)
         return s, -(px - x) * math.sin(th) + (py - y) * math.cos(th)
 

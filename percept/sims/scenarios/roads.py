@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 from highway_env.road.lane import CircularLane, LineType, StraightLane
-from highway_env.road.road import RoadNetwork
 
 from .clothoid import ClothoidLane
+from .network import IndexedRoadNetwork
 
 C, S, N = LineType.CONTINUOUS_LINE, LineType.STRIPED, LineType.NONE
 
@@ -27,7 +27,7 @@ class _Builder:
     """Chains straight and arc segments of a multi-lane road, tracking the reference (leftmost lane) pose."""
 
     def __init__(self, lanes: int, width_m: float, speed_limit: float):
-        self.net = RoadNetwork()
+        self.net = IndexedRoadNetwork()
         self.lanes, self.w, self.v = lanes, width_m, speed_limit
         self.pos = np.zeros(2)  # centre of lane 0 at the current node
         self.heading = 0.0
@@ -88,7 +88,8 @@ class _Builder:
             self.spiral(kappa_end_1pm, length)
 
 
-def straight_road(lanes: int, length_m: float, width_m: float = 4.0, speed_limit: float = 30.0) -> RoadNetwork:
+def straight_road(lanes: int, length_m: float, width_m: float = 4.0,
+                  speed_limit: float = 30.0) -> IndexedRoadNetwork:
     """A straight multi-lane road from node "0" to "1"."""
     b = _Builder(lanes, width_m, speed_limit)
     b.straight(length_m)
@@ -96,7 +97,7 @@ def straight_road(lanes: int, length_m: float, width_m: float = 4.0, speed_limit
 
 
 def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 4000.0, width_m: float = 4.0,
-                 speed_limit: float = 25.0) -> RoadNetwork:
+                 speed_limit: float = 25.0) -> IndexedRoadNetwork:
     """Straight lead-in, then arcs of radius 150–600 m turning alternately left and right, each entered and left
     through a clothoid (straight to arc, or arc to reversed arc)."""
     b = _Builder(lanes, width_m, speed_limit)
@@ -121,7 +122,7 @@ def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 400
 
 
 def loop_road(lanes: int = 2, straight_m: float = 1000.0, radius_m: float = 260.0, width_m: float = 4.0,
-              speed_limit: float = 25.0) -> RoadNetwork:
+              speed_limit: float = 25.0) -> IndexedRoadNetwork:
     """A closed circuit: two straights joined by two half circles turning right (clockwise); ~3.6 km."""
     b = _Builder(lanes, width_m, speed_limit)
     b.straight(straight_m)
