@@ -10,6 +10,7 @@ prediction, pseudo-observations for the priors (width, zero curvature) so that o
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -61,57 +62,65 @@ def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list
     return out
 
 
+@lru_cache(maxsize=8)
+def _prior_normal(cfg: FitConfig) -> tuple[np.ndarray, np.ndarray]:
+    """P^T P and P^T q of the priors, as pseudo-observations on the scaled parameters: w = w0, a2 = 0, a3 = 0
+    and heading ~ 0 (a car drives roughly along its lane): a1 = 0 with sigma_heading."""
+    P = np.array([[0, 0, 0, 1.0 / cfg.width_sigma_m, 0],
+                  [0, 0, 2.0 * 0.01 / cfg.curvature_sigma_1pm, 0, 0],
+                  [0, 0, 0, 0, 6.0 * 0.001 / cfg.curvature_rate_sigma_1pm2],
+                  [0, 0.1 / cfg.heading_sigma_rad, 0, 0, 0]]) * cfg.huber_m
+    q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0, 0.0]) * cfg.huber_m
+    return P.T @ P, P.T @ q
+
+
+_UNSCALE = np.array([1.0, 0.1, 0.01, 1.0, 0.001])
+
+
 def _solve(pts, sides, strength, cfg: FitConfig, iterations: int = 3):
     """IRLS on the normal equations (5 unknowns); returns params, residuals, mask of used points, covariance."""
     m = sides != 0
     x, y, s = pts[m, 0], pts[m, 1], sides[m].astype(float)
     # columns: a0, a1, a2, w, and a3 (x^3) that absorbs curvature changing ahead (a clothoid: a3 = dkappa/ds / 6);
-    # x in units of 10 m keeps the powers well conditioned (undone on the parameters below)
+    # x in units of 10 m keeps the powers well conditioned (undone on the parameters with _UNSCALE)
     xs = x / 10.0
     A = np.column_stack([np.ones_like(xs), xs, xs * xs, s / 2, xs ** 3])
-    unscale = np.array([1.0, 0.1, 0.01, 1.0, 0.001])
     sig = cfg.huber_m
-    # priors as pseudo-observations on the scaled parameters: w = w0, a2 = 0, a3 = 0
-    # and heading ~ 0 (a car drives roughly along its lane): a1 = 0 with sigma_heading
-    P = np.array([[0, 0, 0, 1.0 / cfg.width_sigma_m, 0],
-                  [0, 0, 2.0 * 0.01 / cfg.curvature_sigma_1pm, 0, 0],
-                  [0, 0, 0, 0, 6.0 * 0.001 / cfg.curvature_rate_sigma_1pm2],
-                  [0, 0.1 / cfg.heading_sigma_rad, 0, 0, 0]]) * sig
-    q = np.array([cfg.width_prior_m / cfg.width_sigma_m, 0.0, 0.0, 0.0]) * sig
+    PtP, Ptq = _prior_normal(cfg)
     base = np.clip(strength[m], 1, None)
     w2 = base / base.mean()
     for _ in range(iterations):
         # weighted normal equations (A^T W A + P^T P) p = A^T W y + P^T q
         Aw = A * w2[:, None]
-        normal = A.T @ Aw + P.T @ P
-        sol = np.linalg.solve(normal, Aw.T @ y + P.T @ q)
+        normal = A.T @ Aw + PtP
+        sol = np.linalg.solve(normal, Aw.T @ y + Ptq)
         r = A @ sol - y
         # Huber weights: 1 inside the threshold, threshold/|r| outside
-        hub = np.where(np.abs(r) <= sig, 1.0, sig / np.maximum(np.abs(r), 1e-9))
-        w2 = base * hub
+        w2 = base * (sig / np.maximum(np.abs(r), sig))
         w2 /= w2.mean()
-    params = sol * unscale
+    params = sol * _UNSCALE
     # parameter covariance: sigma^2 (A^T W A)^-1 with the weighted residual scale, back in unscaled units
     sigma2 = max(float(np.sum(w2 * r * r) / max(len(r) - 5, 1)), sig * sig / 4)
-    cov = sigma2 * np.linalg.inv(normal) * np.outer(unscale, unscale)
+    cov = sigma2 * np.linalg.inv(normal) * np.outer(_UNSCALE, _UNSCALE)
     return params, r, m, cov
 
 
 def _grow(pts, sides, strength, cfg: FitConfig):
-    """Fit, re-gate every point around the fitted boundaries, refit; (support, params, sides, r, m, cov, nl, nr)."""
+    """Fit, re-gate every point around the fitted boundaries, refit (twice at most, until the assignment
+    settles); (support, params, sides, r, m, cov, nl, nr)."""
     if (sides != 0).sum() < cfg.min_points:
         return None
+    params, r, m, cov = _solve(pts, sides, strength, cfg)
+    x = pts[:, 0]
     for _ in range(2):
-        params, r, m, cov = _solve(pts, sides, strength, cfg)
-        x = pts[:, 0]
         pred = params[0] + params[1] * x + params[2] * x ** 2 + params[4] * x ** 3
         new = np.zeros(len(pts), dtype=int)
         for s in (1, -1):
             new[np.abs(pts[:, 1] - (pred + s * params[3] / 2)) < 3 * cfg.huber_m + 0.1] = s
-        if (new != 0).sum() < cfg.min_points:
+        if (new != 0).sum() < cfg.min_points or np.array_equal(new, sides):
             break
         sides = new
-    params, r, m, cov = _solve(pts, sides, strength, cfg)
+        params, r, m, cov = _solve(pts, sides, strength, cfg)
     if not 2.4 <= params[3] <= 5.2:
         return None
     inl = np.abs(r) < 3 * cfg.huber_m
