@@ -138,8 +138,10 @@ def drive(
     with progress_bar() as bar:
         task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)
         try:
+            # frames are rendered when a slot or the recording needs them
             result = run_drive(cfg, recorder_factory=make_recorder if rec_path else None,
-                               progress=lambda i, n: bar.update(task, completed=i, total=n))
+                               progress=lambda i, n: bar.update(task, completed=i, total=n),
+                               render=rec_path is not None or cfg.needs_cameras)
         finally:
             if "r" in recorder_box:
                 recorder_box["r"].close()

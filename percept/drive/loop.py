@@ -50,6 +50,11 @@ class DriveConfig:
             if mode is Mode.VISION and slot not in VISION_SLOTS:
                 raise ValueError(f"the {slot} slot has no vision implementation yet; use --{slot} privileged")
 
+    @property
+    def needs_cameras(self) -> bool:
+        """Whether any slot reads the camera images."""
+        return any(getattr(self, slot) is Mode.VISION for slot in SLOTS)
+
 
 def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, int], None] | None = None,
               render: bool = True) -> dict:
