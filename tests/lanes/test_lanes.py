@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from percept.lanes import FitConfig, LaneDetector, LaneEstimate, MarkingEvidence, MarkingExtractor, fit_lane
+from percept.lanes import (FitConfig, LaneDetector, LaneEstimate, LaneTracker, MarkingEvidence, MarkingExtractor,
+                           fit_lane)
 from percept.sensors import StereoRig
 
 
@@ -32,6 +33,36 @@ def test_fit_recovers_a_known_lane(offset, heading, curvature):
     assert e.curvature_1pm == pytest.approx(curvature, abs=3e-4)
     assert e.width_m == pytest.approx(3.6, abs=0.05)
     assert fit.inliers_left > 20 and fit.inliers_right > 20
+
+
+def test_fit_recovers_the_curvature_rate_of_a_clothoid():
+    truth = LaneEstimate(0.3, 0.01, 0.002, 3.7, 1.0, curvature_rate_1pm2=1.2e-4)
+    fit = fit_lane(synthetic_evidence(truth, np.random.default_rng(2), outliers=40), prior=None)
+    assert fit is not None and fit.cov.shape == (5, 5)
+    e = fit.estimate
+    assert e.curvature_rate_1pm2 == pytest.approx(1.2e-4, abs=3e-5)
+    assert e.curvature_1pm == pytest.approx(0.002, abs=3e-4)
+    assert e.heading_rad == pytest.approx(0.01, abs=0.003)
+
+
+def test_tracker_follows_curvature_along_a_spiral():
+    """A car on the centre of a clothoid (curvature rising 6e-5 per metre): the Kalman filter's curvature rate
+    state keeps the curvature within 1.5e-4 1/m of the truth, where a lag of 0.3 s would cost 4.5e-4."""
+    tracker, rng = LaneTracker(), np.random.default_rng(3)
+    v, dt, rate = 25.0, 1 / 15, 6e-5
+    err = []
+    for i in range(90):
+        k = rate * v * dt * i
+        truth = LaneEstimate(0.0, 0.0, k, 3.7, 1.0, curvature_rate_1pm2=rate)
+        if tracker.initialised:
+            # the car turns with the road under it: yaw rate = v k
+            tracker.predict(v, v * k, dt)
+        fit = fit_lane(synthetic_evidence(truth, rng), tracker.estimate if tracker.initialised else None)
+        tracker.update(fit)
+        if i >= 30:
+            err.append(tracker.estimate.curvature_1pm - k)
+    assert np.sqrt(np.mean(np.square(err))) < 1.5e-4
+    assert tracker.estimate.curvature_rate_1pm2 == pytest.approx(rate, abs=2e-5)
 
 
 def test_fit_with_one_side_only_uses_the_width_prior():

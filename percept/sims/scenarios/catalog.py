@@ -168,7 +168,7 @@ SIGN_OFFSET_M = 4.0
 
 
 def build_loop(env, rng) -> Road:
-    """A ~3.6 km circuit with ArUco signs at surveyed positions every 80 m, alternating sides."""
+    """A ~3.7 km circuit with ArUco signs at surveyed positions every 80 m, alternating sides."""
     net = loop_road()
     road = _new_road(env, net)
     env.road = road
@@ -194,12 +194,12 @@ def build_loop(env, rng) -> Road:
 SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
     Scenario("highway", "4-lane straight highway, IDM traffic at 25-30 m/s, a lead vehicle in the ego lane", 40.0,
              build_highway, 25.0),
-    Scenario("curves", "3-lane winding road of arcs with radii 150-600 m in both directions, traffic", 60.0,
+    Scenario("curves", "3-lane winding road: arcs of radii 150-600 m both ways, joined by clothoids, traffic", 60.0,
              build_curves, 20.0),
     Scenario("lead-brake", "the lead brakes at -6 m/s^2 from 25 m/s to a stop", 20.0, build_lead_brake, 25.0),
     Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead", 20.0, build_cut_in, 25.0),
     Scenario("crossing", "pedestrians cross the ego lane at 5 km/h from both sides, others stay on the verge; "
              "ego at 20-60 km/h", 70.0, build_crossing, 12.0),
-    Scenario("loop", "a 3.6 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,
+    Scenario("loop", "a 3.7 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,
              22.0),
 ]}

@@ -67,9 +67,9 @@ class _Builder:
         self.kappa = 1.0 / radius_m if cw else -1.0 / radius_m
         self.k += 1
 
-    def spiral(self, kappa_end_1pm: float, length_m: float) -> None:
+    def spiral(self, kappa_end_1pm: float, length_m: float, end_node: str | None = None) -> None:
         """Clothoid of the reference lane from the current curvature to ``kappa_end_1pm`` (+ right) over length_m."""
-        a, b = self._node(), str(self.k + 1)
+        a, b = self._node(), end_node or str(self.k + 1)
         lanes = [ClothoidLane(self.pos, self.heading, length_m, self.kappa, kappa_end_1pm, offset_m=i * self.w,
                               width=self.w, line_types=line_types(i, self.lanes), speed_limit=self.v)
                  for i in range(self.lanes)]
@@ -80,12 +80,15 @@ class _Builder:
         self.kappa = kappa_end_1pm
         self.k += 1
 
-    def transition(self, kappa_end_1pm: float) -> None:
+    @property
+    def spiral_length_m(self) -> float:
+        return SPIRAL_TIME_S * self.v
+
+    def transition(self, kappa_end_1pm: float, end_node: str | None = None) -> None:
         """A spiral to the next curvature: 2 s of travel per half (straight to arc); a reverse curve gets both."""
-        halves = (abs(self.kappa) > 0) + (abs(kappa_end_1pm) > 0)
-        if halves and kappa_end_1pm != self.kappa:
-            length = SPIRAL_TIME_S * self.v * (2 if self.kappa * kappa_end_1pm < 0 else 1)
-            self.spiral(kappa_end_1pm, length)
+        if kappa_end_1pm != self.kappa:
+            halves = 2 if self.kappa * kappa_end_1pm < 0 else 1
+            self.spiral(kappa_end_1pm, self.spiral_length_m * halves, end_node)
 
 
 def straight_road(lanes: int, length_m: float, width_m: float = 4.0,
@@ -123,14 +126,18 @@ def winding_road(rng: np.random.Generator, lanes: int = 3, length_m: float = 400
 
 def loop_road(lanes: int = 2, straight_m: float = 1000.0, radius_m: float = 260.0, width_m: float = 4.0,
               speed_limit: float = 25.0) -> IndexedRoadNetwork:
-    """A closed circuit: two straights joined by two half circles turning right (clockwise); ~3.6 km."""
+    """A closed circuit: two straights joined by two half turns to the right (clockwise), each a clothoid, an arc
+    and a clothoid; ~3.7 km. The halves are point-symmetric, so the circuit closes exactly."""
     b = _Builder(lanes, width_m, speed_limit)
-    b.straight(straight_m)
-    b.arc(radius_m, np.pi)
-    b.straight(straight_m)
-    b.arc(radius_m, np.pi, end_node="0")
+    for end in (None, "0"):
+        b.straight(straight_m)
+        b.transition(1.0 / radius_m)
+        # each clothoid turns by L / (2 R): the arc takes the rest of the half turn
+        b.arc(radius_m, np.pi - b.spiral_length_m / radius_m)
+        b.transition(0.0, end_node=end)
     return b.net
 
 
-def loop_length_m(straight_m: float = 1000.0, radius_m: float = 260.0) -> float:
-    return 2 * straight_m + 2 * np.pi * radius_m
+def loop_length_m(straight_m: float = 1000.0, radius_m: float = 260.0, speed_limit: float = 25.0) -> float:
+    """Length of the loop's reference lane: two straights and two half turns of pi R + L_spiral each."""
+    return 2 * straight_m + 2 * (np.pi * radius_m + SPIRAL_TIME_S * speed_limit)
