@@ -38,9 +38,10 @@ def test_crossing_stops_for_every_crossing_pedestrian_and_no_other(seed):
 
 
 def test_curves_centering_with_privileged_lateral():
+    # the clothoid transitions leave no curvature step to overshoot (0.109 m worst over seeds 0-9)
     r = drive("curves", 0, duration=30.0)
     assert r["lane_departures"] == 0
-    assert r["lane"]["centering_max_m"] < 0.3
+    assert r["lane"]["centering_max_m"] < 0.15
     assert r["collisions"] == 0
 
 
