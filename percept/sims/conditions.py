@@ -75,27 +75,36 @@ class ConditionEffects:
         rng = frame_rng(seed, frame, camera)
         f = img.astype(np.float32)
         if c is Condition.NIGHT:
-            lights = (f[..., 2] > 180) & (f[..., 1] < 90)  # tail lights glow; the rest is lit by the beam
+            lights = (img[..., 2] > 180) & (img[..., 1] < 90)  # tail lights glow; the rest is lit by the beam
             out = f * self.night_gain
-            glow = cv2.GaussianBlur(np.where(lights[..., None], f, 0), (0, 0), 3) * 1.5
-            out = np.where(lights[..., None], f, out) + glow
-            out += rng.normal(0, 3.0, out.shape[:2]).astype(np.float32)[..., None]
+            if lights.any():
+                # the glow is local: blur only the lights' bounding box, padded by the kernel radius (4 sigma)
+                rows, cols = np.flatnonzero(lights.any(axis=1)), np.flatnonzero(lights.any(axis=0))
+                y0, y1 = max(rows[0] - 13, 0), min(rows[-1] + 14, self.H)
+                x0, x1 = max(cols[0] - 13, 0), min(cols[-1] + 14, self.W)
+                lit, src = lights[y0:y1, x0:x1, None], f[y0:y1, x0:x1]
+                glow = cv2.GaussianBlur(np.where(lit, src, 0), (0, 0), 3) * 1.5
+                out[y0:y1, x0:x1] = np.where(lit, src, out[y0:y1, x0:x1]) + glow
+            out += 3.0 * rng.standard_normal(out.shape[:2], dtype=np.float32)[..., None]
         elif c is Condition.RAIN:
             haze = np.array([150, 150, 145], np.float32)
-            out = 0.62 * cv2.GaussianBlur(f, (0, 0), 1.1) + 0.38 * haze
+            out = 0.62 * cv2.GaussianBlur(img, (0, 0), 1.1).astype(np.float32) + 0.38 * haze
             streaks = np.zeros((self.H, self.W), np.float32)
-            for _ in range(260):
-                x, y = rng.uniform(0, self.W), rng.uniform(0, self.H)
-                ln = rng.uniform(8, 25)
-                cv2.line(streaks, (int(x), int(y)), (int(x + 0.15 * ln), int(y + ln)), float(rng.uniform(20, 45)), 1,
-                         cv2.LINE_AA)
+            x, y = rng.uniform(0, self.W, 260), rng.uniform(0, self.H, 260)
+            ln, val = rng.uniform(8, 25, 260), rng.uniform(20, 45, 260)
+            for k in range(260):
+                cv2.line(streaks, (int(x[k]), int(y[k])), (int(x[k] + 0.15 * ln[k]), int(y[k] + ln[k])),
+                         float(val[k]), 1, cv2.LINE_AA)
             out += streaks[..., None]
             drops = np.zeros((self.H, self.W), np.float32)
-            for _ in range(18):
-                cv2.circle(drops, (int(rng.uniform(0, self.W)), int(rng.uniform(0, self.H))), int(rng.uniform(4, 12)),
-                           1.0, -1, cv2.LINE_AA)
+            du, dv, dr = rng.uniform(0, self.W, 18), rng.uniform(0, self.H, 18), rng.uniform(4, 12, 18)
+            for k in range(18):
+                cv2.circle(drops, (int(du[k]), int(dv[k])), int(dr[k]), 1.0, -1, cv2.LINE_AA)
             drops = cv2.GaussianBlur(drops, (0, 0), 2)[..., None]
-            out = out * (1 - 0.6 * drops) + 0.6 * drops * cv2.GaussianBlur(out, (0, 0), 6)
+            # what a drop shows is the scene blurred (sigma 6 px): blurred at quarter size, scaled back up
+            small = cv2.GaussianBlur(cv2.pyrDown(cv2.pyrDown(out)), (0, 0), 1.5)
+            blurred = cv2.resize(small, (self.W, self.H), interpolation=cv2.INTER_LINEAR)
+            out = out * (1 - 0.6 * drops) + 0.6 * drops * blurred
         elif c is Condition.GLARE:
             out = 0.8 * f + 0.2 * 235 + self.glare * 1.2
             # lens flare: ghosts on the line through the sun and the image centre
@@ -106,6 +115,6 @@ class ConditionEffects:
                 cv2.circle(ghost, (int(gu), int(gv)), rad, 45.0, -1, cv2.LINE_AA)
                 out += cv2.GaussianBlur(ghost, (0, 0), 4)[..., None]
         else:  # NOISE
-            out = f + rng.normal(0, 10.0, f.shape).astype(np.float32)
-            out += rng.normal(0, 3.0, (self.H, 1, 1)).astype(np.float32)
+            out = f + 10.0 * rng.standard_normal(f.shape, dtype=np.float32)
+            out += 3.0 * rng.standard_normal((self.H, 1, 1), dtype=np.float32)
         return np.clip(out, 0, 255).astype(np.uint8)
