@@ -60,7 +60,8 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
               render: bool = True) -> dict:
     """Drive one run; returns the run JSON (DESIGN.md contract).
 
-    ``recorder_factory(world)`` returns an object with ``log_step(t, frame, gt, action, lead_gap_m)`` (optional).
+    ``recorder_factory(world)`` returns an object with ``log_step(t, frame, gt, action, lead_gap_m)`` and
+    ``log_lanes(estimate, debug)`` (optional).
     ``render=False`` skips the cameras: only possible while every slot is privileged (baselines, fast tests).
     """
     world = SimWorld(cfg.world)
@@ -87,7 +88,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         obstacle = in_path_obstacle(gt)
         if lanes is not None:
             t0 = time.perf_counter()
-            est, _ = lanes.process(frame.left, frame.wheel_speed_mps, frame.imu.yaw_rate_rps, world.dt)
+            est, lanes_debug = lanes.process(frame.left, frame.wheel_speed_mps, frame.imu.yaw_rate_rps, world.dt)
             lanes_ms += (time.perf_counter() - t0) * 1e3
             steer = keeping.update(est.offset_m, est.heading_rad, est.curvature_1pm, frame.wheel_speed_mps)
             if est.valid:
@@ -100,6 +101,8 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         scorer.update(gt, obstacle, hit)
         if recorder is not None:
             recorder.log_step(gt.time_s, frame, gt, world.last_action, obstacle.gap_m if obstacle else None)
+            if lanes is not None:
+                recorder.log_lanes(est, lanes_debug)
         world.step(accel, steer)
         frames += 1
         if progress:

@@ -2,7 +2,9 @@
 
 Timeline ``sim_time`` in simulation seconds. Entities: ``world/road`` (lane lines, static), ``world/ego``
 (pose), ``world/ego/camera/left`` (mount and pinhole, static; the JPEG image), ``world/objects`` (true 3D
-boxes), ``world/trajectory``, and ``plots/*`` scalars. The file is written to a temporary name and moved
+boxes), ``world/trajectory``, and ``plots/*`` scalars. With the vision lateral slot also what the lanes module
+saw: ``world/ego/camera/left/lanes`` (fitted boundaries in the image), ``.../evidence`` (marking points by
+side), ``world/ego/lanes`` (the boundaries on the ground) and ``plots/lane/*/{truth,vision}``. The file is written to a temporary name and moved
 into place when the recording closes, so a failed run never leaves a truncated file under the final name.
 """
 
@@ -19,6 +21,10 @@ import rerun.blueprint as rrb
 from percept.sensors import Side, StereoRig
 
 KIND_COLORS = {"vehicle": (70, 130, 230), "pedestrian": (240, 80, 60), "landmark": (250, 220, 60)}
+SIDE_COLORS = {1: (255, 220, 0), -1: (0, 160, 255), 0: (150, 150, 150)}
+"""Lane boundaries and their evidence: left, right, unassigned (RGB)."""
+LANE_DRAW_M = (4.0, 50.0)
+"""Range ahead over which fitted boundaries are drawn [m]."""
 
 
 def blueprint() -> rrb.Blueprint:
@@ -43,6 +49,7 @@ class RunRecorder:
         self.rec = rr.RecordingStream(app_id)
         self.rec.save(str(self.tmp), default_blueprint=blueprint())
         self.quality = jpeg_quality
+        self.rig = rig
         self.trajectory: list[list[float]] = []
         rec = self.rec
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
@@ -88,9 +95,38 @@ class RunRecorder:
         rec.log("plots/speed_mps", rr.Scalars(gt.speed_mps))
         rec.log("plots/accel_cmd_mps2", rr.Scalars(float(action[0])))
         rec.log("plots/steering_rad", rr.Scalars(float(action[1])))
-        rec.log("plots/lane_offset_m", rr.Scalars(gt.lane.offset_m))
+        for name in ("offset_m", "heading_rad", "curvature_1pm"):
+            rec.log(f"plots/lane/{name}/truth", rr.Scalars(getattr(gt.lane, name)))
         if lead_gap_m is not None:
             rec.log("plots/lead_gap_m", rr.Scalars(lead_gap_m))
+
+    def log_lanes(self, est, debug) -> None:
+        """What the lanes module made of this frame (call after ``log_step``): ``est`` a LaneEstimate, ``debug`` a
+        LaneDebug (evidence None for a dropped frame, fit None when evidence was too thin)."""
+        rec = self.rec
+        cam = "world/ego/camera/left"
+        ev, fit = debug.evidence, debug.fit
+        if ev is not None and len(ev.uv_px):
+            side = fit.side if fit is not None else np.zeros(len(ev.uv_px), int)
+            colors = np.where(side[:, None] == 1, SIDE_COLORS[1], np.where(side[:, None] == -1, SIDE_COLORS[-1],
+                                                                              SIDE_COLORS[0]))
+            rec.log(f"{cam}/evidence", rr.Points2D(ev.uv_px, colors=colors, radii=1.5))
+        else:
+            rec.log(f"{cam}/evidence", rr.Clear(recursive=False))
+        if est.valid:
+            x = np.linspace(LANE_DRAW_M[0], LANE_DRAW_M[1], 30)
+            ground = [np.column_stack([x, est.boundary_y(x, s), np.full_like(x, 0.03)]) for s in (1, -1)]
+            rec.log("world/ego/lanes", rr.LineStrips3D(ground, colors=[SIDE_COLORS[1], SIDE_COLORS[-1]], radii=0.1))
+            px = [self.rig.project_vehicle_points(g) for g in ground]
+            rec.log(f"{cam}/lanes", rr.LineStrips2D([uv[z > 0.1] for uv, z in px],
+                                                    colors=[SIDE_COLORS[1], SIDE_COLORS[-1]], radii=2.0))
+            for name, value in (("offset_m", est.offset_m), ("heading_rad", est.heading_rad),
+                                ("curvature_1pm", est.curvature_1pm)):
+                rec.log(f"plots/lane/{name}/vision", rr.Scalars(value))
+        else:
+            rec.log("world/ego/lanes", rr.Clear(recursive=False))
+            rec.log(f"{cam}/lanes", rr.Clear(recursive=False))
+        rec.log("plots/lane/confidence", rr.Scalars(est.confidence))
 
     def close(self) -> Path:
         """Flush and move the recording to its final name."""

@@ -36,6 +36,19 @@ def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
     assert v.returncode == 0, v.stdout + v.stderr
 
 
+def test_vision_lateral_recording_shows_what_the_lanes_module_saw(tmp_path):
+    rrd = tmp_path / "v.rrd"
+    r = runner.invoke(app, ["drive", "--scenario", "curves", "--duration", "1", "--lateral", "vision",
+                            "--record", str(rrd), "--json", str(tmp_path / "v.json")])
+    assert r.exit_code == 0, r.output
+    p = subprocess.run([rerun_bin(), "rrd", "print", str(rrd)], capture_output=True, text=True,
+                       env={"RERUN_ANALYTICS": "0", "PATH": ""})
+    assert p.returncode == 0, p.stderr
+    for entity in ("world/ego/camera/left/lanes", "world/ego/camera/left/evidence", "world/ego/lanes",
+                   "plots/lane/offset_m/vision", "plots/lane/curvature_1pm/truth"):
+        assert entity in p.stdout, entity
+
+
 def test_drive_default_recording_path(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     r = runner.invoke(app, ["drive", "--scenario", "cut-in", "--seed", "2", "--duration", "0.2"])
