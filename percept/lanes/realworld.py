@@ -22,6 +22,7 @@ from percept.sensors import PinholeCamera, StereoRig
 from .calibration import CameraCalibration, VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
 from .detector import LaneConfig, LaneDebug, LaneDetector
 from .evidence import Brightness, EvidenceConfig
+from .fit import FitConfig
 from .types import LaneEstimate
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".webp")
@@ -29,8 +30,11 @@ VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".mpg", ".mpeg", ".web
 
 
 def _real_lane_config() -> LaneConfig:
-    # lower stripe thresholds than in the simulator: white dashes on pale concrete are faint
-    return LaneConfig(evidence=EvidenceConfig(min_contrast=6.0, rel_contrast=0.2, brightness=Brightness.MAX_RG_YELLOW))
+    # lower stripe thresholds than in the simulator: white dashes on pale concrete are faint. Freeway geometry
+    # (radius >= ~500 m, spirals >= ~100 m at 100 km/h) changes curvature by at most ~2e-5 per metre, and a single
+    # frame seen to 40 m cannot tell a cubic from a quadratic: the curvature-rate prior is that tight.
+    return LaneConfig(evidence=EvidenceConfig(min_contrast=6.0, rel_contrast=0.2, brightness=Brightness.MAX_RG_YELLOW),
+                      fit=FitConfig(curvature_rate_sigma_1pm2=3e-5))
 
 
 @dataclass(frozen=True)
