@@ -8,6 +8,7 @@ from typing import Optional
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
@@ -18,7 +19,7 @@ err = Console(stderr=True)
 
 
 def fail(message: str) -> None:
-    err.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    err.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     raise typer.Exit(2)
 
 
@@ -199,6 +200,7 @@ def main() -> None:
 
 
 # commands that live in their own modules register themselves on ``app``
-from . import lanes_cmd  # noqa: E402
+from . import eval_cmd, lanes_cmd  # noqa: E402
 
+eval_cmd.register(app)
 lanes_cmd.register(app)

@@ -1,0 +1,199 @@
+"""Batch evaluation: the closed loop over scenarios x conditions x seeds, one run JSON each, and a summary.
+
+Runs go to worker processes (``workers``, one OpenCV thread each) or to a Ray cluster. Each finished run is
+written at once to ``OUT/runs/<scenario>-<condition>-<seed>.json`` (a temporary name, then renamed), so an
+interrupted batch keeps what it finished, and running the same batch again reuses those files. A run that
+fails is reported in the summary with its error; the others go on.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import traceback
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from enum import Enum
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Callable, Iterator
+
+import cv2
+import numpy as np
+
+from percept.sims import WorldConfig
+
+from .loop import SLOTS, DriveConfig, Mode, run_drive
+
+COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
+GROUPS = ("lane", "longitudinal", "pedestrians", "odometry", "timing_ms")
+
+
+class Engine(str, Enum):
+    LOCAL = "local"
+    RAY = "ray"
+
+
+def parse_seeds(text: str) -> list[int]:
+    """"A-B" (inclusive), "A,B,C" or "N" -> sorted unique seeds; ValueError with the expected forms."""
+    try:
+        seeds: set[int] = set()
+        for part in text.split(","):
+            a, sep, b = part.strip().partition("-")
+            lo, hi = int(a), int(b) if sep else int(a)
+            if lo < 0 or hi < lo:
+                raise ValueError
+            seeds.update(range(lo, hi + 1))
+        return sorted(seeds)
+    except ValueError:
+        raise ValueError(f"--seeds must look like 0-9, 3 or 1,4,7 (non-negative, A <= B), got '{text}'") from None
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of the batch."""
+
+    scenario: str
+    condition: str
+    seed: int
+
+    @property
+    def name(self) -> str:
+        return f"{self.scenario}-{self.condition}-{self.seed}"
+
+
+@dataclass(frozen=True)
+class EvalPlan:
+    """scenarios, conditions: names; seeds: the seeds of every (scenario, condition); slots: Mode per SLOTS entry
+    (missing ones privileged); duration_s: None = each scenario's own. Validated here: a bad name, condition or
+    slot raises ValueError before any run starts."""
+
+    scenarios: tuple[str, ...]
+    conditions: tuple[str, ...]
+    seeds: tuple[int, ...]
+    slots: dict = field(default_factory=dict)
+    duration_s: float | None = None
+
+    def __post_init__(self) -> None:
+        if not self.scenarios or not self.conditions or not self.seeds:
+            raise ValueError("a batch needs at least one scenario, one condition and one seed")
+        for sc in self.scenarios:
+            for c in self.conditions:
+                # builds and validates the whole configuration of one run (names, condition, slots, duration)
+                self.config(Job(sc, c, self.seeds[0]))
+
+    def config(self, job: Job) -> DriveConfig:
+        return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
+                           **{slot: self.slots.get(slot, Mode.PRIVILEGED) for slot in SLOTS})
+
+    @property
+    def jobs(self) -> list[Job]:
+        return [Job(sc, c, s) for sc in self.scenarios for c in self.conditions for s in self.seeds]
+
+
+def run_job(plan: EvalPlan, job: Job) -> dict:
+    """Run one job (in a worker); the run JSON, or {"scenario", "condition", "seed", "error", "traceback"}."""
+    cv2.setNumThreads(1)
+    try:
+        cfg = plan.config(job)
+        return run_drive(cfg, render=cfg.needs_cameras)
+    except Exception as e:  # noqa: BLE001 - one failed run must not take the batch down; it is reported
+        return {"scenario": job.scenario, "condition": job.condition, "seed": job.seed,
+                "error": f"{type(e).__name__}: {e}", "traceback": traceback.format_exc()}
+
+
+def _run_path(out_dir: Path, job: Job) -> Path:
+    return out_dir / "runs" / f"{job.name}.json"
+
+
+def _write(path: Path, data: dict) -> None:
+    """Write under a temporary name, then rename: a reader never sees half a file."""
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_text(json.dumps(data, indent=2))
+    os.replace(tmp, path)
+
+
+def _local(plan: EvalPlan, jobs: list[Job], workers: int) -> Iterator[tuple[Job, dict]]:
+    if workers == 1:
+        for job in jobs:
+            yield job, run_job(plan, job)
+        return
+    # spawned workers: no state (OpenCV threads, pygame) copied from this process
+    with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
+        futures = {pool.submit(run_job, plan, job): job for job in jobs}
+        for f in as_completed(futures):
+            yield futures[f], f.result()
+
+
+def _ray(plan: EvalPlan, jobs: list[Job], address: str | None) -> Iterator[tuple[Job, dict]]:
+    try:
+        import ray
+    except ImportError:
+        raise RuntimeError("the ray engine needs Ray: pip install 'percept[ray]' (or use --engine local)") from None
+    if not ray.is_initialized():
+        ray.init(address=address, logging_level="ERROR", log_to_driver=False)
+    # results travel back to this process, which writes them (cluster nodes need not share its disk)
+    remote = ray.remote(num_cpus=1)(run_job)
+    pending = {remote.remote(plan, job): job for job in jobs}
+    while pending:
+        done, _ = ray.wait(list(pending), num_returns=1)
+        job = pending.pop(done[0])
+        yield job, ray.get(done[0])
+
+
+def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = Engine.LOCAL,
+             address: str | None = None, progress: Callable[[dict], None] | None = None) -> dict:
+    """Run every job of ``plan`` not already in ``out_dir/runs``; write and return the summary."""
+    out_dir = Path(out_dir)
+    (out_dir / "runs").mkdir(parents=True, exist_ok=True)
+    results, todo = [], []
+    for job in plan.jobs:
+        done = _run_path(out_dir, job)
+        if done.exists():
+            results.append(json.loads(done.read_text()))
+            if progress:
+                progress(results[-1])
+        else:
+            todo.append(job)
+    stream = _local(plan, todo, workers) if Engine(engine) is Engine.LOCAL else _ray(plan, todo, address)
+    for job, r in stream:
+        if "error" not in r:
+            _write(_run_path(out_dir, job), r)
+        results.append(r)
+        if progress:
+            progress(r)
+    summary = summarize(plan, results)
+    _write(out_dir / "summary.json", summary)
+    return summary
+
+
+def _stats(values: list) -> dict | None:
+    v = [x for x in values if x is not None and not isinstance(x, (list, dict, bool))]
+    if not v:
+        return None
+    a = np.asarray(v, dtype=float)
+    return {"mean": float(a.mean()), "max": float(a.max()), "min": float(a.min())}
+
+
+def summarize(plan: EvalPlan, results: list[dict]) -> dict:
+    """Per (scenario, condition): runs, failures, summed counts, and mean / max / min of every numeric metric
+    (null where no run has it)."""
+    groups = []
+    for sc in plan.scenarios:
+        for c in plan.conditions:
+            rs = [r for r in results if r.get("scenario") == sc and r.get("condition") == c]
+            ok = sorted((r for r in rs if "error" not in r), key=lambda r: r["seed"])
+            g = {"scenario": sc, "condition": c, "seeds": [r["seed"] for r in ok],
+                 "failed": [{"seed": r["seed"], "error": r["error"]} for r in rs if "error" in r]}
+            for k in COUNTS:
+                g[k] = int(sum(r[k] for r in ok)) if ok else None
+            for grp in GROUPS:
+                keys = sorted({k for r in ok for k in r.get(grp, {})})
+                g[grp] = {k: _stats([r[grp].get(k) for r in ok]) for k in keys}
+            g["realtime_factor"] = _stats([r.get("realtime_factor") for r in ok])
+            stops = [s for r in ok for s in (r["pedestrians"].get("stops") or [])]
+            # pedestrian stops: how many crossings the car stopped for, of all crossings in these runs
+            g["pedestrian_stops"] = {"stopped": int(sum(stops)), "crossings": len(stops)} if stops else None
+            groups.append(g)
+    return {"slots": {s: Mode(plan.slots.get(s, Mode.PRIVILEGED)).value for s in SLOTS},
+            "seeds": list(plan.seeds), "duration_s": plan.duration_s, "groups": groups}

@@ -1,0 +1,103 @@
+"""Batch evaluation: `percept eval` through CliRunner, resume, failures, bad input."""
+
+import json
+import sys
+
+import pytest
+from typer.testing import CliRunner
+
+from percept.cli import app
+from percept.drive import batch as ev
+from percept.drive import EvalPlan, Job, parse_seeds
+
+runner = CliRunner()
+
+
+def test_parse_seeds():
+    assert parse_seeds("0-3") == [0, 1, 2, 3]
+    assert parse_seeds("7") == [7]
+    assert parse_seeds("5,1-2,1") == [1, 2, 5]
+    for bad in ("3-1", "a", "-2", "1-", ""):
+        with pytest.raises(ValueError, match="--seeds must look like"):
+            parse_seeds(bad)
+
+
+def test_eval_writes_runs_and_a_summary_and_resumes(tmp_path):
+    args = ["eval", "--scenario", "lead-brake", "--scenario", "cut-in", "--seeds", "0-1", "--duration", "2",
+            "--out", str(tmp_path), "--json", str(tmp_path / "s.json")]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    runs = sorted(p.name for p in (tmp_path / "runs").iterdir())
+    assert runs == ["cut-in-clear-0.json", "cut-in-clear-1.json", "lead-brake-clear-0.json", "lead-brake-clear-1.json"]
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s == json.loads((tmp_path / "s.json").read_text())
+    g = {(x["scenario"], x["condition"]): x for x in s["groups"]}
+    lb = g[("lead-brake", "clear")]
+    assert lb["seeds"] == [0, 1] and lb["failed"] == [] and lb["collisions"] == 0
+    one = [json.loads((tmp_path / "runs" / f"lead-brake-clear-{k}.json").read_text()) for k in (0, 1)]
+    gaps = [x["longitudinal"]["time_gap_min_s"] for x in one]
+    assert lb["longitudinal"]["time_gap_min_s"] == pytest.approx({"mean": sum(gaps) / 2, "max": max(gaps),
+                                                                  "min": min(gaps)})
+    # a metric no run has stays null; privileged lateral has no estimate to score
+    assert lb["lane"]["offset_rmse_m"] is None and lb["pedestrian_stops"] is None
+    # the same command again reuses the finished runs instead of driving them again
+    stamp = {p: p.stat().st_mtime_ns for p in (tmp_path / "runs").iterdir()}
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert {p: p.stat().st_mtime_ns for p in (tmp_path / "runs").iterdir()} == stamp
+
+
+def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, monkeypatch):
+    real = ev.run_drive
+
+    def flaky(cfg, render=True):
+        if cfg.world.seed == 1:
+            raise RuntimeError("simulated crash")
+        return real(cfg, render=render)
+
+    monkeypatch.setattr(ev, "run_drive", flaky)
+    plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0)
+    s = ev.evaluate(plan, tmp_path)
+    g = s["groups"][0]
+    assert g["seeds"] == [0, 2]
+    assert g["failed"] == [{"seed": 1, "error": "RuntimeError: simulated crash"}]
+    assert sorted(p.name for p in (tmp_path / "runs").iterdir()) == ["lead-brake-clear-0.json",
+                                                                     "lead-brake-clear-2.json"]
+
+
+def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
+    plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0)
+    a = ev.evaluate(plan, tmp_path / "a", workers=1)
+    b = ev.evaluate(plan, tmp_path / "b", workers=2)
+    for s in (a, b):
+        s["groups"][0].pop("timing_ms")
+        s["groups"][0].pop("realtime_factor")
+    assert a == b
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--scenario", "nowhere"], "unknown scenario"),
+    (["--scenario", "highway", "--seeds", "9-1"], "--seeds must look like"),
+    (["--scenario", "highway", "--workers", "0"], "--workers must be at least 1"),
+    (["--scenario", "highway", "--engine", "spark"], "--engine must be local or ray"),
+    (["--scenario", "highway", "--condition", "fog"], "condition"),
+    (["--scenario", "highway", "--longitudinal", "vision"], "no vision implementation yet"),
+])
+def test_eval_bad_input_is_one_line_exit_2(tmp_path, args, message):
+    r = runner.invoke(app, ["eval", "--out", str(tmp_path / "o"), *args])
+    assert r.exit_code == 2
+    assert message in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "o" / "summary.json").exists()
+
+
+def test_ray_engine_without_ray_says_how_to_get_it(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "ray", None)  # import ray -> ImportError
+    r = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--engine", "ray",
+                            "--out", str(tmp_path)])
+    assert r.exit_code == 2
+    assert "pip install 'percept[ray]'" in r.output
+
+
+def test_jobs_cover_the_plan():
+    plan = EvalPlan(("highway", "curves"), ("clear", "rain"), (0, 1, 2))
+    assert len(plan.jobs) == 12 and Job("curves", "rain", 2) in plan.jobs
