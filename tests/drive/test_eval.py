@@ -90,6 +90,24 @@ def test_eval_bad_input_is_one_line_exit_2(tmp_path, args, message):
     assert not (tmp_path / "o" / "summary.json").exists()
 
 
+def test_ray_engine_gives_the_local_engine_s_runs(tmp_path):
+    import ray
+
+    plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0)
+    try:
+        ray.init(num_cpus=2, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
+        a = ev.evaluate(plan, tmp_path / "ray", engine=ev.Engine.RAY)
+    finally:
+        ray.shutdown()
+    b = ev.evaluate(plan, tmp_path / "local")
+    for s in (a, b):
+        s["groups"][0].pop("timing_ms")
+        s["groups"][0].pop("realtime_factor")
+    assert a == b and a["groups"][0]["seeds"] == [0, 1]
+    assert sorted(p.name for p in (tmp_path / "ray" / "runs").iterdir()) == ["cut-in-clear-0.json",
+                                                                            "cut-in-clear-1.json"]
+
+
 def test_ray_engine_without_ray_says_how_to_get_it(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "ray", None)  # import ray -> ImportError
     r = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--engine", "ray",
