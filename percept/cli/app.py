@@ -105,7 +105,8 @@ def drive(
     longitudinal: str = typer.Option("privileged", help="Longitudinal slot: vision | privileged."),
     pedestrians: str = typer.Option("privileged", help="Pedestrian slot: vision | privileged."),
     odometry: str = typer.Option("privileged", help="Odometry slot: vision | privileged."),
-    record: Optional[Path] = typer.Option(None, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd)."),
+    record: Optional[Path] = typer.Option(None, help="Rerun recording path "
+                                                     "(default runs/<scenario>-<condition>-<seed>.rrd)."),
     no_record: bool = typer.Option(False, "--no-record", help="Do not write a Rerun recording."),
     json_path: Optional[Path] = typer.Option(None, "--json", help="Write the run metrics to this JSON file."),
 ):
@@ -151,25 +152,31 @@ def drive(
                     f"{result['duration_s']:.1f} s, realtime x{result['realtime_factor']:.2f}")
     t.add_column("metric")
     t.add_column("value", justify="right")
+    lane, lon = result["lane"], result["longitudinal"]
     rows = [("collisions", result["collisions"]), ("pedestrian collisions", result["pedestrian_collisions"]),
             ("lane departures", result["lane_departures"]),
-            ("centering RMS / max [m]", f"{result['lane']['centering_rms_m']:.3f} / {result['lane']['centering_max_m']:.3f}"),
-            ("time gap mean / min [s]", _pair(result["longitudinal"]["time_gap_mean_s"], result["longitudinal"]["time_gap_min_s"])),
+            ("centering RMS / max [m]", _pair(lane["centering_rms_m"], lane["centering_max_m"], "{:.3f}")),
+            ("time gap mean / min [s]", _pair(lon["time_gap_mean_s"], lon["time_gap_min_s"])),
             ("pedestrian stops", str(result["pedestrians"]["stops"])),
             ("render [ms/frame]", _num(result["timing_ms"]["render"]))]
+    if lane["offset_rmse_m"] is not None:
+        rows += [("lane offset RMSE [m]", _num(lane["offset_rmse_m"], "{:.4f}")),
+                 ("lane heading RMSE [rad]", _num(lane["heading_rmse_rad"], "{:.4f}")),
+                 ("lane curvature RMSE [1/m]", _num(lane["curvature_rmse_1pm"], "{:.5f}")),
+                 ("lanes [ms/frame]", _num(result["timing_ms"]["lanes"]))]
     for k, v in rows:
-        t.add_row(k, str(v))
+        t.add_row(escape(k), str(v))
     console.print(t)
     if rec_path:
         console.print(f"recording: {rec_path}  (open it with `rerun {rec_path}`)")
 
 
-def _num(x) -> str:
-    return "n/a" if x is None else f"{x:.2f}"
+def _num(x, fmt: str = "{:.2f}") -> str:
+    return "n/a" if x is None else fmt.format(x)
 
 
-def _pair(a, b) -> str:
-    return f"{_num(a)} / {_num(b)}"
+def _pair(a, b, fmt: str = "{:.2f}") -> str:
+    return f"{_num(a, fmt)} / {_num(b, fmt)}"
 
 
 @app.command()

@@ -20,12 +20,17 @@ def register(app: typer.Typer) -> None:
     @app.command("lanes")
     def lanes(
         source: Path = typer.Argument(..., help="An image, a video or a folder of images (dash camera, road ahead)."),
-        json_path: Optional[Path] = typer.Option(None, "--json", help="Write per-image / per-frame results to this JSON file."),
-        out: Optional[Path] = typer.Option(None, "--out", help="Folder for overlays: NAME.lanes.png per image, NAME.lanes.mp4 for a video."),
-        calib: Optional[Path] = typer.Option(None, "--calib", help="Calibration JSON from `percept calibrate`: undistort and use its intrinsics."),
-        mount_height: float = typer.Option(1.2, "--mount-height", help="Camera height above the road in metres; scales the metric values."),
+        json_path: Optional[Path] = typer.Option(None, "--json",
+                                                 help="Write per-image / per-frame results to this JSON file."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Folder for overlays: NAME.lanes.png per image, "
+                                                               "NAME.lanes.mp4 for a video."),
+        calib: Optional[Path] = typer.Option(None, "--calib", help="Calibration JSON from `percept calibrate`: "
+                                                                   "undistort and use its intrinsics."),
+        mount_height: float = typer.Option(1.2, "--mount-height", help="Camera height above the road in metres; "
+                                                                       "scales the metric values."),
         hfov: float = typer.Option(60.0, "--hfov", help="Horizontal field of view in degrees, used without --calib."),
-        speed: float = typer.Option(0.0, "--speed", help="Assumed speed in m/s for tracking through a video (0: no motion model)."),
+        speed: float = typer.Option(0.0, "--speed", help="Assumed speed in m/s for tracking through a video "
+                                                         "(0: no motion model)."),
         max_frames: Optional[int] = typer.Option(None, "--max-frames", help="Process at most this many video frames."),
     ):
         """Fit the ego lane on recorded footage; pitch and horizon come from the lane lines' vanishing point."""
@@ -97,7 +102,8 @@ def register(app: typer.Typer) -> None:
                 ("photos with the board", f"{cal.images_found} of {cal.images_total}"),
                 ("photos used", f"{cal.images_used}" + (f" ({skipped} of another size skipped)" if skipped else "")),
                 ("image size [px]", f"{cal.width}x{cal.height}"), ("fx, fy [px]", f"{cal.fx:.1f}, {cal.fy:.1f}"),
-                ("cx, cy [px]", f"{cal.cx:.1f}, {cal.cy:.1f}"), ("dist (k1 k2 p1 p2 k3)", " ".join(f"{k:+.4f}" for k in cal.dist))]
+                ("cx, cy [px]", f"{cal.cx:.1f}, {cal.cy:.1f}"),
+                ("dist (k1 k2 p1 p2 k3)", " ".join(f"{k:+.4f}" for k in cal.dist))]
         for k, v in rows:
             t.add_row(escape(k), v)
         console.print(t)
@@ -111,7 +117,8 @@ def _record(result, **keys) -> dict:
 
 def _summary(records: list[dict], ms: list[float]) -> dict:
     ok = [r for r in records if "error" not in r]
-    return {"count": len(ok), "errors": len(records) - len(ok), "both_boundaries": sum(bool(r["both_boundaries"]) for r in ok),
+    return {"count": len(ok), "errors": len(records) - len(ok),
+            "both_boundaries": sum(bool(r["both_boundaries"]) for r in ok),
             "lane_found": sum(r["offset_m"] is not None for r in ok),
             "ms_per_frame_median": float(sorted(ms)[len(ms) // 2]) if ms else None}
 
@@ -121,12 +128,14 @@ def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
 
     console.print(f"{title}: lane found in {summary['lane_found']} of {summary['count']}, both boundaries in "
                   f"{summary['both_boundaries']}" + (f", {summary['errors']} unreadable" if summary["errors"] else "")
-                  + (f"; {summary['ms_per_frame_median']:.0f} ms each (median)" if summary["ms_per_frame_median"] else ""))
+                  + (f"; {summary['ms_per_frame_median']:.0f} ms each (median)"
+                     if summary["ms_per_frame_median"] else ""))
     if out is not None:
         console.print(f"overlays in {out}")
 
 
-def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict, single: bool) -> None:
+def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,
+                single: bool) -> None:
     import cv2
 
     from percept.cli.app import err, fail, progress_bar, write_json

@@ -1,7 +1,8 @@
 """Privileged implementations of the task slots: they read ground truth. Baselines for the vision modules.
 
-Lateral: lane centring (percept.control.LaneKeeping) on the true lane. Longitudinal: constant time-gap following (ACC) under a set speed, and
-emergency braking (AEB) for vehicles and for pedestrians in or entering the ego's path.
+Lateral: lane centring (percept.control.LaneKeeping) on the true lane. Longitudinal: constant time-gap
+following (ACC) under a set speed, and emergency braking (AEB) for vehicles and for pedestrians in or
+entering the ego's path.
 """
 
 from __future__ import annotations

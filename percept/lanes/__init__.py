@@ -6,5 +6,6 @@ from .fit import FitConfig, fit_lane
 from .tracker import LaneTracker
 from .types import LaneEstimate, LaneFit, MarkingEvidence
 
-__all__ = ["Brightness", "EvidenceConfig", "FitConfig", "LaneConfig", "LaneDebug", "LaneDetector", "LaneEstimate", "LaneFit",
+__all__ = ["Brightness", "EvidenceConfig", "FitConfig", "LaneConfig", "LaneDebug", "LaneDetector", "LaneEstimate",
+           "LaneFit",
            "LaneTracker", "MarkingEvidence", "MarkingExtractor", "fit_lane", "marking_brightness"]

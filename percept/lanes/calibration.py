@@ -118,7 +118,8 @@ class CameraCalibration:
         except (OSError, UnicodeDecodeError) as e:
             raise ValueError(f"cannot read calibration file {path} ({e})") from None
         except (KeyError, TypeError, ValueError, AttributeError) as e:
-            raise ValueError(f"{path} is not a percept calibration file ({e}); make one with `percept calibrate DIR`") from None
+            raise ValueError(f"{path} is not a percept calibration file ({e}); "
+                             "make one with `percept calibrate DIR`") from None
 
 
 def chessboard_images(folder: Path) -> list[Path]:

@@ -90,7 +90,8 @@ class MarkingExtractor:
     def birdseye(self, image: np.ndarray) -> np.ndarray:
         """Top-down marking brightness (rows, cols) float32; rows go from near to far."""
         if image.shape[1::-1] != self.size:
-            raise ValueError(f"image is {image.shape[1]}x{image.shape[0]}, the rig expects {self.size[0]}x{self.size[1]}")
+            raise ValueError(f"image is {image.shape[1]}x{image.shape[0]}, "
+                             f"the rig expects {self.size[0]}x{self.size[1]}")
         # one remap of the colour image through the precomputed fixed-point grid, then the paint measure on the
         # (smaller) grid
         top = cv2.remap(image, self.map1, self.map2, cv2.INTER_LINEAR)

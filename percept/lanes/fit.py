@@ -2,9 +2,10 @@
 
 Model (vehicle frame, y left): y = a0 + a1 x + a2 x^2 + a3 x^3 + s w/2, s = +1 on the left boundary, -1 on the
 right, so the lane centre is y_c = a0 + a1 x + a2 x^2 + a3 x^3, i.e. offset = -a0, heading = atan(-a1),
-curvature = 2 a2, curvature rate (a clothoid) = 6 a3. It is linear in (a0, a1, a2, w, a3): iteratively reweighted least squares with Huber weights (Huber 1964;
-Zhang, "Parameter estimation techniques", IVC 1997), points assigned to a side by gating around the
-prediction, pseudo-observations for the priors (width, zero curvature) so that one visible side suffices.
+curvature = 2 a2, curvature rate (a clothoid) = 6 a3. It is linear in (a0, a1, a2, w, a3): iteratively
+reweighted least squares with Huber weights (Huber 1964; Zhang, "Parameter estimation techniques", IVC 1997),
+points assigned to a side by gating around the prediction, pseudo-observations for the priors (width, heading,
+curvature and its rate near zero) so that one visible side suffices.
 """
 
 from __future__ import annotations

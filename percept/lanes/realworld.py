@@ -70,7 +70,8 @@ class RealLaneConfig:
 
 
 def ground_range_at_row(rig: StereoRig, row_px: float) -> float:
-    """Ground distance ahead [m] seen at image row ``row_px`` (below the horizon): x = h / tan(pitch + atan((v - cy) / fy))."""
+    """Ground distance ahead [m] seen at image row ``row_px`` (below the horizon):
+    x = h / tan(pitch + atan((v - cy) / fy))."""
     cam = rig.camera
     a = rig.pitch_rad + math.atan((row_px - cam.cy) / cam.fy)
     return rig.mount_height_m / math.tan(a) if a > 1e-4 else float("inf")
@@ -249,7 +250,8 @@ def list_inputs(path: Path) -> tuple[str, list[Path]]:
         return "video", [path]
     if path.suffix.lower() in IMAGE_SUFFIXES:
         return "images", [path]
-    raise ValueError(f"{path} is neither an image ({', '.join(IMAGE_SUFFIXES)}) nor a video ({', '.join(VIDEO_SUFFIXES)})")
+    raise ValueError(f"{path} is neither an image ({', '.join(IMAGE_SUFFIXES)}) "
+                     f"nor a video ({', '.join(VIDEO_SUFFIXES)})")
 
 
 def read_image(path: Path) -> np.ndarray:

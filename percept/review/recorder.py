@@ -4,8 +4,9 @@ Timeline ``sim_time`` in simulation seconds. Entities: ``world/road`` (lane line
 (pose), ``world/ego/camera/left`` (mount and pinhole, static; the JPEG image), ``world/objects`` (true 3D
 boxes), ``world/trajectory``, and ``plots/*`` scalars. With the vision lateral slot also what the lanes module
 saw: ``world/ego/camera/left/lanes`` (fitted boundaries in the image), ``.../evidence`` (marking points by
-side), ``world/ego/lanes`` (the boundaries on the ground) and ``plots/lane/*/{truth,vision}``. The file is written to a temporary name and moved
-into place when the recording closes, so a failed run never leaves a truncated file under the final name.
+side), ``world/ego/lanes`` (the boundaries on the ground) and ``plots/lane/*/{truth,vision}``. The file is
+written to a temporary name and moved into place when the recording closes, so a failed run never leaves a
+truncated file under the final name.
 """
 
 from __future__ import annotations

@@ -102,7 +102,8 @@ class StereoRig:
 
     @classmethod
     def from_dict(cls, d: dict) -> "StereoRig":
-        cam = PinholeCamera(float(d["fx"]), float(d["fy"]), float(d["cx"]), float(d["cy"]), int(d["width"]), int(d["height"]))
+        cam = PinholeCamera(float(d["fx"]), float(d["fy"]), float(d["cx"]), float(d["cy"]), int(d["width"]),
+                            int(d["height"]))
         return cls(cam, float(d["baseline_m"]), float(d["mount_height_m"]), float(d.get("pitch_rad", 0.0)),
                    float(d.get("mount_x_m", 0.8)))
 

@@ -94,7 +94,8 @@ def lane_truth(ego) -> LaneTruth:
     return LaneTruth(-float(lat_hw), rel, k, float(lane.width_at(s)), tuple(ego.lane_index))
 
 
-def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visible: float, crossing: bool) -> ObjectTruth:
+def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visible: float,
+                 crossing: bool) -> ObjectTruth:
     """Vehicle-frame position and camera distance of one object."""
     c = ego.to_vehicle_xy(np.array([state.pose.x_m, state.pose.y_m]))
     yaw = float(wrap_angle(state.pose.yaw_rad - ego.yaw_rad))

@@ -31,7 +31,8 @@ def check_condition(name: str) -> Condition:
     try:
         return Condition(name)
     except ValueError:
-        raise ValueError(f"unknown condition '{name}'; choose one of: {', '.join(c.value for c in Condition)}") from None
+        raise ValueError(f"unknown condition '{name}'; "
+                         f"choose one of: {', '.join(c.value for c in Condition)}") from None
 
 
 @dataclass(frozen=True)
@@ -130,7 +131,8 @@ class SimWorld:
                 continue
             src = self.ids.objects[st.obj_id]
             crossing = bool(getattr(src, "crossing", False))
-            objects.append(object_truth(st, scene.ego, rig, boxes.get(st.obj_id), visible.get(st.obj_id, 0.0), crossing))
+            objects.append(object_truth(st, scene.ego, rig, boxes.get(st.obj_id), visible.get(st.obj_id, 0.0),
+                                        crossing))
         ped_hit = any((p.crashed or p.hit) for p in self.env.road.objects if isinstance(p, Pedestrian))
         gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
                          bool(ego.crashed), ped_hit)

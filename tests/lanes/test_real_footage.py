@@ -17,7 +17,8 @@ DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
 LANES = DATA / "udacity-lanes"
 P1 = DATA / "udacity-lanelines-p1"
 VIDEO = P1 / "test_videos" / "solidWhiteRight.mp4"
-needs_lanes = pytest.mark.skipif(not (LANES / "test_images").is_dir(), reason=f"{LANES} is absent (real data in ../shared/data)")
+needs_lanes = pytest.mark.skipif(not (LANES / "test_images").is_dir(),
+                                 reason=f"{LANES} is absent (real data in ../shared/data)")
 needs_p1 = pytest.mark.skipif(not (P1 / "test_images").is_dir(), reason=f"{P1} is absent (real data in ../shared/data)")
 runner = CliRunner()
 
@@ -31,7 +32,8 @@ def calib_file(tmp_path_factory):
     return path
 
 
-def on_marking_fraction(image: np.ndarray, points_px, half_px: int = 6, flank_px: int = 40, contrast: float = 25) -> float:
+def on_marking_fraction(image: np.ndarray, points_px, half_px: int = 6, flank_px: int = 40,
+                        contrast: float = 25) -> float:
     """Share of boundary points with a stripe under them: the marking brightness within +-half_px of the point
     exceeds the median of the +-flank_px row window by ``contrast`` grey levels (dashes leave gaps)."""
     m = marking_brightness(image)
