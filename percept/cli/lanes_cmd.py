@@ -35,7 +35,7 @@ def register(app: typer.Typer) -> None:
     ):
         """Fit the ego lane on recorded footage; pitch and horizon come from the lane lines' vanishing point."""
         from percept.cli.app import fail
-        from percept.lanes.calibration import CameraCalibration
+        from percept.sensors import CameraCalibration
         from percept.lanes.realworld import FootageLanes, RealLaneConfig, list_inputs
 
         if max_frames is not None and max_frames < 1:
@@ -72,7 +72,7 @@ def register(app: typer.Typer) -> None:
         from rich.table import Table
 
         from percept.cli.app import console, fail, progress_bar, write_json
-        from percept.lanes.calibration import calibrate_chessboards, chessboard_images, parse_pattern
+        from percept.sensors.chessboard import calibrate_chessboards, chessboard_images, parse_pattern
 
         try:
             size = parse_pattern(pattern)

@@ -19,7 +19,9 @@ import numpy as np
 
 from percept.sensors import PinholeCamera, StereoRig
 
-from .calibration import CameraCalibration, VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
+from percept.sensors import CameraCalibration
+
+from .horizon import VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
 from .detector import LaneConfig, LaneDebug, LaneDetector
 from .evidence import Brightness, EvidenceConfig
 from .fit import FitConfig

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from percept.cli import app
 from percept.lanes import marking_brightness
-from percept.lanes.calibration import CameraCalibration, calibrate_chessboards, chessboard_images
+from percept.sensors.chessboard import CameraCalibration, calibrate_chessboards, chessboard_images
 from percept.lanes.realworld import FootageLanes, RealLaneConfig, list_inputs, open_video, read_image
 
 DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
