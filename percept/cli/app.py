@@ -207,7 +207,8 @@ def main() -> None:
 
 
 # commands that live in their own modules register themselves on ``app``
-from . import eval_cmd, lanes_cmd  # noqa: E402
+from . import calibrate_cmd, eval_cmd, lanes_cmd  # noqa: E402
 
 eval_cmd.register(app)
 lanes_cmd.register(app)
+calibrate_cmd.register(app)

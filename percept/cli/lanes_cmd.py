@@ -1,4 +1,4 @@
-"""`percept lanes` (the lane module on recorded footage) and `percept calibrate` (camera intrinsics from chessboards).
+"""`percept lanes`: the lane module on recorded footage.
 
 Registered on the main typer app by ``percept.cli.app``; parses options, calls ``percept.lanes``, prints.
 """
@@ -15,7 +15,7 @@ import typer
 
 
 def register(app: typer.Typer) -> None:
-    """Add the ``lanes`` and ``calibrate`` commands to ``app``."""
+    """Add the ``lanes`` command to ``app``."""
 
     @app.command("lanes")
     def lanes(
@@ -59,57 +59,6 @@ def register(app: typer.Typer) -> None:
             _run_video(runner, files[0], out, json_path, max_frames, header)
         else:
             _run_images(runner, files, out, json_path, header, single=source.is_file())
-
-    @app.command("calibrate")
-    def calibrate(
-        folder: Path = typer.Argument(..., help="Folder of chessboard photos taken with one camera."),
-        pattern: str = typer.Option("9x6", "--pattern", help="Inner corners per row x per column, e.g. 9x6."),
-        out: Optional[Path] = typer.Option(None, "--out", help="Calibration file to write (default DIR/calib.json)."),
-        json_path: Optional[Path] = typer.Option(None, "--json", help="Also write the figures to this JSON file."),
-    ):
-        """Camera intrinsics and lens distortion from chessboard photos (Zhang 2000), for `percept lanes --calib`."""
-        from rich.markup import escape
-        from rich.table import Table
-
-        from percept.cli.app import console, fail, progress_bar, write_json
-        from percept.sensors.chessboard import calibrate_chessboards, chessboard_images, parse_pattern
-
-        try:
-            size = parse_pattern(pattern)
-            photos = chessboard_images(folder)
-        except ValueError as e:
-            fail(str(e))
-        target = out if out is not None else folder / "calib.json"
-        problem = None
-        with progress_bar() as bar:
-            task = bar.add_task(f"finding {size[0]}x{size[1]} chessboards", total=len(photos))
-            try:
-                cal = calibrate_chessboards(photos, size, progress=lambda p, ok: bar.advance(task))
-            except ValueError as e:
-                problem = str(e)
-        if problem is not None:
-            fail(problem)
-        try:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            cal.save(target)
-        except OSError as e:
-            fail(f"cannot write {target}: {e.strerror or e}")
-        t = Table(title=f"camera calibration from {folder}")
-        t.add_column("quantity")
-        t.add_column("value", justify="right")
-        skipped = cal.images_found - cal.images_used
-        rows = [("RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
-                ("photos with the board", f"{cal.images_found} of {cal.images_total}"),
-                ("photos used", f"{cal.images_used}" + (f" ({skipped} of another size skipped)" if skipped else "")),
-                ("image size [px]", f"{cal.width}x{cal.height}"), ("fx, fy [px]", f"{cal.fx:.1f}, {cal.fy:.1f}"),
-                ("cx, cy [px]", f"{cal.cx:.1f}, {cal.cy:.1f}"),
-                ("dist (k1 k2 p1 p2 k3)", " ".join(f"{k:+.4f}" for k in cal.dist))]
-        for k, v in rows:
-            t.add_row(escape(k), v)
-        console.print(t)
-        console.print(f"wrote {target}")
-        write_json(json_path, {**cal.to_dict(), "file": str(target), "folder": str(folder)})
-
 
 def _record(result, **keys) -> dict:
     return {**keys, **result.to_dict()}

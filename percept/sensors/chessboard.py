@@ -132,6 +132,25 @@ def find_corners(gray: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | Non
     return cv2.cornerSubPix(gray, corners, (11, 11), (-1, -1), crit)
 
 
+def board_points(pattern: tuple[int, int], square_m: float = 1.0) -> np.ndarray:
+    """Board points (cols * rows, 3) float32: the inner-corner grid (X, Y, 0) in metres (or squares)."""
+    cols, rows = pattern
+    obj = np.zeros((cols * rows, 3), np.float32)
+    obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square_m
+    return obj
+
+
+def calibrate_points(corners: list[np.ndarray], size: tuple[int, int], pattern: tuple[int, int],
+                     square_m: float = 1.0, found: int = 0, total: int = 0) -> CameraCalibration:
+    """Zhang (2000) from the corners (each (N, 1, 2) [px]) of photos of one size (width, height)."""
+    obj = board_points(pattern, square_m)
+    # minimise sum_i sum_j || x_ij - pi(K, dist, R_i, t_i, X_j) ||^2 (Zhang 2000, eq. 10 with distortion)
+    rms, K, dist, _, _ = cv2.calibrateCamera([obj] * len(corners), corners, size, None, None)
+    return CameraCalibration(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), int(size[0]),
+                             int(size[1]), tuple(float(k) for k in np.ravel(dist)), float(rms), len(corners),
+                             found or len(corners), total or len(corners), pattern)
+
+
 def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], square_m: float = 1.0,
                           progress: Callable[[Path, bool], None] | None = None) -> CameraCalibration:
     """Zhang (2000) calibration from photos of a chessboard with ``pattern`` inner corners (cols, rows).
@@ -142,9 +161,6 @@ def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], squar
     Raises ValueError when no photo is readable or the board is found in none.
     """
     cols, rows = pattern
-    # board points (X, Y, 0): the corner grid in board units
-    obj = np.zeros((cols * rows, 3), np.float32)
-    obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square_m
     found: list[tuple[tuple[int, int], np.ndarray]] = []
     readable = 0
     for p in paths:
@@ -163,11 +179,4 @@ def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], squar
         raise ValueError(f"no {cols}x{rows} chessboard found in any of {readable} photos; "
                          "check --pattern (inner corners, e.g. 9x6 for a 10x7-square board)")
     size = Counter(s for s, _ in found).most_common(1)[0][0]
-    pts = [c for s, c in found if s == size]
-    # minimise sum_i sum_j || x_ij - pi(K, dist, R_i, t_i, X_j) ||^2 (Zhang 2000, eq. 10 with distortion)
-    rms, K, dist, _, _ = cv2.calibrateCamera([obj] * len(pts), pts, size, None, None)
-    return CameraCalibration(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), int(size[0]),
-                             int(size[1]), tuple(float(k) for k in np.ravel(dist)), float(rms), len(pts),
-                             len(found), readable, (cols, rows))
-
-
+    return calibrate_points([c for s, c in found if s == size], size, (cols, rows), square_m, len(found), readable)

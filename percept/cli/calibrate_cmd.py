@@ -1,0 +1,94 @@
+"""`percept calibrate`: camera intrinsics (or a whole stereo rig) from chessboard photos.
+
+Registered on the main typer app by ``percept.cli.app``; parses options, calls ``percept.sensors``, prints.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+
+def _cam_rows(name: str, cal) -> list[tuple[str, str]]:
+    return [(f"{name}fx, fy [px]", f"{cal.fx:.1f}, {cal.fy:.1f}"),
+            (f"{name}cx, cy [px]", f"{cal.cx:.1f}, {cal.cy:.1f}"),
+            (f"{name}dist (k1 k2 p1 p2 k3)", " ".join(f"{k:+.4f}" for k in cal.dist))]
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``calibrate`` command to ``app``."""
+
+    @app.command("calibrate")
+    def calibrate(
+        folder: Path = typer.Argument(..., help="Folder of chessboard photos (one camera), or of left<N>/right<N> "
+                                                "photo pairs with --stereo."),
+        pattern: str = typer.Option("9x6", "--pattern", help="Inner corners per row x per column, e.g. 9x6."),
+        stereo: bool = typer.Option(False, "--stereo", help="Calibrate a stereo rig from left<N>.<ext> / "
+                                                            "right<N>.<ext> pairs: both cameras, R, T, rectification."),
+        square: float = typer.Option(1.0, "--square", help="Side of a board square in metres (sets the units of the "
+                                                           "stereo baseline; 1 = board squares)."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Calibration file to write (default DIR/calib.json, "
+                                                               "DIR/stereo_calib.json with --stereo)."),
+        json_path: Optional[Path] = typer.Option(None, "--json", help="Also write the figures to this JSON file."),
+    ):
+        """Camera intrinsics and lens distortion from chessboard photos (Zhang 2000), for `percept lanes --calib`;
+        with --stereo, both cameras of a rig, the right camera's pose and the rectified projections."""
+        from rich.markup import escape
+        from rich.table import Table
+
+        from percept.cli.app import console, fail, progress_bar, write_json
+        from percept.sensors.chessboard import calibrate_chessboards, chessboard_images, parse_pattern
+        from percept.sensors.stereo_calibration import calibrate_stereo, stereo_pairs
+
+        if not square > 0:
+            fail(f"--square must be positive (metres), got {square}")
+        try:
+            size = parse_pattern(pattern)
+            items = stereo_pairs(folder) if stereo else chessboard_images(folder)
+        except ValueError as e:
+            fail(str(e))
+        target = out if out is not None else folder / ("stereo_calib.json" if stereo else "calib.json")
+        problem = None
+        with progress_bar() as bar:
+            what = "pairs" if stereo else "photos"
+            task = bar.add_task(f"finding {size[0]}x{size[1]} chessboards in {len(items)} {what}", total=len(items))
+            tick = lambda p, ok: bar.advance(task)  # noqa: E731
+            try:
+                cal = calibrate_stereo(items, size, square, tick) if stereo else calibrate_chessboards(
+                    items, size, square, tick)
+            except ValueError as e:
+                problem = str(e)
+        if problem is not None:
+            fail(problem)
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            cal.save(target)
+        except OSError as e:
+            fail(f"cannot write {target}: {e.strerror or e}")
+        t = Table(title=f"{'stereo rig' if stereo else 'camera'} calibration from {folder}")
+        t.add_column("quantity")
+        t.add_column("value", justify="right")
+        if stereo:
+            unit = "m" if square != 1.0 else "squares"
+            rows = [("stereo RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
+                    ("mean epipolar error [px]", f"{cal.epipolar_px:.3f}"),
+                    ("pairs with the board in both", f"{cal.pairs_used} of {cal.pairs_total}"),
+                    (f"baseline [{unit}]", f"{cal.baseline_m:.4f}"),
+                    (f"T [{unit}]", " ".join(f"{v:+.4f}" for v in cal.T)),
+                    ("left / right RMS [px]", f"{cal.left.rms_px:.3f} / {cal.right.rms_px:.3f}"),
+                    ("image size [px]", f"{cal.left.width}x{cal.left.height}"),
+                    *_cam_rows("left ", cal.left), *_cam_rows("right ", cal.right)]
+        else:
+            skipped = cal.images_found - cal.images_used
+            rows = [("RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
+                    ("photos with the board", f"{cal.images_found} of {cal.images_total}"),
+                    ("photos used",
+                     f"{cal.images_used}" + (f" ({skipped} of another size skipped)" if skipped else "")),
+                    ("image size [px]", f"{cal.width}x{cal.height}"), *_cam_rows("", cal)]
+        for k, v in rows:
+            t.add_row(escape(k), v)
+        console.print(t)
+        console.print(f"wrote {target}")
+        write_json(json_path, {**cal.to_dict(), "file": str(target), "folder": str(folder)})
