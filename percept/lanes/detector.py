@@ -34,7 +34,7 @@ class LaneDetector:
     def __init__(self, rig: StereoRig, cfg: LaneConfig = LaneConfig()):
         self.rig, self.cfg = rig, cfg
         self.extractor = MarkingExtractor(rig, cfg.evidence)
-        self.tracker = LaneTracker(cfg.fit.width_prior_m)
+        self.tracker = LaneTracker(cfg.fit.width_prior_m, cfg.fit.curvature_rate_sigma_1pm2)
 
     def reset(self) -> None:
         self.tracker.reset()

@@ -24,8 +24,9 @@ from .types import LaneEstimate, LaneFit
 class LaneTracker:
     """Tracks the ego lane; ``predict`` every frame, ``update`` when a fit exists."""
 
-    def __init__(self, width_prior_m: float = 3.7):
+    def __init__(self, width_prior_m: float = 3.7, curvature_rate_sigma_1pm2: float = 1e-4):
         self.width_prior = width_prior_m
+        self.rate_sigma = curvature_rate_sigma_1pm2
         self.reset()
 
     def reset(self) -> None:
@@ -59,6 +60,11 @@ class LaneTracker:
         if not self.initialised:
             self.kf.x = z.copy()
             self.kf.P = R * 4
+            # one frame cannot tell the curvature rate (it bends the far end, where a few stray points decide it):
+            # the track starts from the road-design prior, rate 0 +- sigma, and learns it over the next frames
+            self.kf.x[3] = 0.0
+            self.kf.P[3, :] = self.kf.P[:, 3] = 0.0
+            self.kf.P[3, 3] = self.rate_sigma ** 2
             self.initialised = True
         else:
             # reject fits far from the prediction (Mahalanobis gate, chi2 5 dof, 99.9 %)
