@@ -33,8 +33,12 @@ def register(app: typer.Typer) -> None:
                                                                "DIR/stereo_calib.json with --stereo)."),
         json_path: Optional[Path] = typer.Option(None, "--json", help="Also write the figures to this JSON file."),
     ):
-        """Camera intrinsics and lens distortion from chessboard photos (Zhang 2000), for `percept lanes --calib`;
-        with --stereo, both cameras of a rig, the right camera's pose and the rectified projections."""
+        """Camera intrinsics and distortion from chessboard photos (Zhang 2000); with --stereo, a whole rig.
+
+        One camera: the file is what `percept lanes --calib` reads. Stereo: both cameras, the right camera's
+        rotation and translation in the left one's frame (baseline in metres with --square), the rectified
+        projections, and the mean epipolar error as a check.
+        """
         from rich.markup import escape
         from rich.table import Table
 
