@@ -39,7 +39,9 @@ def marking_brightness(image: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class EvidenceConfig:
     """x_near_m, x_far_m: ground range ahead of the vehicle centre [m]; half_width_m: lateral half range [m];
-    dx_m, dy_m: grid steps [m]; marking_width_m: expected stripe width [m]; min_contrast: absolute top-hat
+    dx_m, dy_m: grid steps [m]; marking_width_m: expected stripe width [m]; full_weight_span_m: a point counts fully
+    where one pixel spans at most this much ground across [m] (further away its weight falls as the span squared);
+    min_contrast: absolute top-hat
     threshold [grey levels]; rel_contrast: threshold relative to the frame's strong responses; brightness: the paint
     measure; max_row_px: image rows below this are not road (a car's hood), None = all rows."""
 
@@ -49,6 +51,7 @@ class EvidenceConfig:
     dx_m: float = 0.25
     dy_m: float = 0.05
     marking_width_m: float = 0.15
+    full_weight_span_m: float = 0.025
     min_contrast: float = 10.0
     rel_contrast: float = 0.3
     brightness: Brightness = Brightness.MAX_RG
@@ -81,6 +84,10 @@ class MarkingExtractor:
         self.valid = ((self.uv[..., 0] >= 0) & (self.uv[..., 0] <= cam.width - 1) & (self.uv[..., 1] >= 0)
                       & (self.uv[..., 1] <= bottom))
         self.valid_f = self.valid.astype(np.float32)
+        # weight of a grid row: image rows per grid row (far rows re-sample one image row many times), capped at 1,
+        # times the lateral precision (sigma_y = x / f per pixel): w = min(1, |dv/dr|) min(1, (f s / x)^2)
+        dv = np.abs(np.gradient(self.uv[:, self.cols // 2, 1]))
+        self.row_weight = np.minimum(1.0, dv) * np.minimum(1.0, (rig.camera.fx * cfg.full_weight_span_m / self.x) ** 2)
         self.w_px = max(int(round(cfg.marking_width_m / cfg.dy_m)), 1)
         self.size = (cam.width, cam.height)
         # grid -> image lookup for cv2.remap, in OpenCV's fast fixed-point form; rows below max_row_px read black
@@ -126,4 +133,4 @@ class MarkingExtractor:
         keep = (v >= resp[r, c - 1]) & (v > resp[r, c + 1])
         r, c = r[keep], c[keep]
         pts = np.column_stack([self.x[r], self.y[c]])
-        return MarkingEvidence(pts, v[keep], self.uv[r, c])
+        return MarkingEvidence(pts, v[keep], self.uv[r, c], self.row_weight[r])

@@ -78,7 +78,7 @@ def _prior_normal(cfg: FitConfig) -> tuple[np.ndarray, np.ndarray]:
 _UNSCALE = np.array([1.0, 0.1, 0.01, 1.0, 0.001])
 
 
-def _solve(pts, sides, strength, cfg: FitConfig, iterations: int = 3):
+def _solve(pts, sides, strength, weight, cfg: FitConfig, iterations: int = 3):
     """IRLS on the normal equations (5 unknowns); returns params, residuals, mask of used points, covariance."""
     m = sides != 0
     x, y, s = pts[m, 0], pts[m, 1], sides[m].astype(float)
@@ -88,7 +88,7 @@ def _solve(pts, sides, strength, cfg: FitConfig, iterations: int = 3):
     A = np.column_stack([np.ones_like(xs), xs, xs * xs, s / 2, xs ** 3])
     sig = cfg.huber_m
     PtP, Ptq = _prior_normal(cfg)
-    base = np.clip(strength[m], 1, None)
+    base = np.clip(strength[m], 1, None) * (1.0 if weight is None else weight[m])
     w2 = base / base.mean()
     for _ in range(iterations):
         # weighted normal equations (A^T W A + P^T P) p = A^T W y + P^T q
@@ -106,12 +106,12 @@ def _solve(pts, sides, strength, cfg: FitConfig, iterations: int = 3):
     return params, r, m, cov
 
 
-def _grow(pts, sides, strength, cfg: FitConfig):
+def _grow(pts, sides, strength, weight, cfg: FitConfig):
     """Fit, re-gate every point around the fitted boundaries, refit (twice at most, until the assignment
     settles); (support, params, sides, r, m, cov, nl, nr)."""
     if (sides != 0).sum() < cfg.min_points:
         return None
-    params, r, m, cov = _solve(pts, sides, strength, cfg)
+    params, r, m, cov = _solve(pts, sides, strength, weight, cfg)
     x = pts[:, 0]
     for _ in range(2):
         pred = params[0] + params[1] * x + params[2] * x ** 2 + params[4] * x ** 3
@@ -121,7 +121,7 @@ def _grow(pts, sides, strength, cfg: FitConfig):
         if (new != 0).sum() < cfg.min_points or np.array_equal(new, sides):
             break
         sides = new
-        params, r, m, cov = _solve(pts, sides, strength, cfg)
+        params, r, m, cov = _solve(pts, sides, strength, weight, cfg)
     if not 2.4 <= params[3] <= 5.2:
         return None
     inl = np.abs(r) < 3 * cfg.huber_m
@@ -147,7 +147,7 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
         seeds = _initial_sides(pts, cfg)
     best = None
     for sides in seeds:
-        result = _grow(pts, sides, ev.strength, cfg)
+        result = _grow(pts, sides, ev.strength, ev.weight, cfg)
         if result is not None and (best is None or result[0] > best[0]):
             best = result
     if best is None:
