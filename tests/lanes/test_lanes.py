@@ -65,6 +65,39 @@ def test_tracker_follows_curvature_along_a_spiral():
     assert tracker.estimate.curvature_rate_1pm2 == pytest.approx(rate, abs=2e-5)
 
 
+def test_far_evidence_weighs_what_the_image_holds():
+    """A grid row's weight: image rows it re-samples (flat ground: dv/dx = f h / x^2) times the lateral precision
+    (f s / x)^2, each capped at 1."""
+    rig = StereoRig()
+    ex = MarkingExtractor(rig)
+    w = ex.row_weight
+    assert w[0] == pytest.approx(1.0) and np.all(np.diff(w) <= 1e-9)
+    cam, cfg = rig.camera, ex.cfg
+    for x in (20.0, 30.0, 45.0):
+        rows = cam.fy * rig.mount_height_m / x ** 2 * cfg.dx_m
+        expect = min(1, rows) * min(1, (cam.fx * cfg.full_weight_span_m / x) ** 2)
+        assert w[np.argmin(np.abs(ex.x - x))] == pytest.approx(expect, rel=0.1)
+
+
+def test_a_far_streak_does_not_bend_the_lane():
+    """Rain streaks near the horizon become long slanted stripes in the bird's-eye view (one image row spans
+    metres there): weighted by what the image holds, 60 such points at 38-50 m leave the near lane alone."""
+    truth = LaneEstimate(0.0, 0.0, 0.0, 4.0, 1.0)
+    rng = np.random.default_rng(4)
+    ev = synthetic_evidence(truth, rng)
+    near = ev.points_m[:, 0] < 25
+    xs = np.linspace(38, 50, 60)
+    streak = np.column_stack([xs, 2.0 + 0.06 * (xs - 38)])
+    pts = np.concatenate([ev.points_m[near], streak])
+    weight = np.array([MarkingExtractor(StereoRig()).row_weight[int(round((x - 6.0) / 0.25))] for x in pts[:, 0]])
+    fits = {}
+    for name, wt in (("weighted", weight), ("unweighted", None)):
+        fits[name] = fit_lane(MarkingEvidence(pts, np.full(len(pts), 40.0), np.zeros((len(pts), 2)), wt), None)
+    assert abs(fits["weighted"].estimate.heading_rad) < 0.006 and abs(fits["weighted"].estimate.offset_m) < 0.05
+    # the same points counted alike pull the heading several times further off
+    assert abs(fits["unweighted"].estimate.heading_rad) > 3 * abs(fits["weighted"].estimate.heading_rad)
+
+
 def test_fit_with_one_side_only_uses_the_width_prior():
     truth = LaneEstimate(0.2, 0.0, 0.0, 3.7, 1.0)
     ev = synthetic_evidence(truth, np.random.default_rng(1))
