@@ -168,7 +168,7 @@ def drive(
         t.add_row(escape(k), str(v))
     console.print(t)
     if rec_path:
-        console.print(f"recording: {rec_path}  (open it with `rerun {rec_path}`)")
+        console.print(f"recording: {rec_path}  (open it with `percept view {rec_path}`)")
 
 
 def _num(x, fmt: str = "{:.2f}") -> str:
@@ -207,8 +207,9 @@ def main() -> None:
 
 
 # commands that live in their own modules register themselves on ``app``
-from . import calibrate_cmd, eval_cmd, lanes_cmd  # noqa: E402
+from . import calibrate_cmd, eval_cmd, lanes_cmd, view_cmd  # noqa: E402
 
 eval_cmd.register(app)
 lanes_cmd.register(app)
 calibrate_cmd.register(app)
+view_cmd.register(app)

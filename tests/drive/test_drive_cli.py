@@ -1,15 +1,13 @@
 """`percept drive` through typer's CliRunner: contract, recording, bad input."""
 
 import json
-import shutil
 import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
 from percept.cli import app
+from percept.cli.view_cmd import rerun_executable
 
 runner = CliRunner()
 KEYS = ["scenario", "condition", "seed", "duration_s", "frames", "realtime_factor", "collisions",
@@ -17,8 +15,7 @@ KEYS = ["scenario", "condition", "seed", "duration_s", "frames", "realtime_facto
 
 
 def rerun_bin() -> str:
-    exe = Path(sys.executable).with_name("rerun")
-    return str(exe) if exe.exists() else shutil.which("rerun")
+    return rerun_executable()
 
 
 def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
