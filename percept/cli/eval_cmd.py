@@ -71,6 +71,7 @@ def register(app: typer.Typer) -> None:
             except RuntimeError as e:
                 fail(str(e))
         t = Table(title=f"{len(plan.jobs)} runs, lateral {lateral}", box=box.SIMPLE_HEAD, pad_edge=False,
+                  collapse_padding=True,
                   caption="lane errors (offset m, heading rad, curvature 1/m) and centering RMS (m): means over "
                           "seeds; centering max (m): the worst run")
         for col in ("scenario", "cond", "runs", "coll", "dep", "offset", "head", "curv", "c.rms", "c.max"):
