@@ -41,9 +41,9 @@ class EvidenceConfig:
     """x_near_m, x_far_m: ground range ahead of the vehicle centre [m]; half_width_m: lateral half range [m];
     dx_m, dy_m: grid steps [m]; marking_width_m: expected stripe width [m]; full_weight_span_m: a point counts fully
     where one pixel spans at most this much ground across [m] (further away its weight falls as the span squared);
-    min_contrast: absolute top-hat
-    threshold [grey levels]; rel_contrast: threshold relative to the frame's strong responses; brightness: the paint
-    measure; max_row_px: image rows below this are not road (a car's hood), None = all rows."""
+    min_contrast: absolute top-hat threshold [grey levels]; rel_contrast: threshold relative to the frame's strong
+    responses; brightness: the paint measure; max_row_px: image rows below this are not road (a car's hood),
+    None = all rows."""
 
     x_near_m: float = 6.0
     x_far_m: float = 50.0
@@ -62,6 +62,8 @@ class EvidenceConfig:
             raise ValueError(f"need 0 < x_near_m < x_far_m, got {self.x_near_m}, {self.x_far_m}")
         if self.dx_m <= 0 or self.dy_m <= 0:
             raise ValueError("grid steps dx_m, dy_m must be positive")
+        if not self.full_weight_span_m > 0:
+            raise ValueError(f"full_weight_span_m must be positive, got {self.full_weight_span_m}")
 
 
 class MarkingExtractor:

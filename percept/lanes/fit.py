@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -76,19 +77,50 @@ def _prior_normal(cfg: FitConfig) -> tuple[np.ndarray, np.ndarray]:
 
 
 _UNSCALE = np.array([1.0, 0.1, 0.01, 1.0, 0.001])
+_POLY = [0, 1, 2, 4]
+"""Parameters that multiply powers of x (a0, a1, a2, a3); index 3 is the width."""
 
 
-def _solve(pts, sides, strength, weight, cfg: FitConfig, iterations: int = 3):
+class _Points(NamedTuple):
+    """One frame's evidence, prepared once per fit: y (N,); powers (N, 4) of x / 10 m (1, x, x^2, x^3), which
+    keeps the normal equations well conditioned (undone with _UNSCALE); base (N,) point weights."""
+
+    y: np.ndarray
+    powers: np.ndarray
+    base: np.ndarray
+
+    @classmethod
+    def of(cls, ev: MarkingEvidence) -> "_Points":
+        xs = ev.points_m[:, 0] / 10.0
+        base = np.clip(ev.strength, 1, None) * (1.0 if ev.weight is None else ev.weight)
+        return cls(ev.points_m[:, 1], np.column_stack([np.ones_like(xs), xs, xs * xs, xs ** 3]), base)
+
+    def boundary(self, params: np.ndarray, side: int) -> np.ndarray:
+        """y of the fitted boundary on ``side`` at every point's x."""
+        return self.powers @ (params[_POLY] / _UNSCALE[_POLY]) + side * params[3] / 2
+
+
+class _Grown(NamedTuple):
+    support: int
+    params: np.ndarray
+    sides: np.ndarray
+    residual: np.ndarray
+    used: np.ndarray
+    cov: np.ndarray
+    inliers: np.ndarray
+    n_left: int
+    n_right: int
+
+
+def _solve(pts: _Points, sides: np.ndarray, cfg: FitConfig, iterations: int = 3):
     """IRLS on the normal equations (5 unknowns); returns params, residuals, mask of used points, covariance."""
     m = sides != 0
-    x, y, s = pts[m, 0], pts[m, 1], sides[m].astype(float)
-    # columns: a0, a1, a2, w, and a3 (x^3) that absorbs curvature changing ahead (a clothoid: a3 = dkappa/ds / 6);
-    # x in units of 10 m keeps the powers well conditioned (undone on the parameters with _UNSCALE)
-    xs = x / 10.0
-    A = np.column_stack([np.ones_like(xs), xs, xs * xs, s / 2, xs ** 3])
+    y, X = pts.y[m], pts.powers[m]
+    # columns: a0, a1, a2, w, and a3 (x^3) that absorbs curvature changing ahead (a clothoid: a3 = dkappa/ds / 6)
+    A = np.column_stack([X[:, :3], sides[m] / 2.0, X[:, 3]])
     sig = cfg.huber_m
     PtP, Ptq = _prior_normal(cfg)
-    base = np.clip(strength[m], 1, None) * (1.0 if weight is None else weight[m])
+    base = pts.base[m]
     w2 = base / base.mean()
     for _ in range(iterations):
         # weighted normal equations (A^T W A + P^T P) p = A^T W y + P^T q
@@ -106,60 +138,58 @@ def _solve(pts, sides, strength, weight, cfg: FitConfig, iterations: int = 3):
     return params, r, m, cov
 
 
-def _grow(pts, sides, strength, weight, cfg: FitConfig):
+def _grow(pts: _Points, sides: np.ndarray, cfg: FitConfig) -> _Grown | None:
     """Fit, re-gate every point around the fitted boundaries, refit (twice at most, until the assignment
-    settles); (support, params, sides, r, m, cov, nl, nr)."""
+    settles)."""
     if (sides != 0).sum() < cfg.min_points:
         return None
-    params, r, m, cov = _solve(pts, sides, strength, weight, cfg)
-    x = pts[:, 0]
+    params, r, m, cov = _solve(pts, sides, cfg)
     for _ in range(2):
-        pred = params[0] + params[1] * x + params[2] * x ** 2 + params[4] * x ** 3
-        new = np.zeros(len(pts), dtype=int)
+        new = np.zeros(len(pts.y), dtype=int)
         for s in (1, -1):
-            new[np.abs(pts[:, 1] - (pred + s * params[3] / 2)) < 3 * cfg.huber_m + 0.1] = s
+            new[np.abs(pts.y - pts.boundary(params, s)) < 3 * cfg.huber_m + 0.1] = s
         if (new != 0).sum() < cfg.min_points or np.array_equal(new, sides):
             break
         sides = new
-        params, r, m, cov = _solve(pts, sides, strength, weight, cfg)
+        params, r, m, cov = _solve(pts, sides, cfg)
     if not 2.4 <= params[3] <= 5.2:
         return None
     inl = np.abs(r) < 3 * cfg.huber_m
     nl = int(((sides[m] == 1) & inl).sum())
     nr = int(((sides[m] == -1) & inl).sum())
     # support favours both sides seen
-    support = nl + nr + 2 * min(nl, nr)
-    return support, params, sides, r, m, cov, nl, nr
+    return _Grown(nl + nr + 2 * min(nl, nr), params, sides, r, m, cov, inl, nl, nr)
 
 
 def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = FitConfig()) -> LaneFit | None:
     """Fit both boundaries; ``prior`` (a prediction) gates the assignment. None when evidence is too thin."""
-    pts = ev.points_m
-    if len(pts) < cfg.min_points:
+    if len(ev.points_m) < cfg.min_points:
         return None
     if prior is not None and prior.valid:
-        sides = np.zeros(len(pts), dtype=int)
+        x, y = ev.points_m[:, 0], ev.points_m[:, 1]
+        sides = np.zeros(len(x), dtype=int)
         gate = cfg.gate_m * (1.5 - 0.5 * prior.confidence)
         for s in (1, -1):
-            sides[np.abs(pts[:, 1] - prior.boundary_y(pts[:, 0], s)) < gate] = s
+            sides[np.abs(y - prior.boundary_y(x, s)) < gate] = s
         seeds = [sides]
     else:
-        seeds = _initial_sides(pts, cfg)
+        seeds = _initial_sides(ev.points_m, cfg)
+    pts = _Points.of(ev)
     best = None
     for sides in seeds:
-        result = _grow(pts, sides, ev.strength, ev.weight, cfg)
-        if result is not None and (best is None or result[0] > best[0]):
-            best = result
+        g = _grow(pts, sides, cfg)
+        if g is not None and (best is None or g.support > best.support):
+            best = g
     if best is None:
         return None
-    _, params, sides, r, m, cov, nl, nr = best
-    inl = np.abs(r) < 3 * cfg.huber_m
-    a0, a1, a2, w, a3 = params
+    a0, a1, a2, w, a3 = best.params
+    nl, nr = best.n_left, best.n_right
     support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6)
     est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support),
                        curvature_rate_1pm2=float(6 * a3))
+    r, inl = best.residual, best.inliers
     res = float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan")
     # (a0, a1, a2, w, a3) -> (offset, heading, curvature, curvature_rate, width): rows of the Jacobian
     J = np.zeros((5, 5))
     J[0, 0], J[1, 1], J[2, 2], J[3, 4], J[4, 3] = -1.0, -1.0 / (1 + a1 * a1), 2.0, 6.0, 1.0
-    return LaneFit(est, np.where(m, sides, 0), res, nl, nr, J @ cov @ J.T)
+    return LaneFit(est, np.where(best.used, best.sides, 0), res, nl, nr, J @ best.cov @ J.T)

@@ -90,12 +90,10 @@ def make_detector(rig: StereoRig, cfg: RealLaneConfig) -> LaneDetector:
 
 def boundary_points_px(rig: StereoRig, est: LaneEstimate, x_near_m: float, x_far_m: float,
                        n: int = 40) -> dict[str, np.ndarray]:
-    """Both boundaries projected into the image: {"left"|"right": (n, 2) (u, v) [px]} for ground points
-    (x, boundary_y(x, side), 0) of the vehicle frame, x from x_near_m to x_far_m [m]."""
-    x = np.linspace(x_near_m, x_far_m, n)
+    """Both boundaries projected into the image: {"left"|"right": (m <= n, 2) (u, v) [px]} of
+    ``est.boundary_points_m`` (the points in front of the camera)."""
     out = {}
-    for name, side in (("left", 1), ("right", -1)):
-        pts = np.column_stack([x, est.boundary_y(x, side), np.zeros_like(x)])
+    for name, pts in est.boundary_points_m(x_near_m, x_far_m, n).items():
         uv, z = rig.project_vehicle_points(pts)
         out[name] = uv[z > 0.1]
     return out

@@ -37,6 +37,12 @@ class LaneEstimate:
         """side +1: left boundary, -1: right boundary."""
         return self.centre_y(x_m) + side * self.width_m / 2
 
+    def boundary_points_m(self, x_near_m: float, x_far_m: float, n: int = 40) -> dict[str, np.ndarray]:
+        """Both boundaries on the ground: {"left"|"right": (n, 3) vehicle-frame (x, y, 0) [m]}, x_near..x_far."""
+        x = np.linspace(x_near_m, x_far_m, n)
+        return {name: np.column_stack([x, self.boundary_y(x, side), np.zeros_like(x)])
+                for name, side in (("left", 1), ("right", -1))}
+
 
 @dataclass(frozen=True)
 class MarkingEvidence:

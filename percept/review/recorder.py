@@ -19,6 +19,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from percept.lanes.realworld import boundary_points_px
 from percept.sensors import Side, StereoRig
 
 KIND_COLORS = {"vehicle": (70, 130, 230), "pedestrian": (240, 80, 60), "landmark": (250, 220, 60)}
@@ -115,12 +116,11 @@ class RunRecorder:
         else:
             rec.log(f"{cam}/evidence", rr.Clear(recursive=False))
         if est.valid:
-            x = np.linspace(LANE_DRAW_M[0], LANE_DRAW_M[1], 30)
-            ground = [np.column_stack([x, est.boundary_y(x, s), np.full_like(x, 0.03)]) for s in (1, -1)]
-            rec.log("world/ego/lanes", rr.LineStrips3D(ground, colors=[SIDE_COLORS[1], SIDE_COLORS[-1]], radii=0.1))
-            px = [self.rig.project_vehicle_points(g) for g in ground]
-            rec.log(f"{cam}/lanes", rr.LineStrips2D([uv[z > 0.1] for uv, z in px],
-                                                    colors=[SIDE_COLORS[1], SIDE_COLORS[-1]], radii=2.0))
+            ground = est.boundary_points_m(*LANE_DRAW_M, n=30)
+            px = boundary_points_px(self.rig, est, *LANE_DRAW_M, n=30)
+            colors = [SIDE_COLORS[1], SIDE_COLORS[-1]]
+            rec.log("world/ego/lanes", rr.LineStrips3D([ground["left"], ground["right"]], colors=colors, radii=0.1))
+            rec.log(f"{cam}/lanes", rr.LineStrips2D([px["left"], px["right"]], colors=colors, radii=2.0))
             for name, value in (("offset_m", est.offset_m), ("heading_rad", est.heading_rad),
                                 ("curvature_1pm", est.curvature_1pm)):
                 rec.log(f"plots/lane/{name}/vision", rr.Scalars(value))
