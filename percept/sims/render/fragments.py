@@ -24,8 +24,9 @@ from .textures import TextureAtlas
 BIG_PX = 1500
 """Patches covering more than this [px] (estimated) are rasterised one by one with OpenCV texture warps;
 the others all at once as fragments (one per covered pixel) with vectorised texture lookups."""
-INV_NEAR = 1.0 / 0.3
-"""1 / raster.NEAR_M (raster imports this module)."""
+NEAR_M = 0.3
+"""Near clipping distance of every camera [m] (re-exported by raster, which imports this module)."""
+INV_NEAR = 1.0 / NEAR_M
 _ALBEDO = (np.arange(256, dtype=np.float32) * np.float32(1.0 / 255.0)).reshape(256, 1, 1)
 """Texel value / 255, the colour map of a patch's albedo when multiplied by its colour."""
 
@@ -240,9 +241,12 @@ def _small_patches(wbuf: np.ndarray, p: PreparedPatches, rp, v, lo, hi, sil) -> 
         if len(objs):
             foid = np.repeat(oid, n)
             on = np.flatnonzero(foid > 0)
-            opix, foid = pix[on], foid[on]
-            for o in objs.tolist():
-                sil.setdefault(o, []).append(opix[foid == o])
+            # group the fragments by object with one stable sort (order within an object is kept)
+            order = np.argsort(foid[on], kind="stable")
+            opix, foid = pix[on][order], foid[on][order]
+            ids, starts = np.unique(foid, return_index=True)
+            for o, px in zip(ids.tolist(), np.split(opix, starts[1:])):
+                sil.setdefault(o, []).append(px)
     # z-test against the buffer, then among the batch: the largest 1/Z per pixel wins (fragments with equal
     # 1/Z at a pixel are all kept; the last one written wins, the same in every buffer)
     wflat = wbuf.reshape(-1)

@@ -10,14 +10,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+SUN_DIR = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
+"""Unit vector towards the sun in the world frame (x forward, y left, z up); shading of every patch."""
+
 QUAD = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 _phi = np.linspace(0.0, 2 * np.pi, 20, endpoint=False)
 ELLIPSE = np.column_stack([0.5 + 0.5 * np.cos(_phi), 0.5 + 0.5 * np.sin(_phi)])
 OUTLINES = [QUAD, ELLIPSE]
 """Outline index 0: quad, 1: ellipse inscribed in the quad (the polygons are for reference; the
 rasteriser tests the exact shapes)."""
-
-_FIELDS = ("origin", "e1", "e2", "color", "texture", "outline", "obj_id", "two_sided", "shade", "repeat")
 
 
 @dataclass
@@ -56,10 +57,6 @@ class PatchBatch:
     def __len__(self) -> int:
         return len(self.origin)
 
-    def take(self, index: np.ndarray) -> "PatchBatch":
-        """The patches selected by a boolean mask or an index array."""
-        return PatchBatch(*[getattr(self, f)[index] for f in _FIELDS])
-
     def pack(self) -> np.ndarray:
         """All fields as one (P, 19) float64 array (see ``unpack``): cheap to select and stack."""
         return np.column_stack([self.origin, self.e1, self.e2, self.color, self.texture, self.outline, self.obj_id,
@@ -71,15 +68,6 @@ class PatchBatch:
         return PatchBatch(a[:, 0:3], a[:, 3:6], a[:, 6:9], a[:, 9:12], a[:, 12].astype(np.int32),
                           a[:, 13].astype(np.int32), a[:, 14].astype(np.int32), a[:, 15] > 0.5, a[:, 16] > 0.5,
                           a[:, 17:19])
-
-    @staticmethod
-    def concat(batches: list["PatchBatch"]) -> "PatchBatch":
-        batches = [b for b in batches if len(b)]
-        if not batches:
-            return PatchBatch.empty()
-        if len(batches) == 1:
-            return batches[0]
-        return PatchBatch(*[np.concatenate([getattr(b, f) for b in batches]) for f in _FIELDS])
 
 
 class PatchBuilder:

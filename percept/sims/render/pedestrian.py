@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 
+from .patches import SUN_DIR
 from .raster import PatchBuilder
 from .scene import ObjectState
 
@@ -36,7 +37,6 @@ SKINS = [(150, 180, 225), (125, 160, 210), (95, 130, 185), (70, 100, 150), (50, 
 HAIR = [(20, 20, 25), (25, 40, 65), (45, 75, 120), (80, 150, 190), (150, 150, 155), (30, 30, 90)]
 SHOES = [(25, 25, 28), (30, 50, 80), (215, 215, 215), (40, 40, 40)]
 
-SUN = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 """Light direction (world) for the lit/shadowed halves; matches the renderer's sun."""
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -84,10 +84,10 @@ class _Figure:
             self.limb(p0, pm, r0, rm, color, caps=(caps[0], False))
             self.limb(pm, p1, rm, r1, color, caps=(False, caps[1]))
             return
-        lit = 1.0 if side @ SUN >= 0 else -1.0
+        lit = 1.0 if side @ SUN_DIR >= 0 else -1.0
         for sgn in (lit, -lit):
             s = sgn * side
-            k = 1.0 + (0.13 * abs(float(side @ SUN)) + 0.04) * (1 if sgn == lit else -1)
+            k = 1.0 + (0.13 * abs(float(side @ SUN_DIR)) + 0.04) * (1 if sgn == lit else -1)
             col = tuple(min(255.0, c * k) for c in color)
             # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
             over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)

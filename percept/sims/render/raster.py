@@ -24,15 +24,13 @@ import numpy as np
 
 from percept.sensors import PinholeCamera, Transform
 
-from .fragments import PreparedPatches, rasterize_prepared
+from .fragments import NEAR_M, PreparedPatches, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
 from .textures import TextureAtlas
 
 __all__ = ["ELLIPSE", "LOD_PX", "NEAR_M", "OUTLINES", "QUAD", "PatchBatch", "PatchBuilder", "RenderTarget",
            "prepare", "rasterize"]
 
-NEAR_M = 0.3
-"""Near clipping plane [m]: geometry closer to the camera than this is cut away."""
 LOD_PX = 0.5
 """Scenery patches narrower than this on screen [px] are skipped."""
 _NEXT = np.array([1, 2, 3, 0])
@@ -84,11 +82,6 @@ class RenderTarget:
         seen = int(np.count_nonzero(mark & (self.ids[v0:v1] == obj_id))) if self.ids is not None else 0
         box = (int(cols[0]), v0 + int(rows[0]), int(cols[-1]) + 1, v0 + int(rows[-1]) + 1)
         return box, int(np.count_nonzero(mark)), seen
-
-    def silhouette_px(self, obj_id: int) -> int:
-        """Pixels the object would cover inside the image if nothing occluded it."""
-        s = self.silhouette(obj_id)
-        return s[1] if s else 0
 
 
 def rasterize(target: RenderTarget, batch: PatchBatch, cam: PinholeCamera, cam_from_world: Transform,

@@ -23,7 +23,7 @@ from ..road_geometry import RoadGeometry
 from .ground import GroundLayer, Palette
 from .fragments import PreparedPatches, rasterize_prepared
 from .paint import GroundPaint, ground_paint
-from .patches import PatchBatch, PatchBuilder
+from .patches import SUN_DIR, PatchBatch, PatchBuilder
 from .pedestrian import pedestrian_patches
 from .raster import LOD_PX, RenderTarget, prepare
 from .scene import ObjectKind, ObjectState, Scene
@@ -33,7 +33,6 @@ from .textures import TextureAtlas, building_texture, foliage_texture, marker_te
 from .vehicles import vehicle_patches
 
 SCENERY_RANGE_M = 260.0
-SUN_DIR = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 _TEMPLATE_CACHE = 1024
 
 
