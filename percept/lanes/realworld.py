@@ -20,6 +20,7 @@ import numpy as np
 from percept.sensors import PinholeCamera, StereoRig
 
 from percept.sensors import CameraCalibration
+from percept.sensors.chessboard import IMAGE_SUFFIXES
 
 from .horizon import VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
 from .detector import LaneConfig, LaneDebug, LaneDetector
@@ -27,7 +28,6 @@ from .evidence import Brightness, EvidenceConfig
 from .fit import FitConfig
 from .types import LaneEstimate
 
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".webp")
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".mpg", ".mpeg", ".webm")
 
 

@@ -24,7 +24,11 @@ import numpy as np
 
 from .camera import PinholeCamera
 
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm")
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".webp")
+MIN_VIEWS = 3
+"""Fewest board views (photos, or stereo pairs) a calibration accepts: fewer leave K undetermined."""
+MAX_CORNERS = 100
+"""Most inner corners a board side may have (OpenCV's detector is not meant for more)."""
 
 
 def parse_pattern(text: str) -> tuple[int, int]:
@@ -35,6 +39,9 @@ def parse_pattern(text: str) -> tuple[int, int]:
     cols, rows = int(m.group(1)), int(m.group(2))
     if cols < 2 or rows < 2:
         raise ValueError(f"pattern {text!r} needs at least 2x2 inner corners")
+    if cols > MAX_CORNERS or rows > MAX_CORNERS:
+        raise ValueError(f"pattern {text!r} has more than {MAX_CORNERS} inner corners a side; count the corners "
+                         "where four squares meet, e.g. 9x6")
     return cols, rows
 
 
@@ -178,5 +185,8 @@ def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], squar
     if not found:
         raise ValueError(f"no {cols}x{rows} chessboard found in any of {readable} photos; "
                          "check --pattern (inner corners, e.g. 9x6 for a 10x7-square board)")
-    size = Counter(s for s, _ in found).most_common(1)[0][0]
+    size, views = Counter(s for s, _ in found).most_common(1)[0]
+    if views < MIN_VIEWS:
+        raise ValueError(f"the {cols}x{rows} board was found in only {views} photo(s) of one size; at least "
+                         f"{MIN_VIEWS} views at different angles are needed")
     return calibrate_points([c for s, c in found if s == size], size, (cols, rows), square_m, len(found), readable)

@@ -16,6 +16,7 @@ distance of a corner to the epipolar line of its partner, both ways) and the rec
 from __future__ import annotations
 
 import json
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -23,7 +24,8 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from .chessboard import CameraCalibration, board_points, calibrate_points, chessboard_images, find_corners
+from .chessboard import (MIN_VIEWS, CameraCalibration, board_points, calibrate_points, chessboard_images,
+                         find_corners)
 
 
 def stereo_pairs(folder: Path) -> list[tuple[Path, Path]]:
@@ -84,24 +86,25 @@ def _epipolar_error(pl: np.ndarray, pr: np.ndarray, left: CameraCalibration, rig
 def calibrate_stereo(pairs: list[tuple[Path, Path]], pattern: tuple[int, int], square_m: float = 1.0,
                      progress: Callable[[Path, bool], None] | None = None) -> StereoCalibration:
     """Calibrate a stereo rig from (left, right) chessboard photos; only pairs with the board found in both
-    images, of one size, are used. ValueError when fewer than three such pairs remain."""
+    images, of the most common size (as for one camera), are used. ValueError when fewer than MIN_VIEWS remain."""
     obj = board_points(pattern, square_m)
-    left_pts, right_pts, size = [], [], None
+    found: list[tuple[tuple[int, int], np.ndarray, np.ndarray]] = []
     for lp, rp in pairs:
         imgs = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) for p in (lp, rp)]
         ok = all(im is not None for im in imgs) and imgs[0].shape == imgs[1].shape
         corners = [find_corners(im, pattern) for im in imgs] if ok else [None, None]
-        ok = ok and all(c is not None for c in corners) and (size is None or imgs[0].shape[::-1] == size)
+        ok = ok and all(c is not None for c in corners)
         if ok:
-            size = imgs[0].shape[::-1]
-            left_pts.append(corners[0])
-            right_pts.append(corners[1])
+            found.append((imgs[0].shape[::-1], corners[0], corners[1]))
         if progress is not None:
             progress(lp, ok)
-    if len(left_pts) < 3:
-        raise ValueError(f"the {pattern[0]}x{pattern[1]} board was found in both images of only {len(left_pts)} of "
-                         f"{len(pairs)} pairs; at least 3 are needed (check --pattern)")
-    n, total = len(left_pts), len(pairs)
+    size, n = Counter(s for s, _, _ in found).most_common(1)[0] if found else (None, 0)
+    if n < MIN_VIEWS:
+        raise ValueError(f"the {pattern[0]}x{pattern[1]} board was found in both images of only {n} of "
+                         f"{len(pairs)} pairs; at least {MIN_VIEWS} are needed (check --pattern)")
+    left_pts = [lc for s, lc, _ in found if s == size]
+    right_pts = [rc for s, _, rc in found if s == size]
+    total = len(pairs)
     left = calibrate_points(left_pts, size, pattern, square_m, n, total)
     right = calibrate_points(right_pts, size, pattern, square_m, n, total)
     # minimise the reprojection error of every corner in both images over R, T (and the board poses),

@@ -32,7 +32,8 @@ def test_pattern_strings(text, expected):
     assert parse_pattern(text) == expected
 
 
-@pytest.mark.parametrize("text, match", [("9by6", "not COLSxROWS"), ("9x", "not COLSxROWS"), ("1x6", "at least 2x2")])
+@pytest.mark.parametrize("text, match", [("9by6", "not COLSxROWS"), ("9x", "not COLSxROWS"), ("1x6", "at least 2x2"),
+                                         ("99999999999x2", "more than 100 inner corners")])
 def test_bad_pattern_strings(text, match):
     with pytest.raises(ValueError, match=match):
         parse_pattern(text)
@@ -83,6 +84,19 @@ def test_no_board_and_no_images(tmp_path):
         chessboard_images(tmp_path)
     cv2.imwrite(str(tmp_path / "grey.png"), np.full((120, 160), 128, np.uint8))
     with pytest.raises(ValueError, match="no 9x6 chessboard found in any of 1 photos"):
+        calibrate_chessboards(chessboard_images(tmp_path), (9, 6))
+
+
+def test_one_or_two_views_are_refused(tmp_path):
+    """A single front-on board leaves the focal length undetermined (it came out near 1e18 px): refused."""
+    board = np.full((9 * 40, 12 * 40), 255, np.uint8)
+    for r in range(7):
+        for c in range(10):
+            if (r + c) % 2 == 0:
+                board[40 + r * 40:80 + r * 40, 40 + c * 40:80 + c * 40] = 0
+    for k in range(2):
+        cv2.imwrite(str(tmp_path / f"b{k}.png"), board)
+    with pytest.raises(ValueError, match="found in only 2 photo"):
         calibrate_chessboards(chessboard_images(tmp_path), (9, 6))
 
 

@@ -62,6 +62,10 @@ class ClothoidLane(AbstractLane):
         self._tab_c = np.array([self.position(si, 0.0) for si in self._tab_s])
         self._mid = self._tab_c.mean(axis=0)
         self._reach = float(np.max(np.linalg.norm(self._tab_c - self._mid, axis=1)))
+        # the chord from start to end: unit direction and lane length per metre of chord, for far points
+        (ax, ay), (bx, by) = self._tab_c[0], self._tab_c[-1]
+        chord = max(math.hypot(bx - ax, by - ay), 1e-9)
+        self._chord = (float(ax), float(ay), (bx - ax) / chord, (by - ay) / chord, self.length / chord)
 
     def _theta_u(self, u):
         # theta(u) = theta0 + k0 u + (k1 - k0) u^2 / (2 L_ref)
@@ -121,11 +125,9 @@ class ClothoidLane(AbstractLane):
         dx, dy = px - self._mid[0], py - self._mid[1]
         if dx * dx + dy * dy > (self._reach + 60.0) ** 2:
             # far from this lane: project on the chord (only distance rankings use such points)
-            (ax, ay), (bx, by) = self._tab_c[0], self._tab_c[-1]
-            chord = max(math.hypot(bx - ax, by - ay), 1e-9)
-            tx, ty = (bx - ax) / chord, (by - ay) / chord
+            ax, ay, tx, ty, per_m = self._chord
             qx, qy = px - ax, py - ay
-            return (qx * tx + qy * ty) * self.length / chord, tx * qy - ty * qx
+            return (qx * tx + qy * ty) * per_m, tx * qy - ty * qx
         k = int(np.argmin((self._tab_c[:, 0] - px) ** 2 + (self._tab_c[:, 1] - py) ** 2))
         s = float(self._tab_s[k])
         for _ in range(2):

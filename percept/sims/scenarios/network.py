@@ -23,8 +23,12 @@ class IndexedRoadNetwork(RoadNetwork):
         super().__init__()
         self._index_size = -1
 
+    def add_lane(self, _from: str, _to: str, lane) -> None:
+        super().add_lane(_from, _to, lane)
+        self._index_size = -1
+
     def _build_index(self) -> None:
-        idx, centres, radii = [], [], []
+        idx, lanes_, centres, radii = [], [], [], []
         for _from, tos in self.graph.items():
             for _to, lanes in tos.items():
                 for _id, lane in enumerate(lanes):
@@ -32,19 +36,20 @@ class IndexedRoadNetwork(RoadNetwork):
                     pts = np.array([lane.position(si, 0.0) for si in s])
                     c = pts.mean(axis=0)
                     idx.append((_from, _to, _id))
+                    lanes_.append(lane)
                     centres.append(c)
                     # half a lane width and the 5 m sampling's chord gap on top of the farthest sample
                     radii.append(float(np.max(np.linalg.norm(pts - c, axis=1))) + lane.width_at(0.0) / 2 + 2.5)
-        self._idx, self._centres, self._radii = idx, np.array(centres), np.array(radii)
+        self._idx, self._lanes, self._centres, self._radii = idx, lanes_, np.array(centres), np.array(radii)
         self._index_size = len(idx)
 
     def get_closest_lane_index(self, position: np.ndarray, heading: float | None = None) -> LaneIndex:
-        if self._index_size != sum(len(lanes) for tos in self.graph.values() for lanes in tos.values()):
+        if self._index_size < 0:
             self._build_index()
         gap = np.linalg.norm(self._centres - np.asarray(position)[:2], axis=1) - self._radii
         near = np.flatnonzero(gap < NEAR_M)
         if len(near):
-            dist = [self.get_lane(self._idx[i]).distance_with_heading(position, heading) for i in near]
+            dist = [self._lanes[i].distance_with_heading(position, heading) for i in near]
             best = int(np.argmin(dist))
             # a lane outside the filter is at least NEAR_M away, so a nearer answer is exact
             if dist[best] < NEAR_M:

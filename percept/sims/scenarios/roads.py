@@ -137,7 +137,3 @@ def loop_road(lanes: int = 2, straight_m: float = 1000.0, radius_m: float = 260.
         b.transition(0.0, end_node=end)
     return b.net
 
-
-def loop_length_m(straight_m: float = 1000.0, radius_m: float = 260.0, speed_limit: float = 25.0) -> float:
-    """Length of the loop's reference lane: two straights and two half turns of pi R + L_spiral each."""
-    return 2 * straight_m + 2 * (np.pi * radius_m + SPIRAL_TIME_S * speed_limit)
