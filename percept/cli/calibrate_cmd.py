@@ -12,8 +12,9 @@ import typer
 
 
 def _cam_rows(name: str, cal) -> list[tuple[str, str]]:
-    return [(f"{name}fx, fy [px]", f"{cal.fx:.1f}, {cal.fy:.1f}"),
-            (f"{name}cx, cy [px]", f"{cal.cx:.1f}, {cal.cy:.1f}"),
+    cam = cal.camera
+    return [(f"{name}fx, fy [px]", f"{cam.fx:.1f}, {cam.fy:.1f}"),
+            (f"{name}cx, cy [px]", f"{cam.cx:.1f}, {cam.cy:.1f}"),
             (f"{name}dist (k1 k2 p1 p2 k3)", " ".join(f"{k:+.4f}" for k in cal.dist))]
 
 
@@ -42,7 +43,7 @@ def register(app: typer.Typer) -> None:
         from rich.markup import escape
         from rich.table import Table
 
-        from percept.cli.app import console, fail, progress_bar, write_json
+        from percept.cli.common import console, fail, progress_bar, write_json
         from percept.sensors.chessboard import calibrate_chessboards, chessboard_images, parse_pattern
         from percept.sensors.stereo_calibration import calibrate_stereo, stereo_pairs
 
@@ -82,7 +83,7 @@ def register(app: typer.Typer) -> None:
                     (f"baseline [{unit}]", f"{cal.baseline_m:.4f}"),
                     (f"T [{unit}]", " ".join(f"{v:+.4f}" for v in cal.T)),
                     ("left / right RMS [px]", f"{cal.left.rms_px:.3f} / {cal.right.rms_px:.3f}"),
-                    ("image size [px]", f"{cal.left.width}x{cal.left.height}"),
+                    ("image size [px]", f"{cal.left.camera.width}x{cal.left.camera.height}"),
                     *_cam_rows("left ", cal.left), *_cam_rows("right ", cal.right)]
         else:
             skipped = cal.images_found - cal.images_used
@@ -90,7 +91,7 @@ def register(app: typer.Typer) -> None:
                     ("photos with the board", f"{cal.images_found} of {cal.images_total}"),
                     ("photos used",
                      f"{cal.images_used}" + (f" ({skipped} of another size skipped)" if skipped else "")),
-                    ("image size [px]", f"{cal.width}x{cal.height}"), *_cam_rows("", cal)]
+                    ("image size [px]", f"{cal.camera.width}x{cal.camera.height}"), *_cam_rows("", cal)]
         for k, v in rows:
             t.add_row(escape(k), v)
         console.print(t)

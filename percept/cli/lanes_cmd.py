@@ -6,7 +6,6 @@ Registered on the main typer app by ``percept.cli.app``; parses options, calls `
 from __future__ import annotations
 
 import math
-import os
 import time
 from pathlib import Path
 from typing import Optional
@@ -34,16 +33,16 @@ def register(app: typer.Typer) -> None:
         max_frames: Optional[int] = typer.Option(None, "--max-frames", help="Process at most this many video frames."),
     ):
         """Fit the ego lane on recorded footage; pitch and horizon come from the lane lines' vanishing point."""
-        from percept.cli.app import fail
-        from percept.sensors import CameraCalibration
-        from percept.lanes.realworld import FootageLanes, RealLaneConfig, list_inputs
+        from percept.cli.common import fail
+        from percept.lanes.realworld import FootageLanes, RealLaneConfig
+        from percept.sensors import CameraCalibration, FootageKind, list_footage
 
         if max_frames is not None and max_frames < 1:
             fail(f"--max-frames must be at least 1, got {max_frames}")
         try:
             cfg = RealLaneConfig(hfov_rad=math.radians(hfov), mount_height_m=mount_height, speed_mps=speed)
             cal = CameraCalibration.load(calib) if calib is not None else None
-            kind, files = list_inputs(source)
+            kind, files = list_footage(source)
         except ValueError as e:
             fail(str(e))
         if out is not None:
@@ -52,10 +51,10 @@ def register(app: typer.Typer) -> None:
             except OSError as e:
                 fail(f"cannot create {out}: {e.strerror or e}")
         runner = FootageLanes(cfg, cal)
-        header = {"source": str(source), "kind": kind, "calibration": None if calib is None else str(calib),
+        header = {"source": str(source), "kind": kind.value, "calibration": None if calib is None else str(calib),
                   "mount_height_m": mount_height, "hfov_deg": None if cal is not None else hfov,
                   "assumed_speed_mps": speed}
-        if kind == "video":
+        if kind is FootageKind.VIDEO:
             _run_video(runner, files[0], out, json_path, max_frames, header)
         else:
             _run_images(runner, files, out, json_path, header, single=source.is_file())
@@ -73,7 +72,7 @@ def _summary(records: list[dict], ms: list[float]) -> dict:
 
 
 def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
-    from percept.cli.app import console
+    from percept.cli.common import console
 
     console.print(f"{title}: lane found in {summary['lane_found']} of {summary['count']}, both boundaries in "
                   f"{summary['both_boundaries']}" + (f", {summary['errors']} unreadable" if summary["errors"] else "")
@@ -87,9 +86,9 @@ def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optio
                 single: bool) -> None:
     import cv2
 
-    from percept.cli.app import err, fail, progress_bar, write_json
+    from percept.cli.common import err, fail, progress_bar, write_json
     from percept.lanes.overlay import draw_overlay
-    from percept.lanes.realworld import read_image
+    from percept.sensors import read_image
 
     records, ms, problem = [], [], None
     with progress_bar() as bar:
@@ -125,22 +124,21 @@ def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optio
 
 
 def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict) -> None:
-    from percept.cli.app import fail, progress_bar, write_json
+    from percept.cli.common import err, fail, progress_bar, write_json
     from percept.lanes.overlay import draw_overlay
-    from percept.lanes.realworld import open_video
+    from percept.sensors import open_video
 
-    # FFmpeg's own log lines (e.g. "moov atom not found") would repeat our one-line error
-    os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
     try:
-        frames, fps, total, size = open_video(path, max_frames)
+        video = open_video(path, max_frames)
     except ValueError as e:
         fail(str(e))
-    writer, target = _open_writer(out, path.stem, fps, size) if out is not None else (None, None)
+    fps = video.fps
+    writer, target = _open_writer(out, path.stem, fps, video.size) if out is not None else (None, None)
     records, ms, problem = [], [], None
     try:
         with progress_bar() as bar:
-            task = bar.add_task(f"lanes on {path.name}", total=total)
-            stream = runner.video(frames, fps)
+            task = bar.add_task(f"lanes on {path.name}", total=video.expected_frames)
+            stream = runner.video(video, fps)
             i = 0
             while True:
                 t0 = time.perf_counter()
@@ -159,16 +157,21 @@ def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path
                 i += 1
                 bar.advance(task)
     finally:
+        video.close()
         if writer is not None:
             writer.release()
+    if video.ended_early:
+        err.print(f"[yellow]warning:[/] {path} ended after {video.frames_read} of the {video.declared_frames} frames "
+                  "its header declares (truncated or damaged?)", highlight=False)
     summary = _summary(records, ms)
-    write_json(json_path, {**header, "fps": fps, "frames": len(records),
+    write_json(json_path, {**header, "fps": fps, "frames": len(records), "frames_declared": video.declared_frames,
+                           "ended_early": video.ended_early,
                            "overlay": None if target is None else str(target), "results": records, "summary": summary})
     if problem is not None:
         fail(problem)
     _print_summary(f"{len(records)} frame(s) of {path.name}", summary, None)
     if target is not None:
-        from percept.cli.app import console
+        from percept.cli.common import console
         console.print(f"overlay video: {target}")
 
 
@@ -176,7 +179,7 @@ def _open_writer(out: Path, stem: str, fps: float, size: tuple[int, int]):
     """An mp4v .mp4 writer, or MJPG .avi when this OpenCV build cannot write mp4."""
     import cv2
 
-    from percept.cli.app import fail
+    from percept.cli.common import fail
 
     for fourcc, ext in (("mp4v", ".mp4"), ("MJPG", ".avi")):
         target = out / f"{stem}.lanes{ext}"

@@ -1,6 +1,11 @@
-"""Controllers shared by the task modules: a small base class and the vehicle model they invert."""
+"""Control laws, one per file, shared by the vision and privileged slots: each reads records only and returns
+``(command, debug)``."""
 
 from .base import Controller, sideslip_for_curvature, steering_for_curvature
-from .lane_keeping import LaneKeeping
+from .emergency_braking import EmergencyBraking, EmergencyBrakingDebug
+from .following import Following, FollowingDebug
+from .lane_keeping import LaneKeeping, LaneKeepingDebug
+from .target import Target, nearest_target
 
-__all__ = ["Controller", "LaneKeeping", "sideslip_for_curvature", "steering_for_curvature"]
+__all__ = ["Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Following", "FollowingDebug", "LaneKeeping",
+           "LaneKeepingDebug", "Target", "nearest_target", "sideslip_for_curvature", "steering_for_curvature"]

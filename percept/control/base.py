@@ -1,22 +1,35 @@
-"""The controller base class and the kinematic-bicycle inversion used by lateral controllers."""
+"""The control-law base class and the kinematic-bicycle inversion used by lateral laws."""
 
 from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
 
-WHEELBASE_M = 5.0
-"""highway-env's Vehicle integrates heading with the body length as its wheelbase."""
+from percept.sensors.vehicle import WHEELBASE_M
 
 
 class Controller(ABC):
-    """A stateful controller: ``update`` gives the next command, ``reset`` forgets the past."""
+    """A stateful control law: ``update`` gives ``(command, debug)``, ``reset`` forgets the past.
+
+    The debug record says which term limited the command (openpilot's controls are the model).
+    """
 
     @abstractmethod
-    def update(self, *args, **kwargs) -> float: ...
+    def update(self, *args, **kwargs) -> tuple[float, object]: ...
 
     def reset(self) -> None:
-        """Stateless controllers have nothing to forget."""
+        """Stateless laws have nothing to forget."""
+
+
+def limiting(terms: dict[str, float | None]) -> tuple[float, str]:
+    """The smallest of the named terms (None = not active) and its name; the first wins a tie."""
+    name, value = None, math.inf
+    for k, v in terms.items():
+        if v is not None and v < value:
+            name, value = k, v
+    if name is None:
+        raise ValueError("no active term")
+    return value, name
 
 
 def sideslip_for_curvature(curvature_1pm: float, wheelbase_m: float = WHEELBASE_M) -> float:

@@ -1,4 +1,4 @@
-"""Lane keeping: steering from lateral offset, heading and curvature (shared by privileged and vision slots).
+"""Lane keeping: steering from the ego path's offset, heading and curvature (shared by privileged and vision slots).
 
 Lateral error dynamics of a path-following car: y' = v sin(theta), theta' = v (kappa_cmd - kappa_lane).
 Choosing kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2 gives y'' + 2 w y' + w^2 y = 0:
@@ -8,8 +8,24 @@ critically damped with time constant T = 1/w (Rajamani, *Vehicle Dynamics and Co
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+
+from percept.sensors import EgoPath
+from percept.sensors.vehicle import STEER_RANGE_RAD
 
 from .base import Controller, sideslip_for_curvature, steering_for_curvature
+
+
+@dataclass(frozen=True)
+class LaneKeepingDebug:
+    """The curvature terms [1/m] of the command: feed-forward (the lane's), offset and heading feedback; the
+    uncommanded steering [rad]; limited_by: "path" (no lane: hold straight), "steer_limit" or "none"."""
+
+    feedforward_1pm: float
+    offset_1pm: float
+    heading_1pm: float
+    steering_rad: float
+    limited_by: str
 
 
 class LaneKeeping(Controller):
@@ -21,11 +37,19 @@ class LaneKeeping(Controller):
         self.T = time_constant_s
         self.v_min = min_speed_mps
 
-    def update(self, offset_m: float, heading_rad: float, curvature_1pm: float, speed_mps: float) -> float:
-        """Front-wheel angle [rad], ISO 8855 (positive turns left)."""
-        v = max(speed_mps, self.v_min)
+    def update(self, path: EgoPath) -> tuple[float, LaneKeepingDebug]:
+        """Front-wheel angle [rad], ISO 8855 (positive turns left), and how it was made."""
+        if path.lane is None:
+            return 0.0, LaneKeepingDebug(0.0, 0.0, 0.0, 0.0, "path")
+        lane = path.lane
+        v = max(path.speed_mps, self.v_min)
         w = 1.0 / self.T
         # path heading relative to the lane: body heading plus the sideslip of the steady turn
-        theta = heading_rad + sideslip_for_curvature(curvature_1pm)
-        kappa = curvature_1pm - 2 * w * math.sin(theta) / v - w * w * offset_m / (v * v)
-        return steering_for_curvature(kappa)
+        theta = lane.heading_rad + sideslip_for_curvature(lane.curvature_1pm)
+        k_heading = 2 * w * math.sin(theta) / v
+        k_offset = w * w * lane.offset_m / (v * v)
+        # kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2
+        kappa = lane.curvature_1pm - k_heading - k_offset
+        steer = steering_for_curvature(kappa)
+        limited = "steer_limit" if not STEER_RANGE_RAD[0] <= steer <= STEER_RANGE_RAD[1] else "none"
+        return steer, LaneKeepingDebug(lane.curvature_1pm, -k_offset, -k_heading, steer, limited)

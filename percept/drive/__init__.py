@@ -1,12 +1,14 @@
-"""Composition: the agent, the closed loop, scoring, batch evaluation and benchmarks."""
+"""Composition: the slot table, the agent, the closed loop, scoring, batch evaluation and benchmarks."""
 
-from .bench import StageCost, bench_lanes, bench_render, median_ms
+from .agent import Agent, AgentStep
 from .batch import Engine, EvalPlan, Job, evaluate, parse_seeds, summarize
-from .loop import SLOTS, DriveConfig, Mode, run_drive
-from .privileged import PrivilegedLateral, PrivilegedLongitudinal, in_path_obstacle
-from .scoring import RunScorer
+from .bench import StageCost, bench_render, bench_task, median_ms
+from .config import DriveConfig
+from .loop import run_drive
+from .privileged import TruthFeed, in_path_obstacle
+from .scoring import StepTruth
+from .tasks import TASKS, Headline, SlotContext, Source, Task, task_order
 
-__all__ = ["SLOTS", "DriveConfig", "Engine", "EvalPlan", "Job", "Mode", "PrivilegedLateral", "PrivilegedLongitudinal",
-           "RunScorer", "StageCost",
-           "bench_lanes", "bench_render", "evaluate", "in_path_obstacle", "median_ms", "parse_seeds", "run_drive",
-           "summarize"]
+__all__ = ["TASKS", "Agent", "AgentStep", "DriveConfig", "Engine", "EvalPlan", "Headline", "Job", "SlotContext",
+           "Source", "StageCost", "StepTruth", "Task", "TruthFeed", "bench_render", "bench_task", "evaluate",
+           "in_path_obstacle", "median_ms", "parse_seeds", "run_drive", "summarize", "task_order"]

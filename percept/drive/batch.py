@@ -23,7 +23,9 @@ import numpy as np
 
 from percept.sims import WorldConfig
 
-from .loop import SLOTS, DriveConfig, Mode, run_drive
+from .config import DriveConfig
+from .loop import run_drive
+from .tasks import TASKS, Source
 
 COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
 GROUPS = ("lane", "longitudinal", "pedestrians", "odometry", "timing_ms")
@@ -64,7 +66,7 @@ class Job:
 
 @dataclass(frozen=True)
 class EvalPlan:
-    """scenarios, conditions: names; seeds: the seeds of every (scenario, condition); slots: Mode per SLOTS entry
+    """scenarios, conditions: names; seeds: the seeds of every (scenario, condition); slots: Source per task name
     (missing ones privileged); duration_s: None = each scenario's own. Validated here: a bad name, condition or
     slot raises ValueError before any run starts."""
 
@@ -84,7 +86,7 @@ class EvalPlan:
 
     def config(self, job: Job) -> DriveConfig:
         return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
-                           **{slot: self.slots.get(slot, Mode.PRIVILEGED) for slot in SLOTS})
+                           dict(self.slots))
 
     @property
     def jobs(self) -> list[Job]:
@@ -195,5 +197,5 @@ def summarize(plan: EvalPlan, results: list[dict]) -> dict:
             # pedestrian stops: how many crossings the car stopped for, of all crossings in these runs
             g["pedestrian_stops"] = {"stopped": int(sum(stops)), "crossings": len(stops)} if stops else None
             groups.append(g)
-    return {"slots": {s: Mode(plan.slots.get(s, Mode.PRIVILEGED)).value for s in SLOTS},
+    return {"slots": {t.name: Source(plan.slots.get(t.name, Source.PRIVILEGED)).value for t in TASKS},
             "seeds": list(plan.seeds), "duration_s": plan.duration_s, "groups": groups}

@@ -1,4 +1,5 @@
-"""Per-stage cost against named peers, measured in the same run on one thread.
+"""Per-stage cost against named peers, measured in the same run on one thread. Stages are named by the run JSON's
+``timing_ms`` keys: ``render`` and each task's timing key (its vision slot, from the slot table).
 
 Peers: highway-env's own top-down ``render()`` of a 640x480 frame for the stereo renderer.
 """
@@ -13,13 +14,18 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from .privileged import TruthFeed
+from .tasks import SlotContext, Task
+
 
 @dataclass(frozen=True)
 class StageCost:
-    """stage: what was timed; ms: median milliseconds per call; peer: the peer's name and peer_ms its cost in the
-    same run (None where no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any."""
+    """stage: the ``timing_ms`` key; what: what was timed; ms: median milliseconds per call; peer: the peer's name
+    and peer_ms its cost in the same run (None where no peer does the same job); ratio = ms / peer_ms; target_ms:
+    the stage's budget, if any."""
 
     stage: str
+    what: str
     ms: float
     peer: str | None = None
     peer_ms: float | None = None
@@ -31,7 +37,7 @@ class StageCost:
 
     def to_dict(self) -> dict:
         r = self.ratio
-        return {"stage": self.stage, "ms": round(self.ms, 3), "peer": self.peer,
+        return {"stage": self.stage, "what": self.what, "ms": round(self.ms, 3), "peer": self.peer,
                 "peer_ms": None if self.peer_ms is None else round(self.peer_ms, 3),
                 "ratio": None if r is None else round(r, 3), "target_ms": self.target_ms}
 
@@ -48,6 +54,19 @@ def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2) -> float:
     return float(np.median(times))
 
 
+def _cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], object]:
+    """A function that returns the next item each call (round robin), ticking ``progress``."""
+    state = {"i": 0}
+
+    def nxt():
+        item = items[state["i"] % len(items)]
+        state["i"] += 1
+        if progress:
+            progress()
+        return item
+    return nxt
+
+
 def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] | None = None) -> StageCost:
     """One stereo pair of the ``highway`` scenario vs highway-env's top-down render of the same world."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -62,44 +81,43 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
     for _ in range(frames):
         world.step()
         scenes.append(scene_from_road(world.env.road, world.ego, world.ids))
-    it = iter(range(10**9))
-
-    def ours():
-        world.renderer.render(scenes[next(it) % len(scenes)])
-        if progress:
-            progress()
+    scene = _cycle(scenes, progress)
+    size = (world.cfg.rig.camera.height, world.cfg.rig.camera.width)
 
     def peer():
         img = world.env.render()
-        assert img is not None and img.shape[:2] == (world.cfg.rig.camera.height, world.cfg.rig.camera.width)
+        assert img is not None and img.shape[:2] == size
         if progress:
             progress()
 
-    ms = median_ms(ours, frames)
+    ms = median_ms(lambda: world.renderer.render(scene()), frames)
     peer_ms = median_ms(peer, frames)
     world.env.close()
-    return StageCost("render stereo pair 640x480", ms, "highway-env top-down render()", peer_ms, None)
+    return StageCost("render", "stereo pair 640x480 (highway)", ms, "highway-env top-down render()", peer_ms)
 
 
-def bench_lanes(frames: int = 30, seed: int = 0, progress: Callable[[], None] | None = None) -> StageCost:
-    """The lanes stage (evidence, fit, tracking) on rendered ``curves`` frames, 640x480, one thread."""
-    from percept.lanes import LaneDetector
+def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int = 0,
+               progress: Callable[[], None] | None = None) -> StageCost:
+    """A task's vision slot on rendered frames of its bench scenario (640x480, one thread); the slots upstream of
+    it are privileged (computed beforehand, not timed)."""
     from percept.sims import SimWorld, WorldConfig
 
+    if task.vision is None:
+        raise ValueError(f"the {task.name} task has no vision slot to time")
     cv2.setNumThreads(1)
-    world = SimWorld(WorldConfig("curves", seed=seed, autopilot=True))
+    world = SimWorld(WorldConfig(task.bench_scenario, seed=seed, autopilot=True))
+    feed = TruthFeed()
+    lm = world.landmark_map()
+    ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed)
+    by_name = {t.name: t for t in tasks}
+    upstream = {u: by_name[u].privileged(ctx) for u in task.upstream}
     shots = []
     for _ in range(frames):
-        frame, _ = world.observe()
-        shots.append(frame)
+        frame, feed.truth = world.observe()
+        shots.append((frame, {u: s.step(frame, {})[0] for u, s in upstream.items()}))
         world.step()
-    det = LaneDetector(world.cfg.rig)
-    it = iter(range(10**9))
-
-    def ours():
-        f = shots[next(it) % len(shots)]
-        det.process(f.left, f.wheel_speed_mps, f.imu.yaw_rate_rps, world.dt)
-        if progress:
-            progress()
-
-    return StageCost("lanes (640x480 frame)", median_ms(ours, frames), target_ms=3.0)
+    slot = task.vision(ctx)
+    shot = _cycle(shots, progress)
+    ms = median_ms(lambda: slot.step(*shot()), frames)
+    return StageCost(task.timing_key, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms,
+                     target_ms=task.budget_ms)

@@ -1,4 +1,9 @@
-"""Run metrics against ground truth (DESIGN.md, "Scoring definitions"). A metric that does not apply is None."""
+"""Run metrics against ground truth (DESIGN.md, "Scoring definitions"), one scorer per task returning its JSON
+group, plus the run-level safety counts. A metric that does not apply is None. The formulas live in each task's
+``metrics`` module (pure numpy), shared with the footage commands.
+
+A scorer has ``update(estimate, debug, step)`` once per frame and ``result() -> dict``.
+"""
 
 from __future__ import annotations
 
@@ -6,68 +11,196 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .privileged import EGO_HALF_WIDTH_M, Obstacle
+from percept.lanes.metrics import centering, rmse_columns
+from percept.longitudinal.metrics import range_abs_rel_err, range_abs_rel_err_by_bin, ttc_abs_err_s
+from percept.odometry.metrics import ate_rmse_m, kitti_drift
+from percept.sensors import ObjectKind
+from percept.sensors.vehicle import EGO_WIDTH_M
+
+from .privileged import Obstacle, path_objects
 
 STOP_SPEED_MPS = 0.5
+PHANTOM_DECEL_MPS2 = -3.0
+"""A commanded deceleration below this with nothing in the path to justify it is a phantom brake [m/s²]."""
+
+
+@dataclass(frozen=True)
+class ScoreContext:
+    """vision: the task's slot is a vision one (its estimates are scored); crossing_pedestrians: how many the
+    scenario has; time_gap_setting_s: the following law's setting; dt_s: frame period [s]."""
+
+    vision: bool
+    crossing_pedestrians: int
+    time_gap_setting_s: float
+    dt_s: float
+
+
+@dataclass(frozen=True)
+class StepTruth:
+    """One frame for the scorers: truth (GroundTruth), in_path (the true obstacle the ego must respect, or None),
+    the commands sent (accel_mps2, steering_rad)."""
+
+    truth: object
+    in_path: Obstacle | None
+    accel_mps2: float
+    steering_rad: float
 
 
 @dataclass
-class RunScorer:
-    """Accumulates per-frame truth and commands; ``result()`` gives the JSON-ready metrics."""
+class SafetyScorer:
+    """Run-level counts: collisions (0/1), pedestrians hit, lane departures (a body edge crossing a lane boundary;
+    no lane change is ever commanded)."""
 
-    offsets_m: list = field(default_factory=list)
-    gaps_s: list = field(default_factory=list)
     departures: int = 0
-    _outside: bool = False
     crashed: bool = False
     ped_hits: set = field(default_factory=set)
-    crossing_seen: dict = field(default_factory=dict)
-    crossing_stopped: dict = field(default_factory=dict)
-    false_stops: int = 0
-    _stopped: bool = False
+    _outside: bool = False
 
-    def update(self, gt, obstacle: Obstacle | None, hit_pedestrians: list[int]) -> None:
-        lane = gt.lane
-        self.offsets_m.append(lane.offset_m)
-        # a departure: a body edge crosses a lane boundary (no lane changes are commanded)
-        outside = abs(lane.offset_m) + EGO_HALF_WIDTH_M > lane.width_m / 2
+    def update(self, step: StepTruth) -> None:
+        gt = step.truth
+        outside = abs(gt.lane.offset_m) + EGO_WIDTH_M / 2 > gt.lane.width_m / 2
         if outside and not self._outside:
             self.departures += 1
         self._outside = outside
-        self.crashed |= gt.crashed and not hit_pedestrians
-        self.ped_hits.update(hit_pedestrians)
+        self.crashed |= gt.crashed and not gt.pedestrians_hit
+        self.ped_hits.update(gt.pedestrians_hit)
+
+    def result(self) -> dict:
+        return {"collisions": int(self.crashed), "pedestrian_collisions": len(self.ped_hits),
+                "lane_departures": self.departures}
+
+
+class LaneScorer:
+    """Lane estimate errors (vision) and centering (always: the true offset from the lane centre)."""
+
+    def __init__(self, ctx: ScoreContext):
+        self.ctx = ctx
+        self.offsets_m: list[float] = []
+        self.errors: list[list[float]] = []
+
+    def update(self, path, debug, step: StepTruth) -> None:
+        lane = step.truth.lane
+        self.offsets_m.append(lane.offset_m)
+        est = path.lane if path is not None else None
+        if self.ctx.vision and est is not None and est.valid:
+            self.errors.append([est.offset_m - lane.offset_m, est.heading_rad - lane.heading_rad,
+                                est.curvature_1pm - lane.curvature_1pm])
+
+    def result(self) -> dict:
+        return {**rmse_columns(self.errors), **centering(self.offsets_m)}
+
+
+class LongitudinalScorer:
+    """Range / TTC errors of the lead (vision), time gaps behind a vehicle, phantom brakes."""
+
+    def __init__(self, ctx: ScoreContext):
+        self.ctx = ctx
+        self.gaps_s: list[float] = []
+        self.pairs: list[tuple[float, float, float, float]] = []  # est range, true range, est ttc, true ttc
+        self.phantom_brakes = 0
+        self._braking_for_nothing = False
+
+    def update(self, lead, debug, step: StepTruth) -> None:
+        gt, obstacle = step.truth, step.in_path
         # time gap to an in-path vehicle lead within 100 m, while moving
-        if obstacle is not None and obstacle.kind == "vehicle" and obstacle.gap_m < 100 and gt.speed_mps > 5:
+        if obstacle is not None and obstacle.kind is ObjectKind.VEHICLE and obstacle.gap_m < 100 and gt.speed_mps > 5:
             self.gaps_s.append(obstacle.gap_m / gt.speed_mps)
-        # pedestrians: a crossing person counts as stopped for if the ego halts while it is within 40 m ahead
+        # phantom brake: a hard deceleration with nothing in the path within the stopping distance at 3 m/s^2 + 10 m
+        reach = gt.speed_mps ** 2 / (2 * -PHANTOM_DECEL_MPS2) + 10.0
+        justified = obstacle is not None and obstacle.gap_m <= reach
+        phantom = step.accel_mps2 < PHANTOM_DECEL_MPS2 and not justified
+        if phantom and not self._braking_for_nothing:
+            self.phantom_brakes += 1
+        self._braking_for_nothing = phantom
+        if self.ctx.vision and lead is not None:
+            truth = [p for p in path_objects(gt) if p.now]
+            if truth:
+                t = min(truth, key=lambda p: p.gap_m)
+                closing = gt.speed_mps - t.vx_mps
+                true_ttc = t.obj.distance_m / closing if closing > 0 else np.nan
+                est_ttc = lead.ttc_s if lead.ttc_s is not None else np.nan
+                self.pairs.append((lead.range_m, t.obj.distance_m, est_ttc, true_ttc))
+
+    def result(self) -> dict:
+        g = self.gaps_s
+        p = np.asarray(self.pairs, dtype=float).reshape(-1, 4)
+        scored = self.ctx.vision
+        return {
+            "range_abs_rel_err": range_abs_rel_err(p[:, 0], p[:, 1]) if scored else None,
+            "range_abs_rel_err_by_bin": range_abs_rel_err_by_bin(p[:, 0], p[:, 1]) if scored else None,
+            "ttc_abs_err_s": ttc_abs_err_s(p[:, 2], p[:, 3]) if scored else None,
+            "time_gap_mean_s": float(np.mean(g)) if g else None,
+            "time_gap_min_s": float(np.min(g)) if g else None,
+            # steady state: the last quarter of the frames that had a lead
+            "time_gap_steady_s": float(np.mean(g[-max(len(g) // 4, 1):])) if g else None,
+            "time_gap_setting_s": self.ctx.time_gap_setting_s,
+            "phantom_brakes": self.phantom_brakes,
+        }
+
+
+class PedestrianScorer:
+    """Stops for crossing pedestrians and false stops (detection scores join with the vision slot)."""
+
+    def __init__(self, ctx: ScoreContext):
+        self.ctx = ctx
+        self.crossing_seen: dict = {}
+        self.crossing_stopped: dict = {}
+        self.false_stops = 0
+        self._stopped = False
+
+    def update(self, request, debug, step: StepTruth) -> None:
+        gt, obstacle = step.truth, step.in_path
+        # a crossing person counts as stopped for if the ego halts while it is within 40 m ahead
         stopped = gt.speed_mps < STOP_SPEED_MPS
         near_crossing = False
         for o in gt.objects:
-            if o.kind == "pedestrian" and o.crossing and 0 < o.position_m[0] < 40:
+            if o.kind is ObjectKind.PEDESTRIAN and o.crossing and 0 < o.position_m[0] < 40:
                 self.crossing_seen.setdefault(o.obj_id, True)
                 near_crossing = True
                 if stopped:
                     self.crossing_stopped[o.obj_id] = True
         # a stop with no crossing pedestrian near is a false stop (e.g. for a roadside one), unless a vehicle halts us
-        if stopped and not self._stopped and not near_crossing and not (obstacle and obstacle.kind == "vehicle"):
+        if stopped and not self._stopped and not near_crossing and not (
+                obstacle and obstacle.kind is ObjectKind.VEHICLE):
             self.false_stops += 1
         self._stopped = stopped
 
-    def result(self, has_crossing: bool) -> dict:
-        off = np.abs(np.asarray(self.offsets_m))
+    def result(self) -> dict:
         stops = [bool(self.crossing_stopped.get(k, False)) for k in sorted(self.crossing_seen)]
-        return {
-            "collisions": int(self.crashed),
-            "pedestrian_collisions": len(self.ped_hits),
-            "lane_departures": self.departures,
-            "centering_rms_m": float(np.sqrt(np.mean(off ** 2))) if len(off) else None,
-            "centering_max_m": float(off.max()) if len(off) else None,
-            "time_gap_mean_s": float(np.mean(self.gaps_s)) if self.gaps_s else None,
-            "time_gap_min_s": float(np.min(self.gaps_s)) if self.gaps_s else None,
-            # steady state: the last quarter of the frames that had a lead
-            "time_gap_steady_s": float(np.mean(self.gaps_s[-max(len(self.gaps_s) // 4, 1):])) if self.gaps_s else None,
-            "stops": stops if has_crossing else None,
-            "false_stops": self.false_stops,
-        }
+        return {"recall": None, "precision": None, "fppi": None, "first_detection_range_m": None,
+                "stops": stops if self.ctx.crossing_pedestrians else None, "false_stops": self.false_stops}
 
 
+class OdometryScorer:
+    """Drift (KITTI's protocol scaled to the run) and ATE of the fused pose (vision); VO-only and landmark fixes
+    when the slot's debug carries ``vo_pose`` / ``landmark_fix``."""
+
+    def __init__(self, ctx: ScoreContext):
+        self.ctx = ctx
+        self.true: list[list[float]] = []
+        self.fused: list[list[float]] = []
+        self.vo: list[list[float]] = []
+        self.fixes = 0
+
+    def update(self, pose, debug, step: StepTruth) -> None:
+        if not self.ctx.vision or pose is None:
+            return
+        e = step.truth.ego
+        self.true.append([e.x_m, e.y_m, e.yaw_rad])
+        self.fused.append([pose.pose.x_m, pose.pose.y_m, pose.pose.yaw_rad])
+        vo = getattr(debug, "vo_pose", None)
+        if vo is not None:
+            self.vo.append([vo.x_m, vo.y_m, vo.yaw_rad])
+        self.fixes += int(bool(getattr(debug, "landmark_fix", False)))
+
+    def result(self) -> dict:
+        if not self.fused:
+            return {"drift_pct_vo": None, "drift_pct_fused": None, "ate_rmse_vo_m": None, "ate_rmse_fused_m": None,
+                    "landmark_fixes": None}
+        true = np.asarray(self.true)
+        vo_ok = len(self.vo) == len(self.true)
+        return {"drift_pct_vo": kitti_drift(np.asarray(self.vo), true)["drift_pct"] if vo_ok else None,
+                "drift_pct_fused": kitti_drift(np.asarray(self.fused), true)["drift_pct"],
+                "ate_rmse_vo_m": ate_rmse_m(np.asarray(self.vo), true) if vo_ok else None,
+                "ate_rmse_fused_m": ate_rmse_m(np.asarray(self.fused), true),
+                "landmark_fixes": self.fixes}

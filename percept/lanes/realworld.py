@@ -12,23 +12,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
-import cv2
 import numpy as np
 
-from percept.sensors import PinholeCamera, StereoRig
-
-from percept.sensors import CameraCalibration
-from percept.sensors.chessboard import IMAGE_SUFFIXES
+from percept.sensors import CameraCalibration, PinholeCamera, StereoRig
 
 from .horizon import VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
 from .detector import LaneConfig, LaneDebug, LaneDetector
 from .evidence import Brightness, EvidenceConfig
 from .fit import FitConfig
 from .types import LaneEstimate
-
-VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".mpg", ".mpeg", ".webm")
 
 
 def _real_lane_config() -> LaneConfig:
@@ -155,25 +148,17 @@ class FootageLanes:
 
     def __init__(self, cfg: RealLaneConfig = RealLaneConfig(), calibration: CameraCalibration | None = None):
         self.cfg, self.calibration = cfg, calibration
-        self._maps: tuple[np.ndarray, np.ndarray] | None = None
+        self._undistort = calibration.undistorter() if calibration is not None else None
 
     def prepare(self, image: np.ndarray) -> np.ndarray:
-        """Undistort with the calibration (maps cached; ValueError on a size mismatch), or pass through."""
+        """Undistort with the calibration (maps computed once; ValueError on a size mismatch), or pass through."""
         if image is None or image.ndim != 3 or image.shape[2] != 3:
             raise ValueError("expected a BGR colour image")
-        cal = self.calibration
-        if cal is None:
-            return image
-        h, w = image.shape[:2]
-        if (w, h) != (cal.width, cal.height):
-            raise ValueError(f"image is {w}x{h} but the calibration is for {cal.width}x{cal.height}")
-        if self._maps is None:
-            self._maps = cv2.initUndistortRectifyMap(cal.K, np.asarray(cal.dist), None, cal.K, (w, h), cv2.CV_16SC2)
-        return cv2.remap(image, *self._maps, cv2.INTER_LINEAR)
+        return image if self._undistort is None else self._undistort(image)
 
     def camera(self, width: int, height: int) -> PinholeCamera:
         if self.calibration is not None:
-            return self.calibration.camera()
+            return self.calibration.camera
         return PinholeCamera.from_hfov(width, height, self.cfg.hfov_rad)
 
     def rig_for(self, images: list[np.ndarray]) -> tuple[StereoRig, VanishingPoint | None]:
@@ -235,56 +220,3 @@ class FootageLanes:
             est, dbg = det.process(img, self.cfg.speed_mps, 0.0, dt)
             yield img, self._result(det, est, dbg, vp)
 
-
-def list_inputs(path: Path) -> tuple[str, list[Path]]:
-    """("video", [file]) or ("images", files) for an image, a video or a folder of images (sorted by name)."""
-    path = Path(path)
-    if path.is_dir():
-        files = sorted(p for p in path.iterdir() if p.is_file() and p.suffix.lower() in IMAGE_SUFFIXES)
-        if not files:
-            raise ValueError(f"{path} holds no images ({', '.join(IMAGE_SUFFIXES)})")
-        return "images", files
-    if not path.exists():
-        raise ValueError(f"{path} does not exist; give an image, a video or a folder of images")
-    if path.suffix.lower() in VIDEO_SUFFIXES:
-        return "video", [path]
-    if path.suffix.lower() in IMAGE_SUFFIXES:
-        return "images", [path]
-    raise ValueError(f"{path} is neither an image ({', '.join(IMAGE_SUFFIXES)}) "
-                     f"nor a video ({', '.join(VIDEO_SUFFIXES)})")
-
-
-def read_image(path: Path) -> np.ndarray:
-    """BGR image; ValueError when the file cannot be decoded."""
-    img = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    if img is None:
-        raise ValueError(f"cannot read {path} as an image")
-    return img
-
-
-def open_video(path: Path, max_frames: int | None = None):
-    """(frames iterator, fps [1/s], frame count or None, (width, height) [px]) of a video, at most ``max_frames``
-    frames; ValueError when it cannot be opened or its first frame cannot be decoded."""
-    cap = cv2.VideoCapture(str(path))
-    ok, first = cap.read() if cap.isOpened() else (False, None)
-    if not ok:
-        cap.release()
-        raise ValueError(f"cannot read {path} as a video")
-    fps = float(cap.get(cv2.CAP_PROP_FPS))
-    fps = fps if math.isfinite(fps) and 0 < fps < 1000 else 25.0
-    n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
-    limit = max_frames if max_frames is not None else (1 << 62)
-    total = min(n, limit) if n > 0 else None
-
-    def frames():
-        try:
-            img, i = first, 0
-            while img is not None and i < limit:
-                yield img
-                i += 1
-                ok, img = cap.read()
-                img = img if ok else None
-        finally:
-            cap.release()
-
-    return frames(), fps, total, (first.shape[1], first.shape[0])

@@ -2,9 +2,15 @@
 
 from .camera import PinholeCamera
 from .chessboard import CameraCalibration, calibrate_chessboards, chessboard_images, parse_pattern
+from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, VideoReader, list_footage,
+                      list_images, open_video, read_image)
 from .frame import Frame, ImuSample
+from .records import BrakingRequest, EgoPath, LandmarkMap, LaneEstimate, Lead, ObjectKind, PoseEstimate, Source
 from .poses import Pose2D, Transform, rot_z, wrap_angle
 from .rig import Side, StereoRig
 
-__all__ = ["CameraCalibration", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform",
+__all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "ObjectKind", "PoseEstimate", "Source",
+           "IMAGE_SUFFIXES", "VIDEO_SUFFIXES", "FootageKind", "Undistorter", "VideoReader", "list_footage",
+           "list_images", "open_video", "read_image",
+           "CameraCalibration", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform",
            "calibrate_chessboards", "chessboard_images", "parse_pattern", "rot_z", "wrap_angle"]

@@ -13,9 +13,11 @@ The calibration file (JSON) holds fx, fy, cx, cy [px], width, height [px], dist 
 from __future__ import annotations
 
 import json
+import math
+import os
 import re
 from collections import Counter
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -23,8 +25,8 @@ import cv2
 import numpy as np
 
 from .camera import PinholeCamera
+from .footage import Undistorter, list_images, read_image
 
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".webp")
 MIN_VIEWS = 3
 """Fewest board views (photos, or stereo pairs) a calibration accepts: fewer leave K undetermined."""
 MAX_CORNERS = 100
@@ -49,19 +51,14 @@ def parse_pattern(text: str) -> tuple[int, int]:
 class CameraCalibration:
     """Intrinsics and lens distortion of one camera.
 
-    fx, fy: focal lengths [px]; cx, cy: principal point [px]; width, height: image size [px];
-    dist: distortion coefficients in OpenCV's order (k1, k2, p1, p2, k3) [unitless];
-    rms_px: RMS reprojection error over the used photos [px]; images_used: photos of the calibrated size in
-    which the board was found; images_found: photos with the board (any size); images_total: photos read;
-    pattern: inner corners (cols, rows).
+    camera: the pinhole camera (fx, fy, cx, cy, width, height [px]) of the undistorted images, which keep the
+    same K; dist: distortion coefficients in OpenCV's order (k1, k2, p1, p2, k3) [unitless]; rms_px: RMS
+    reprojection error over the used photos [px]; images_used: photos of the calibrated size in which the board
+    was found; images_found: photos with the board (any size); images_total: photos read; pattern: inner
+    corners (cols, rows).
     """
 
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-    width: int
-    height: int
+    camera: PinholeCamera
     dist: tuple[float, ...]
     rms_px: float
     images_used: int = 0
@@ -70,39 +67,37 @@ class CameraCalibration:
     pattern: tuple[int, int] = (9, 6)
 
     def __post_init__(self) -> None:
-        self.camera()  # PinholeCamera validates focal lengths and size
+        if len(self.dist) not in (4, 5, 8, 12, 14) or not all(math.isfinite(k) for k in self.dist):
+            raise ValueError(f"distortion {list(self.dist)} is not 4, 5, 8, 12 or 14 finite coefficients")
 
     @property
     def K(self) -> np.ndarray:
-        return self.camera().K
+        return self.camera.K
 
-    def camera(self) -> PinholeCamera:
-        """The pinhole camera of the undistorted images (same K, no distortion)."""
-        return PinholeCamera(self.fx, self.fy, self.cx, self.cy, self.width, self.height)
+    def undistorter(self) -> Undistorter:
+        """Undistorts frames of the calibrated size (maps computed once): for a video or a folder of images."""
+        return Undistorter(self.camera, self.dist)
 
     def undistort(self, image: np.ndarray) -> np.ndarray:
-        """Remove lens distortion (cv2.undistort, same K); the image must have the calibrated size."""
-        h, w = image.shape[:2]
-        if (w, h) != (self.width, self.height):
-            raise ValueError(f"image is {w}x{h} but the calibration is for {self.width}x{self.height}; "
-                             "calibrate with photos of the same camera and resolution")
-        return cv2.undistort(image, self.K, np.asarray(self.dist, dtype=np.float64))
+        """Remove lens distortion from one image of the calibrated size (same K); ValueError for another size."""
+        return self.undistorter()(image)
 
     def to_dict(self) -> dict:
-        d = asdict(self)
-        d["dist"] = list(self.dist)
-        d["pattern"] = f"{self.pattern[0]}x{self.pattern[1]}"
-        return d
+        """The flat calibration file: fx, fy, cx, cy, width, height, dist, rms_px, counts, pattern 'COLSxROWS'."""
+        return {**self.camera.to_dict(), "dist": list(self.dist), "rms_px": self.rms_px,
+                "images_used": self.images_used, "images_found": self.images_found,
+                "images_total": self.images_total, "pattern": f"{self.pattern[0]}x{self.pattern[1]}"}
 
     @classmethod
     def from_dict(cls, d: dict) -> "CameraCalibration":
-        return cls(float(d["fx"]), float(d["fy"]), float(d["cx"]), float(d["cy"]), int(d["width"]),
-                   int(d["height"]), tuple(float(k) for k in d["dist"]), float(d.get("rms_px", float("nan"))),
+        camera = PinholeCamera(float(d["fx"]), float(d["fy"]), float(d["cx"]), float(d["cy"]), int(d["width"]),
+                               int(d["height"]))
+        return cls(camera, tuple(float(k) for k in d["dist"]), float(d.get("rms_px", float("nan"))),
                    int(d.get("images_used", 0)), int(d.get("images_found", 0)), int(d.get("images_total", 0)),
                    parse_pattern(d.get("pattern", "9x6")))
 
     def save(self, path: Path) -> None:
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2))
+        write_text_atomic(Path(path), json.dumps(self.to_dict(), indent=2))
 
     @classmethod
     def load(cls, path: Path) -> "CameraCalibration":
@@ -117,15 +112,29 @@ class CameraCalibration:
                              "make one with `percept calibrate DIR`") from None
 
 
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to a temporary file beside ``path``, then rename it: ``path`` is never left half-written."""
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
 def chessboard_images(folder: Path) -> list[Path]:
     """Image files directly in ``folder``, sorted by name; ValueError when there are none."""
-    folder = Path(folder)
-    if not folder.is_dir():
+    if not Path(folder).is_dir():
         raise ValueError(f"{folder} is not a folder of chessboard photos")
-    files = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file())
-    if not files:
-        raise ValueError(f"{folder} holds no images ({', '.join(IMAGE_SUFFIXES)})")
-    return files
+    return list_images(folder)
+
+
+def read_gray(path: Path) -> np.ndarray | None:
+    """The photo as a grey image, or None when it cannot be read (missing, not an image, truncated)."""
+    try:
+        return read_image(path, gray=True)
+    except ValueError:
+        return None
 
 
 def find_corners(gray: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | None:
@@ -153,8 +162,8 @@ def calibrate_points(corners: list[np.ndarray], size: tuple[int, int], pattern: 
     obj = board_points(pattern, square_m)
     # minimise sum_i sum_j || x_ij - pi(K, dist, R_i, t_i, X_j) ||^2 (Zhang 2000, eq. 10 with distortion)
     rms, K, dist, _, _ = cv2.calibrateCamera([obj] * len(corners), corners, size, None, None)
-    return CameraCalibration(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), int(size[0]),
-                             int(size[1]), tuple(float(k) for k in np.ravel(dist)), float(rms), len(corners),
+    camera = PinholeCamera(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), int(size[0]), int(size[1]))
+    return CameraCalibration(camera, tuple(float(k) for k in np.ravel(dist)), float(rms), len(corners),
                              found or len(corners), total or len(corners), pattern)
 
 
@@ -171,7 +180,7 @@ def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], squar
     found: list[tuple[tuple[int, int], np.ndarray]] = []
     readable = 0
     for p in paths:
-        img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
+        img = read_gray(p)
         corners = None
         if img is not None:
             readable += 1

@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 
 from .chessboard import (MIN_VIEWS, CameraCalibration, board_points, calibrate_points, chessboard_images,
-                         find_corners)
+                         find_corners, read_gray, write_text_atomic)
 
 
 def stereo_pairs(folder: Path) -> list[tuple[Path, Path]]:
@@ -66,7 +66,7 @@ class StereoCalibration:
                 "pairs_used": self.pairs_used, "pairs_total": self.pairs_total}
 
     def save(self, path: Path) -> None:
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2))
+        write_text_atomic(Path(path), json.dumps(self.to_dict(), indent=2))
 
 
 def _epipolar_error(pl: np.ndarray, pr: np.ndarray, left: CameraCalibration, right: CameraCalibration,
@@ -90,7 +90,7 @@ def calibrate_stereo(pairs: list[tuple[Path, Path]], pattern: tuple[int, int], s
     obj = board_points(pattern, square_m)
     found: list[tuple[tuple[int, int], np.ndarray, np.ndarray]] = []
     for lp, rp in pairs:
-        imgs = [cv2.imread(str(p), cv2.IMREAD_GRAYSCALE) for p in (lp, rp)]
+        imgs = [read_gray(p) for p in (lp, rp)]
         ok = all(im is not None for im in imgs) and imgs[0].shape == imgs[1].shape
         corners = [find_corners(im, pattern) for im in imgs] if ok else [None, None]
         ok = ok and all(c is not None for c in corners)

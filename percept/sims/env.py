@@ -13,11 +13,10 @@ from highway_env.envs.common.abstract import AbstractEnv
 from highway_env.envs.common.observation import ObservationType
 from highway_env.vehicle.behavior import IDMVehicle
 
+from percept.sensors.vehicle import ACCEL_RANGE_MPS2, STEER_RANGE_RAD
+
 from .actors import Pedestrian, ScriptedVehicle
 
-ACCEL_RANGE_MPS2 = (-8.0, 4.0)
-"""Braking down to -8 m/s² (highway-env's default continuous range stops at -5)."""
-STEER_RANGE_RAD = (-0.5, 0.5)
 
 
 class NoObservation(ObservationType):

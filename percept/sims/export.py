@@ -53,8 +53,8 @@ def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], N
     out = prepare_out_dir(out)
     world.cfg.rig.save(out / "camera.json")
     landmarks = world.landmark_map()
-    if landmarks:
-        (out / "landmarks.json").write_text(json.dumps({str(k): v for k, v in sorted(landmarks.items())}, indent=1))
+    if len(landmarks):
+        (out / "landmarks.json").write_text(json.dumps(landmarks.to_dict(), indent=1))
     for i in range(frames):
         frame, gt = world.observe()
         write_frame(out, i, frame, gt)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from percept.sensors import ImuSample, Pose2D, Side, StereoRig, wrap_angle
+from percept.sensors import ImuSample, ObjectKind, Pose2D, Side, StereoRig, wrap_angle
 
 from .coords import hw_to_world_yaw
 from .render.scene import ObjectState
@@ -26,13 +26,13 @@ class LaneTruth:
 
 @dataclass(frozen=True)
 class ObjectTruth:
-    """kind: vehicle | pedestrian | landmark; box_px: (u0, v0, u1, v1) in the left image or None when not seen;
+    """kind: what it is; box_px: (u0, v0, u1, v1) in the left image or None when not seen;
     visible: 0..1 unoccluded share of its silhouette; distance_m: left-camera depth of the nearest point of its
     3D box; position_m: (3,) box centre in the vehicle frame; size_m: (length, width, height); yaw_rad: heading
     relative to the ego; speed_mps; crossing: pedestrians that cross the road; marker_id: landmark sign id."""
 
     obj_id: int
-    kind: str
+    kind: ObjectKind
     box_px: tuple | None
     visible: float
     distance_m: float
@@ -44,11 +44,11 @@ class ObjectTruth:
     marker_id: int | None = None
 
     def to_dict(self) -> dict:
-        d = {"kind": self.kind, "id": self.obj_id, "box_px": list(self.box_px) if self.box_px else None,
+        d = {"kind": self.kind.value, "id": self.obj_id, "box_px": list(self.box_px) if self.box_px else None,
              "visible": round(self.visible, 4), "distance_m": round(self.distance_m, 4),
              "position_m": [round(v, 4) for v in self.position_m], "size_m": list(self.size_m),
              "yaw_rad": round(self.yaw_rad, 5), "speed_mps": round(self.speed_mps, 4)}
-        if self.kind == "pedestrian":
+        if self.kind is ObjectKind.PEDESTRIAN:
             d["crossing"] = self.crossing
         if self.marker_id is not None:
             d["marker_id"] = self.marker_id
@@ -58,7 +58,8 @@ class ObjectTruth:
 @dataclass(frozen=True)
 class GroundTruth:
     """time_s; ego pose (world), speed_mps, steering_rad, accel_mps2; lane; objects; depth_m: (H, W) float32
-    left-camera depth [m], inf for sky; imu: the true IMU values; crashed / pedestrian_hit flags."""
+    left-camera depth [m], inf for sky; imu: the true IMU values; crashed: the ego hit something;
+    pedestrians_hit: ids of the pedestrians hit so far."""
 
     time_s: float
     ego: Pose2D
@@ -68,7 +69,11 @@ class GroundTruth:
     depth_m: np.ndarray
     imu: ImuSample
     crashed: bool
-    pedestrian_hit: bool
+    pedestrians_hit: tuple[int, ...]
+
+    @property
+    def pedestrian_hit(self) -> bool:
+        return bool(self.pedestrians_hit)
 
     def to_dict(self) -> dict:
         return {
@@ -107,5 +112,5 @@ def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visibl
     pts = np.column_stack([c[0] + cy * local[:, 0] - sy * local[:, 1], c[1] + sy * local[:, 0] + cy * local[:, 1],
                            local[:, 2]])
     z = rig.cam_from_vehicle(Side.LEFT).apply(pts)[:, 2]
-    return ObjectTruth(state.obj_id, state.kind.value, box_px, float(visible), float(z.min()),
+    return ObjectTruth(state.obj_id, state.kind, box_px, float(visible), float(z.min()),
                        (float(c[0]), float(c[1]), H / 2), (L, W, H), yaw, state.speed_mps, crossing, state.marker_id)

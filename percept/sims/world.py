@@ -6,7 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from percept.sensors import Frame, StereoRig
+from percept.sensors import Frame, LandmarkMap, StereoRig
+from percept.sensors.vehicle import SIGN_PANEL_CENTRE_M
 
 from .actors import Pedestrian, Sign
 from .conditions import Condition, ConditionEffects, is_dropped
@@ -133,17 +134,22 @@ class SimWorld:
             crossing = bool(getattr(src, "crossing", False))
             objects.append(object_truth(st, scene.ego, rig, boxes.get(st.obj_id), visible.get(st.obj_id, 0.0),
                                         crossing))
-        ped_hit = any((p.crashed or p.hit) for p in self.env.road.objects if isinstance(p, Pedestrian))
+        ped_hit = tuple(self.ids(p) for p in self.env.road.objects if isinstance(p, Pedestrian) and (p.crashed or p.hit))
         gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
                          bool(ego.crashed), ped_hit)
         frame = Frame(self.frame_index, self.time_s, None if dropped else left, None if dropped else right, imu, wheel)
         return frame, gt
 
-    def landmark_map(self) -> dict[int, list[float]]:
-        """Surveyed landmark signs: marker id -> [x, y, z] of the panel centre in the world frame [m]."""
+    @property
+    def crossing_pedestrians(self) -> int:
+        """How many pedestrians of this scenario cross the road (the others stay on the verge)."""
+        return sum(1 for o in self.env.road.objects if isinstance(o, Pedestrian) and o.crossing)
+
+    def landmark_map(self) -> LandmarkMap:
+        """Surveyed landmark signs: marker ids and panel centres in the world frame [m]."""
         out = {}
         for o in self.env.road.objects:
             if isinstance(o, Sign):
                 x, y = hw_to_world_xy(o.position)
-                out[o.marker_id] = [float(x), float(y), 2.05]
-        return out
+                out[o.marker_id] = [float(x), float(y), SIGN_PANEL_CENTRE_M]
+        return LandmarkMap.from_dict(out)

@@ -56,9 +56,12 @@ def test_drive_default_recording_path(tmp_path, monkeypatch):
 @pytest.mark.parametrize("args, message", [
     (["--scenario", "motorway"], "unknown scenario 'motorway'"),
     (["--condition", "snow"], "unknown condition 'snow'"),
-    (["--lateral", "magic"], "--lateral must be vision or privileged"),
+    (["--lateral", "magic"], "Invalid value for '--lateral'"),
     (["--longitudinal", "vision"], "no vision implementation yet"),
-    (["--duration", "-3"], "--duration must be positive"),
+    (["--duration", "-3"], "--duration must be a finite number"),
+    (["--duration", "inf"], "--duration must be a finite number"),
+    (["--duration", "1e308"], "--duration must be a finite number"),
+    (["--seed", "-1"], "--seed must be a finite number between 0 and"),
 ])
 def test_drive_bad_input_is_one_line_exit_2(tmp_path, args, message):
     js, rrd = tmp_path / "r.json", tmp_path / "r.rrd"

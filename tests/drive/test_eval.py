@@ -78,7 +78,7 @@ def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--scenario", "nowhere"], "unknown scenario"),
     (["--scenario", "highway", "--seeds", "9-1"], "--seeds must look like"),
-    (["--scenario", "highway", "--workers", "0"], "--workers must be at least 1"),
+    (["--scenario", "highway", "--workers", "0"], "--workers must be a finite number between 1 and 256"),
     (["--scenario", "highway", "--engine", "spark"], "--engine must be local or ray"),
     (["--scenario", "highway", "--condition", "fog"], "condition"),
     (["--scenario", "highway", "--longitudinal", "vision"], "no vision implementation yet"),

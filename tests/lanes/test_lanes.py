@@ -147,20 +147,24 @@ def test_black_frame_and_dropped_frame_degrade_gracefully():
 
 
 def test_tracking_on_the_simulated_highway():
-    from percept.drive import PrivilegedLateral, PrivilegedLongitudinal, in_path_obstacle
+    from percept.drive import TASKS, Agent, SlotContext, Source, TruthFeed
     from percept.sims import SimWorld, WorldConfig
 
     w = SimWorld(WorldConfig("highway", 1, scenery=False))
     det = LaneDetector(w.cfg.rig)
-    lat, lon = PrivilegedLateral(), PrivilegedLongitudinal(w.cruise_speed_mps)
+    feed = TruthFeed()
+    agent = Agent(TASKS, {t.name: Source.PRIVILEGED for t in TASKS}, SlotContext(w.cfg.rig, w.dt, None, feed),
+                  w.cruise_speed_mps)
     err = []
     for i in range(60):
         f, gt = w.observe()
+        feed.truth = gt
         est, _ = det.process(f.left, f.wheel_speed_mps, f.imu.yaw_rate_rps, w.dt)
         if i >= 5:
             assert est.valid and est.confidence > 0.5
             err.append([est.offset_m - gt.lane.offset_m, est.heading_rad - gt.lane.heading_rad])
         # a gentle weave so that offset and heading are not trivially zero
-        w.step(lon.update(in_path_obstacle(gt), gt.speed_mps), lat.update(gt.lane, gt.speed_mps) + 0.01 * np.sin(i / 8))
+        step = agent.step(f)
+        w.step(step.accel_mps2, step.steering_rad + 0.01 * np.sin(i / 8))
     rmse = np.sqrt(np.mean(np.square(err), axis=0))
     assert rmse[0] < 0.05 and rmse[1] < 0.005

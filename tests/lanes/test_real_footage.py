@@ -10,8 +10,9 @@ from typer.testing import CliRunner
 
 from percept.cli import app
 from percept.lanes import marking_brightness
+from percept.lanes.realworld import FootageLanes, RealLaneConfig
+from percept.sensors import PinholeCamera, list_footage, open_video, read_image
 from percept.sensors.chessboard import CameraCalibration, calibrate_chessboards, chessboard_images
-from percept.lanes.realworld import FootageLanes, RealLaneConfig, list_inputs, open_video, read_image
 
 DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
 LANES = DATA / "udacity-lanes"
@@ -130,9 +131,9 @@ def test_video_runs_end_to_end(tmp_path):
 
 def test_library_bad_input(tmp_path):
     with pytest.raises(ValueError, match="holds no images"):
-        list_inputs(tmp_path)
+        list_footage(tmp_path)
     with pytest.raises(ValueError, match="does not exist"):
-        list_inputs(tmp_path / "nothing.jpg")
+        list_footage(tmp_path / "nothing.jpg")
     (tmp_path / "broken.jpg").write_text("not a jpeg")
     (tmp_path / "broken.mp4").write_text("not a video")
     with pytest.raises(ValueError, match="cannot read .* as an image"):
@@ -141,7 +142,7 @@ def test_library_bad_input(tmp_path):
         open_video(tmp_path / "broken.mp4")
     with pytest.raises(ValueError, match="mount height"):
         RealLaneConfig(mount_height_m=-1.0)
-    cal = CameraCalibration(1000.0, 1000.0, 640.0, 360.0, 1280, 720, (0.0,) * 5, 0.5)
+    cal = CameraCalibration(PinholeCamera(1000.0, 1000.0, 640.0, 360.0, 1280, 720), (0.0,) * 5, 0.5)
     with pytest.raises(ValueError, match="calibration is for 1280x720"):
         FootageLanes(RealLaneConfig(), cal).still(np.zeros((540, 960, 3), np.uint8))
 
@@ -187,3 +188,24 @@ def test_a_folder_with_one_unreadable_image_keeps_the_others(tmp_path, calib_fil
     assert d["summary"] == {**d["summary"], "count": 1, "errors": 1, "both_boundaries": 1}
     # a 960x540 image with a 1280x720 calibration: one line, exit 2
     _one_error_line(runner.invoke(app, ["lanes", str(src), "--calib", str(calib_file)]), "calibration is for 1280x720")
+
+
+def test_truncated_footage_through_the_cli(tmp_path):
+    """A cut JPEG is one clear error; a cut video keeps the frames it has and says it ended early."""
+    grey = np.full((240, 320, 3), 90, np.uint8)
+    cv2.imwrite(str(tmp_path / "a.jpg"), grey)
+    data = (tmp_path / "a.jpg").read_bytes()
+    (tmp_path / "cut.jpg").write_bytes(data[:len(data) // 2])
+    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "cut.jpg")]), "truncated")
+    w = cv2.VideoWriter(str(tmp_path / "v.avi"), cv2.VideoWriter_fourcc(*"MJPG"), 10.0, (320, 240))
+    for _ in range(30):
+        w.write(grey)
+    w.release()
+    data = (tmp_path / "v.avi").read_bytes()
+    (tmp_path / "cut.avi").write_bytes(data[:len(data) // 2])
+    js = tmp_path / "cut.json"
+    r = runner.invoke(app, ["lanes", str(tmp_path / "cut.avi"), "--json", str(js)])
+    assert r.exit_code == 0, r.output
+    assert "ended after" in r.output
+    d = json.loads(js.read_text())
+    assert d["ended_early"] and d["frames_declared"] == 30 and 0 < d["frames"] < 30

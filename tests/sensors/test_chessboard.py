@@ -63,13 +63,21 @@ def test_synthetic_board_recovers_the_focal_length(tmp_path):
         cv2.imwrite(str(paths[-1]), img)
     cal = calibrate_chessboards(paths, (9, 6))
     assert cal.images_used == 8 and cal.rms_px < 0.5
-    assert cal.fx == pytest.approx(cam.fx, rel=0.01) and cal.fy == pytest.approx(cam.fy, rel=0.01)
+    assert cal.camera.fx == pytest.approx(cam.fx, rel=0.01) and cal.camera.fy == pytest.approx(cam.fy, rel=0.01)
 
 
 def test_calibration_file_round_trip_and_bad_files(tmp_path):
-    cal = CameraCalibration(1000.0, 1001.0, 640.0, 360.0, 1280, 720, (-0.2, 0.05, 0.0, 0.0, 0.0), 0.5, 10, 12, 15)
+    cam = PinholeCamera(1000.0, 1001.0, 640.0, 360.0, 1280, 720)
+    cal = CameraCalibration(cam, (-0.2, 0.05, 0.0, 0.0, 0.0), 0.5, 10, 12, 15)
     cal.save(tmp_path / "c.json")
     assert CameraCalibration.load(tmp_path / "c.json") == cal
+    assert [p.name for p in tmp_path.iterdir()] == ["c.json"]  # written under a temporary name, then renamed
+    # the file stays flat: the fields of the camera beside the distortion and the counts
+    assert json.loads((tmp_path / "c.json").read_text()) == {
+        "fx": 1000.0, "fy": 1001.0, "cx": 640.0, "cy": 360.0, "width": 1280, "height": 720,
+        "dist": [-0.2, 0.05, 0.0, 0.0, 0.0], "rms_px": 0.5, "images_used": 10, "images_found": 12,
+        "images_total": 15, "pattern": "9x6"}
+    assert cal.K[0, 0] == 1000.0 and cal.camera is cam
     with pytest.raises(ValueError, match="does not exist"):
         CameraCalibration.load(tmp_path / "missing.json")
     (tmp_path / "bad.json").write_text('{"fx": 1}')
@@ -77,6 +85,9 @@ def test_calibration_file_round_trip_and_bad_files(tmp_path):
         CameraCalibration.load(tmp_path / "bad.json")
     with pytest.raises(ValueError, match="calibration is for 1280x720"):
         cal.undistort(np.zeros((540, 960, 3), np.uint8))
+    (tmp_path / "nan.json").write_text(json.dumps({**cal.to_dict(), "dist": [0.1, "nan", 0, 0, 0]}))
+    with pytest.raises(ValueError, match="not a percept calibration file.*finite"):
+        CameraCalibration.load(tmp_path / "nan.json")
 
 
 def test_no_board_and_no_images(tmp_path):

@@ -51,7 +51,7 @@ def test_synthetic_rig_gives_back_its_baseline(tmp_path):
     assert cal.baseline_m == pytest.approx(0.30, rel=0.01)
     assert cal.T[0] == pytest.approx(-0.30, rel=0.01)
     assert np.allclose(cal.R, np.eye(3), atol=0.01)
-    assert cal.left.fx == pytest.approx(cam.fx, rel=0.01)
+    assert cal.left.camera.fx == pytest.approx(cam.fx, rel=0.01)
 
 
 @needs_pairs

@@ -325,9 +325,9 @@ def test_loop_is_a_closed_circuit_over_3_km_with_landmarks_off_the_road():
     signs = [o for o in w.env.road.objects if isinstance(o, Sign)]
     landmarks = w.landmark_map()
     assert len(landmarks) == len(signs) >= int(length // 100)
-    assert sorted(landmarks) == sorted(s.marker_id for s in signs)
+    assert sorted(landmarks.ids) == sorted(s.marker_id for s in signs)
     all_lanes = [lane for tos in net.graph.values() for lanes in tos.values() for lane in lanes]
-    for mid, (x, y, z) in landmarks.items():
+    for mid, (x, y, z) in zip(landmarks.ids, landmarks.positions_m):
         p = world_to_hw_xy(np.array([x, y]))
         assert z > 1.0
         for lane in all_lanes:

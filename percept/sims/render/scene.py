@@ -3,15 +3,8 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
 
-from percept.sensors import Pose2D
-
-
-class ObjectKind(str, Enum):
-    VEHICLE = "vehicle"
-    PEDESTRIAN = "pedestrian"
-    LANDMARK = "landmark"
+from percept.sensors import ObjectKind, Pose2D
 
 
 @dataclass(frozen=True)

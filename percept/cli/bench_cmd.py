@@ -1,0 +1,38 @@
+"""`percept bench`: per-stage cost on one thread against the named peers, in one run."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from . import options as opt
+from .common import check_outputs, console, fmt, progress_bar, write_json
+
+
+def bench(
+    json_path: opt.JsonOut = None,
+    frames: Annotated[int, typer.Option("--frames", help="Timed calls per stage, 1 to 10,000 (the median is "
+                                                         "reported).")] = 30,
+):
+    """Per-stage cost on one thread (stages named by the run JSON's timing_ms keys), against the named peers
+    measured in the same run (ratio = ours / peer)."""
+    from percept.drive import TASKS
+    from percept.drive.bench import bench_render, bench_task
+
+    opt.check_number("--frames", frames, 1, 10000)
+    check_outputs([json_path])
+    tasks = [t for t in TASKS if t.vision is not None]
+    with progress_bar() as bar:
+        task = bar.add_task("benchmarking", total=(2 + len(tasks)) * (frames + 2))
+        tick = lambda: bar.advance(task)  # noqa: E731
+        results = [bench_render(frames, progress=tick)] + [bench_task(t, TASKS, frames, progress=tick)
+                                                           for t in tasks]
+    t = Table(title="percept bench (one thread, median ms per call)")
+    for col in ("stage", "what", "ms", "target ms", "peer", "peer ms", "ratio"):
+        t.add_column(col, justify="left" if col in ("stage", "what", "peer") else "right")
+    for r in results:
+        t.add_row(r.stage, r.what, f"{r.ms:.2f}", fmt(r.target_ms), r.peer or "-", fmt(r.peer_ms), fmt(r.ratio))
+    console.print(t)
+    write_json(json_path, {"stages": [r.to_dict() for r in results]})

@@ -1,0 +1,87 @@
+"""Emergency braking (AEB) with pedestrian yielding: the last word on the longitudinal command.
+
+Takes the following law's command and lowers it where stopping demands: the constant deceleration that stops
+short of a person, a = -v^2 / (2 s) over the room s left; an emergency brake when the deceleration needed to
+cancel the closing speed before the margin, a_req = closing^2 / (2 s), exceeds a trigger (braking 30 % harder
+than needed); a hold at standstill. Yielding to a pedestrian is a commitment: the car stops before their line
+and goes once stopped and clear. Then the command limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from percept.sensors.vehicle import MAX_BRAKE_MPS2
+
+from .base import Controller, limiting
+from .target import Target
+
+MAX_ACCEL_MPS2 = 2.5
+"""Comfort limit on the commanded acceleration [m/s²]."""
+
+
+@dataclass(frozen=True)
+class EmergencyBrakingDebug:
+    """terms: every active term [m/s²] by name (follow, yield, emergency, hold, commitment); limited_by: the one
+    that set the command (or "speed_limit"/"brake_limit" when clipped); stop_in_m: distance left to a committed
+    stop [m] (None without one); command_mps2: the final command."""
+
+    terms: dict
+    limited_by: str
+    stop_in_m: float | None
+    command_mps2: float
+
+
+class EmergencyBraking(Controller):
+    """standstill_m: margin kept to a vehicle [m]; ped_margin_m: margin kept to a pedestrian [m];
+    trigger_mps2: required deceleration that triggers an emergency brake; gain: braking / required."""
+
+    def __init__(self, standstill_m: float = 4.0, ped_margin_m: float = 4.0, trigger_mps2: float = 2.0,
+                 gain: float = 1.3):
+        self.d0, self.ped_margin, self.trigger, self.gain = standstill_m, ped_margin_m, trigger_mps2, gain
+        self.reset()
+
+    def reset(self) -> None:
+        self.travelled_m = 0.0
+        self.stop_at_m: float | None = None  # odometer reading to stop at while yielding to a pedestrian
+
+    def update(self, target: Target | None, speed_mps: float, follow_mps2: float,
+               dt: float = 1.0 / 15) -> tuple[float, EmergencyBrakingDebug]:
+        v = speed_mps
+        self.travelled_m += v * dt
+        self._commit(target, v)
+        terms: dict[str, float | None] = {"follow": follow_mps2}
+        if target is not None:
+            margin = self.ped_margin if target.is_pedestrian else self.d0
+            room = target.gap_m - margin
+            if target.is_pedestrian:
+                # yield: a constant deceleration that stops the car the margin before the person, a = -v^2 / (2 s)
+                terms["yield"] = -v * v / (2 * max(room, 0.1))
+            if target.closing_mps > 0:
+                # emergency: the deceleration needed to cancel the closing before the margin, a = c^2 / (2 s)
+                a_req = target.closing_mps * target.closing_mps / (2 * max(room, 0.1))
+                if a_req > self.trigger:
+                    terms["emergency"] = -self.gain * a_req
+            if room < 0.5 and v < 1.0:
+                terms["hold"] = -MAX_BRAKE_MPS2  # hold the car at a standstill
+        stop_in = None if self.stop_at_m is None else self.stop_at_m - self.travelled_m
+        if stop_in is not None:
+            # a = -v^2 / (2 s) stops the car in the remaining distance s
+            terms["commitment"] = -MAX_BRAKE_MPS2 if stop_in < 0.2 else -v * v / (2 * stop_in)
+        a, name = limiting(terms)
+        if v <= 0.05:
+            a = max(a, 0.0) if a > -1e-3 else a
+        out = float(np.clip(a, -MAX_BRAKE_MPS2, MAX_ACCEL_MPS2))
+        if out != a:
+            name = "speed_limit" if out > a else "brake_limit"
+        return out, EmergencyBrakingDebug(terms, name, stop_in, out)
+
+    def _commit(self, target: Target | None, v: float) -> None:
+        """Commit to stop before a pedestrian; release once stopped with no pedestrian ahead."""
+        if target is not None and target.is_pedestrian:
+            stop_at = self.travelled_m + target.gap_m - self.ped_margin
+            self.stop_at_m = stop_at if self.stop_at_m is None else min(self.stop_at_m, stop_at)
+        elif self.stop_at_m is not None and v < 0.3:
+            self.stop_at_m = None

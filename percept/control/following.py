@@ -1,0 +1,53 @@
+"""Following (ACC): cruise at the set speed, or keep a constant time gap to what is ahead.
+
+Gap error e = gap - gap*, gap* = max(d0, v h) behind a vehicle (h the time gap), d0 behind anything else; the
+law a = e / Td^2 - 2 closing / Td makes the gap error critically damped with time constant Td (constant
+time-gap policy: Rajamani, *Vehicle Dynamics and Control*, 2nd ed., ch. 6). Cruise: a = (v_set - v) / Tv.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from percept.sensors import ObjectKind
+
+from .base import Controller, limiting
+from .target import Target
+
+
+@dataclass(frozen=True)
+class FollowingDebug:
+    """cruise_mps2, follow_mps2 (None without a target): the two terms [m/s²]; target_gap_m: the gap aimed at
+    (None without a target); limited_by: "cruise" or "follow"."""
+
+    cruise_mps2: float
+    follow_mps2: float | None
+    target_gap_m: float | None
+    limited_by: str
+
+
+class Following(Controller):
+    """Acceleration [m/s²] from the set speed and the in-path target; gains as time constants [s]."""
+
+    def __init__(self, set_speed_mps: float, time_gap_s: float = 1.8, standstill_m: float = 4.0,
+                 gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5):
+        for name, v in (("time_gap_s", time_gap_s), ("gap_time_constant_s", gap_time_constant_s),
+                        ("speed_time_constant_s", speed_time_constant_s)):
+            if not v > 0:
+                raise ValueError(f"{name} must be positive, got {v}")
+        if not set_speed_mps >= 0:
+            raise ValueError(f"set_speed_mps must be >= 0, got {set_speed_mps}")
+        self.set_speed, self.time_gap, self.d0 = set_speed_mps, time_gap_s, standstill_m
+        self.Td, self.Tv = gap_time_constant_s, speed_time_constant_s
+
+    def update(self, target: Target | None, speed_mps: float) -> tuple[float, FollowingDebug]:
+        v = speed_mps
+        # cruise: first-order approach to the set speed
+        cruise = (self.set_speed - v) / self.Tv
+        if target is None:
+            return cruise, FollowingDebug(cruise, None, None, "cruise")
+        gap_ref = max(self.d0, v * self.time_gap) if target.kind is ObjectKind.VEHICLE else self.d0
+        # gap dynamics critically damped: a = (gap - gap*) / Td^2 - 2 closing / Td
+        follow = (target.gap_m - gap_ref) / self.Td ** 2 - 2 * target.closing_mps / self.Td
+        a, name = limiting({"cruise": cruise, "follow": follow})
+        return a, FollowingDebug(cruise, follow, gap_ref, name)

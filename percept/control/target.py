@@ -1,0 +1,33 @@
+"""What the longitudinal laws act on: the nearest of the lead and the braking request, as a bumper gap."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from percept.sensors import BrakingRequest, Lead, ObjectKind
+from percept.sensors.vehicle import bumper_gap_m
+
+
+@dataclass(frozen=True)
+class Target:
+    """gap_m: free distance from the front bumper [m]; closing_mps: how fast the gap shrinks [m/s] (-range rate);
+    kind: what is there; source: "lead" or "request"."""
+
+    gap_m: float
+    closing_mps: float
+    kind: ObjectKind
+    source: str
+
+    @property
+    def is_pedestrian(self) -> bool:
+        return self.kind is ObjectKind.PEDESTRIAN
+
+
+def nearest_target(lead: Lead | None, request: BrakingRequest | None) -> Target | None:
+    """The nearer of the lead (longitudinal slot) and the braking request (pedestrian slot); None when neither."""
+    cands = []
+    if lead is not None:
+        cands.append(Target(bumper_gap_m(lead.range_m), -lead.range_rate_mps, lead.kind, "lead"))
+    if request is not None:
+        cands.append(Target(bumper_gap_m(request.stop_before_m), -request.range_rate_mps, request.kind, "request"))
+    return min(cands, key=lambda t: t.gap_m) if cands else None

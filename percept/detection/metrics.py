@@ -1,0 +1,153 @@
+"""Scoring formulas for pedestrian detection: IoU, greedy matching with ignore regions, rates.
+
+DESIGN, "Scoring definitions": a detection matches a ground-truth box of a pedestrian at least half
+visible and at least 24 px tall when IoU >= 0.5; recall, precision, false positives per image.
+Boxes are (u0, v0, u1, v1) in pixels, u = column, v = row, u0 <= u1 and v0 <= v1.
+
+Matching follows the PASCAL VOC rule (Everingham et al. 2010, "The PASCAL Visual Object Classes
+(VOC) Challenge", IJCV) with the ignore regions of the Caltech pedestrian benchmark (Dollár et
+al. 2012, "Pedestrian Detection: An Evaluation of the State of the Art", PAMI): ground truth
+that is not eligible (too small, mostly hidden) neither earns nor costs anything.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def _boxes(boxes: np.ndarray, what: str) -> np.ndarray:
+    """Validated (K, 4) float boxes; an empty input is (0, 4)."""
+    b = np.asarray(boxes, dtype=np.float64)
+    if b.size == 0:
+        return b.reshape(0, 4)
+    if b.ndim != 2 or b.shape[1] != 4:
+        raise ValueError(f"{what}: expected boxes of shape (K, 4) as (u0, v0, u1, v1), got {b.shape}")
+    if not np.all(np.isfinite(b)):
+        raise ValueError(f"{what}: box coordinates must be finite")
+    if np.any(b[:, 2] < b[:, 0]) or np.any(b[:, 3] < b[:, 1]):
+        raise ValueError(f"{what}: a box has u1 < u0 or v1 < v0; boxes are (u0, v0, u1, v1)")
+    return b
+
+
+def iou_matrix(a_boxes: np.ndarray, b_boxes: np.ndarray) -> np.ndarray:
+    """Intersection over union of every box of A (N, 4) with every box of B (M, 4) -> (N, M).
+
+    Two boxes of zero area have IoU 0.
+    """
+    a = _boxes(a_boxes, "iou_matrix A")[:, None, :]
+    b = _boxes(b_boxes, "iou_matrix B")[None, :, :]
+    # |A ∩ B| = max(0, min(u1) - max(u0)) * max(0, min(v1) - max(v0))
+    inter_w = np.clip(np.minimum(a[..., 2], b[..., 2]) - np.maximum(a[..., 0], b[..., 0]), 0.0, None)
+    inter_h = np.clip(np.minimum(a[..., 3], b[..., 3]) - np.maximum(a[..., 1], b[..., 1]), 0.0, None)
+    inter = inter_w * inter_h
+    area_a = (a[..., 2] - a[..., 0]) * (a[..., 3] - a[..., 1])
+    area_b = (b[..., 2] - b[..., 0]) * (b[..., 3] - b[..., 1])
+    # |A ∪ B| = |A| + |B| - |A ∩ B|
+    union = area_a + area_b - inter
+    # IoU = |A ∩ B| / |A ∪ B|
+    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0.0)
+
+
+def iou(a: np.ndarray, b: np.ndarray) -> float:
+    """Intersection over union of two boxes (u0, v0, u1, v1) [px]."""
+    return float(iou_matrix(np.reshape(a, (1, -1)), np.reshape(b, (1, -1)))[0, 0])
+
+
+def eligible(box_px: np.ndarray, visible: float, min_height_px: float = 24.0, min_visible: float = 0.5) -> bool:
+    """True when a ground-truth pedestrian counts: visible fraction >= min_visible, height >= min_height_px."""
+    box = _boxes(np.reshape(box_px, (1, -1)), "eligible")[0]
+    if not 0.0 <= visible <= 1.0:
+        raise ValueError(f"visible is the visible fraction in [0, 1], got {visible!r}")
+    # h = v1 - v0
+    return bool(box[3] - box[1] >= min_height_px and visible >= min_visible)
+
+
+@dataclass(frozen=True)
+class FrameMatch:
+    """Outcome of matching one frame's detections to its ground truth.
+
+    tp, fp, fn: counts; ignored: detections absorbed by an ignore region (neither tp nor fp);
+    pairs: (detection index, ground-truth index) of the true positives, in matching order.
+    """
+
+    tp: int
+    fp: int
+    fn: int
+    ignored: int = 0
+    pairs: tuple[tuple[int, int], ...] = ()
+
+
+def match_detections(det_boxes: np.ndarray, det_scores: np.ndarray, gt_boxes: np.ndarray,
+                     gt_eligible: np.ndarray, iou_min: float = 0.5) -> FrameMatch:
+    """Greedy matching by descending detection score, each eligible ground-truth box at most once.
+
+    A detection's candidates are the still unmatched eligible boxes and all ignore boxes
+    (``gt_eligible`` False) with IoU >= iou_min; it takes the one of highest IoU (an eligible
+    box on a tie). Matched to an eligible box: true positive. Matched to an ignore box: neither
+    true nor false positive (an ignore box may absorb several). No candidate: false positive.
+    Eligible boxes left unmatched are misses; ignore boxes never are.
+    """
+    det = _boxes(det_boxes, "detections")
+    gt = _boxes(gt_boxes, "ground truth")
+    scores = np.asarray(det_scores, dtype=np.float64).reshape(-1)
+    keep_gt = np.asarray(gt_eligible, dtype=bool).reshape(-1)
+    if scores.size != len(det) or keep_gt.size != len(gt):
+        raise ValueError(f"{len(det)} detection boxes with {scores.size} scores, {len(gt)} ground-truth boxes "
+                         f"with {keep_gt.size} eligibility flags: give one per box")
+    if not np.all(np.isfinite(scores)):
+        raise ValueError("detection scores must be finite")
+    if not (0.0 < iou_min <= 1.0):
+        raise ValueError(f"iou_min must be in (0, 1], got {iou_min!r}")
+    overlap = iou_matrix(det, gt)
+    taken = np.zeros(len(gt), dtype=bool)
+    pairs: list[tuple[int, int]] = []
+    fp = ignored = 0
+    for d in np.argsort(-scores, kind="stable"):
+        # an eligible box already taken is no candidate; ignore boxes always are
+        cand = np.where((overlap[d] >= iou_min) & ~(keep_gt & taken), overlap[d], -1.0)
+        # highest IoU first, an eligible box first on a tie
+        best = int(np.lexsort((~keep_gt, -cand))[0]) if len(gt) else -1
+        if best < 0 or cand[best] < 0.0:
+            fp += 1
+        elif keep_gt[best]:
+            taken[best] = True
+            pairs.append((int(d), best))
+        else:
+            ignored += 1
+    fn = int(np.count_nonzero(keep_gt & ~taken))
+    return FrameMatch(tp=len(pairs), fp=fp, fn=fn, ignored=ignored, pairs=tuple(pairs))
+
+
+@dataclass(frozen=True)
+class DetectionScore:
+    """Totals over frames; the rates are None when their denominator is 0."""
+
+    tp: int
+    fp: int
+    fn: int
+    frames: int
+
+    @property
+    def recall(self) -> float | None:
+        # recall = TP / (TP + FN)
+        return self.tp / (self.tp + self.fn) if self.tp + self.fn else None
+
+    @property
+    def precision(self) -> float | None:
+        # precision = TP / (TP + FP)
+        return self.tp / (self.tp + self.fp) if self.tp + self.fp else None
+
+    @property
+    def fppi(self) -> float | None:
+        # FPPI = sum FP / number of images
+        return self.fp / self.frames if self.frames else None
+
+
+def score_frames(matches: list[FrameMatch]) -> dict:
+    """Recall, precision and false positives per image over frames, with the totals behind them."""
+    s = DetectionScore(tp=sum(m.tp for m in matches), fp=sum(m.fp for m in matches),
+                       fn=sum(m.fn for m in matches), frames=len(matches))
+    return {"recall": s.recall, "precision": s.precision, "fppi": s.fppi,
+            "tp": s.tp, "fp": s.fp, "fn": s.fn, "frames": s.frames}

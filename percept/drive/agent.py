@@ -1,0 +1,61 @@
+"""The agent: the task slots in dependency order, each timed, then the control laws on their records."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from percept.control import EmergencyBraking, Following, LaneKeeping, nearest_target
+from percept.sensors import Frame
+
+from .tasks import SlotContext, Source, Task, task_order
+
+
+@dataclass(frozen=True)
+class AgentStep:
+    """One step of the agent. accel_mps2, steering_rad: the command (ISO 8855, steering + left); estimates, debug:
+    each task's record and debug object by task name; timing_ms: each slot's step [ms]; control: the laws' debug
+    records by law name (lane_keeping, following, emergency_braking)."""
+
+    accel_mps2: float
+    steering_rad: float
+    estimates: dict
+    debug: dict
+    timing_ms: dict
+    control: dict
+
+
+class Agent:
+    """Slots from the table (vision or privileged per task), and the shared laws: lane keeping on the lateral
+    task's ego path; following and emergency braking on the longitudinal lead and the pedestrians' braking
+    request, at the odometry task's speed."""
+
+    def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float):
+        self.order = task_order(tasks)
+        self.slots = {t.name: (t.vision if sources[t.name] is Source.VISION else t.privileged)(ctx)
+                      for t in self.order}
+        self.dt_s = ctx.dt_s
+        self.keeping = LaneKeeping()
+        self.following = Following(set_speed_mps)
+        self.braking = EmergencyBraking()
+
+    def reset(self) -> None:
+        for slot in self.slots.values():
+            slot.reset()
+        for law in (self.keeping, self.following, self.braking):
+            law.reset()
+
+    def step(self, frame: Frame) -> AgentStep:
+        estimates, debug, timing = {}, {}, {}
+        for task in self.order:
+            upstream = {u: estimates[u] for u in task.upstream}
+            t0 = time.perf_counter()
+            estimates[task.name], debug[task.name] = self.slots[task.name].step(frame, upstream)
+            timing[task.name] = (time.perf_counter() - t0) * 1e3
+        steer, keeping = self.keeping.update(estimates["lateral"])
+        speed = estimates["odometry"].speed_mps
+        target = nearest_target(estimates["longitudinal"], estimates["pedestrians"])
+        follow, following = self.following.update(target, speed)
+        accel, braking = self.braking.update(target, speed, follow, self.dt_s)
+        return AgentStep(accel, steer, estimates, debug, timing,
+                         {"lane_keeping": keeping, "following": following, "emergency_braking": braking})

@@ -1,0 +1,52 @@
+"""What one drive run is: the world, its length and where each task's estimate comes from."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from percept.sims import WorldConfig
+
+from .tasks import TASKS, Source, Task
+
+MAX_DURATION_S = 24 * 3600.0
+"""Longest run a configuration accepts [s] (a day of simulated driving)."""
+
+
+
+@dataclass(frozen=True)
+class DriveConfig:
+    """world: scenario, seed, condition, rig; duration_s: None = the scenario's default [s]; sources: task name ->
+    Source (missing = privileged); tasks: the slot table. Validated on construction (ValueError naming the bad
+    value)."""
+
+    world: WorldConfig = field(default_factory=WorldConfig)
+    duration_s: float | None = None
+    sources: dict = field(default_factory=dict)
+    tasks: tuple[Task, ...] = TASKS
+
+    def __post_init__(self) -> None:
+        d = self.duration_s
+        if d is not None and not (isinstance(d, (int, float)) and math.isfinite(d) and 0 < d <= MAX_DURATION_S):
+            raise ValueError(f"--duration must be a finite number of seconds between 0 and {MAX_DURATION_S:g}, "
+                             f"got {d}")
+        names = {t.name: t for t in self.tasks}
+        clean = {}
+        for name, src in dict(self.sources).items():
+            if name not in names:
+                raise ValueError(f"unknown task '{name}'; the tasks are: {', '.join(names)}")
+            try:
+                clean[name] = Source(src)
+            except ValueError:
+                raise ValueError(f"--{name} must be vision or privileged, got '{src}'") from None
+            if clean[name] is Source.VISION and names[name].vision is None:
+                raise ValueError(f"the {name} slot has no vision implementation yet; use --{name} privileged")
+        object.__setattr__(self, "sources", {t.name: clean.get(t.name, Source.PRIVILEGED) for t in self.tasks})
+
+    def source(self, task: str) -> Source:
+        return self.sources[task]
+
+    @property
+    def needs_cameras(self) -> bool:
+        """Whether any slot reads the camera images (every vision slot does)."""
+        return any(s is Source.VISION for s in self.sources.values())

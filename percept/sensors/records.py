@@ -1,0 +1,172 @@
+"""The records task slots exchange (DESIGN.md, "Agent and slots"): frozen, in SI units, vehicle frame unless named.
+
+A vision slot and its privileged twin return the same record, so either can feed the control laws and the
+slots downstream. Vehicle frame: ISO 8855 (x forward, y left, z up); ranges are measured from the left camera.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+
+from .poses import Pose2D
+
+
+class Source(str, Enum):
+    """Where a task's estimate comes from: its vision module, or ground truth (the privileged baseline)."""
+
+    VISION = "vision"
+    PRIVILEGED = "privileged"
+
+
+class ObjectKind(str, Enum):
+    """What an object is, for ground truth, scoring and review."""
+
+    VEHICLE = "vehicle"
+    PEDESTRIAN = "pedestrian"
+    LANDMARK = "landmark"
+
+
+@dataclass(frozen=True)
+class LaneEstimate:
+    """The ego lane in the vehicle frame (x forward, y left), as the lateral controller needs it.
+
+    offset_m: vehicle centre's lateral offset from the lane centre (+ left); heading_rad: vehicle heading relative
+    to the lane (+ CCW); curvature_1pm: lane curvature (+ turning left); width_m; confidence: 0..1 (0 = no
+    evidence, the values are a prediction); valid: False before the first fit; curvature_rate_1pm2: change of
+    the curvature per metre ahead (a clothoid). The lane centre in the vehicle frame is
+    y_c(x) = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6.
+    """
+
+    offset_m: float
+    heading_rad: float
+    curvature_1pm: float
+    width_m: float
+    confidence: float
+    valid: bool = True
+    curvature_rate_1pm2: float = 0.0
+
+    def centre_y(self, x_m: np.ndarray) -> np.ndarray:
+        """Lateral position of the lane centre at distances x_m ahead [m]."""
+        x = np.asarray(x_m, dtype=float)
+        # y_c = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6
+        return (-self.offset_m - np.tan(self.heading_rad) * x + 0.5 * self.curvature_1pm * x * x
+                + self.curvature_rate_1pm2 * x ** 3 / 6)
+
+    def boundary_y(self, x_m: np.ndarray, side: int) -> np.ndarray:
+        """side +1: left boundary, -1: right boundary."""
+        return self.centre_y(x_m) + side * self.width_m / 2
+
+    def boundary_points_m(self, x_near_m: float, x_far_m: float, n: int = 40) -> dict[str, np.ndarray]:
+        """Both boundaries on the ground: {"left"|"right": (n, 3) vehicle-frame (x, y, 0) [m]}, x_near..x_far."""
+        x = np.linspace(x_near_m, x_far_m, n)
+        return {name: np.column_stack([x, self.boundary_y(x, side), np.zeros_like(x)])
+                for name, side in (("left", 1), ("right", -1))}
+
+
+@dataclass(frozen=True)
+class EgoPath:
+    """Where the ego is going: the lane it keeps (or, without one, a straight corridor along its x axis) and the
+    speed it goes at [m/s] (the speed the estimate was made with: wheel speed for vision, true for privileged).
+
+    What the lateral slot returns; lane keeping steers along it and the longitudinal and pedestrian slots look
+    for obstacles in it.
+    """
+
+    lane: LaneEstimate | None
+    speed_mps: float
+
+    @classmethod
+    def straight(cls, speed_mps: float) -> "EgoPath":
+        return cls(None, speed_mps)
+
+    @property
+    def follows_lane(self) -> bool:
+        return self.lane is not None and self.lane.valid
+
+    def centre_y(self, x_m: np.ndarray) -> np.ndarray:
+        """Lateral position [m] of the path's centre x_m ahead (vehicle frame)."""
+        return self.lane.centre_y(x_m) if self.follows_lane else np.zeros_like(np.asarray(x_m, dtype=float))
+
+
+@dataclass(frozen=True)
+class Lead:
+    """The nearest thing standing in the ego path (a vehicle, a person, anything else that stands up).
+
+    range_m: left-camera depth of its nearest point [m]; range_rate_mps: d(range)/dt [m/s], negative when closing;
+    kind: what it is; confidence: 0..1; ttc_s: time to contact [s] (None when not closing); box_px: (u0, v0, u1,
+    v1) in the left image, or None; obj_id: the tracker's (or the simulator's) id.
+    """
+
+    range_m: float
+    range_rate_mps: float
+    kind: ObjectKind = ObjectKind.VEHICLE
+    confidence: float = 1.0
+    ttc_s: float | None = None
+    box_px: tuple | None = None
+    obj_id: int | None = None
+
+    @staticmethod
+    def time_to_contact(range_m: float, range_rate_mps: float) -> float | None:
+        """tau = Z / -Zdot while closing; None otherwise [s]."""
+        return range_m / -range_rate_mps if range_rate_mps < 0 else None
+
+
+@dataclass(frozen=True)
+class BrakingRequest:
+    """Stop before ``stop_before_m`` (left-camera range of the conflict point, e.g. a person stepping into the
+    path) [m]; range_rate_mps: its d(range)/dt [m/s]; reason: why, for review; kind: what is there; obj_id."""
+
+    stop_before_m: float
+    range_rate_mps: float
+    reason: str
+    kind: ObjectKind = ObjectKind.PEDESTRIAN
+    obj_id: int | None = None
+
+
+@dataclass(frozen=True)
+class PoseEstimate:
+    """Planar pose of the vehicle in the world frame, its speed [m/s] and the (3, 3) covariance of (x_m, y_m,
+    yaw_rad) [m², m·rad, rad²]; valid: False while the estimator has nothing to go on."""
+
+    pose: Pose2D
+    speed_mps: float
+    covariance: np.ndarray
+    valid: bool = True
+
+
+@dataclass(frozen=True)
+class LandmarkMap:
+    """Surveyed landmark signs: marker ids (N,) and their panel centres (N, 3) in the world frame [m]."""
+
+    ids: tuple[int, ...]
+    positions_m: np.ndarray
+
+    def __post_init__(self) -> None:
+        p = np.asarray(self.positions_m, dtype=float).reshape(-1, 3)
+        if len(p) != len(self.ids):
+            raise ValueError(f"landmark map has {len(self.ids)} ids but {len(p)} positions")
+        if not np.all(np.isfinite(p)):
+            raise ValueError("landmark map has a non-finite position")
+        object.__setattr__(self, "positions_m", p)
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def position(self, marker_id: int) -> np.ndarray | None:
+        """World position (3,) [m] of a marker, or None when it is not in the map."""
+        try:
+            return self.positions_m[self.ids.index(marker_id)]
+        except ValueError:
+            return None
+
+    def to_dict(self) -> dict[str, list[float]]:
+        return {str(i): [float(v) for v in p] for i, p in sorted(zip(self.ids, self.positions_m.tolist()))}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "LandmarkMap":
+        items = sorted((int(k), v) for k, v in d.items())
+        return cls(tuple(k for k, _ in items), np.array([v for _, v in items], dtype=float).reshape(-1, 3))
+
