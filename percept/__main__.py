@@ -1,3 +1,6 @@
-from percept.cli import main
+"""`python -m percept`: the console script (guarded: spawned worker processes import this module too)."""
 
-main()
+if __name__ == "__main__":
+    from percept.cli import main
+
+    main()

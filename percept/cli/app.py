@@ -5,7 +5,7 @@ from __future__ import annotations
 import typer
 
 from . import bench_cmd, calibrate_cmd, drive_cmd, eval_cmd, lanes_cmd, render_cmd, scenarios_cmd, view_cmd
-from .common import console, err, fail, progress_bar, write_json
+from .common import console, err, fail, progress_bar, run_cli, write_json
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="percept: a camera-only driving stack on highway-env, with a simulated stereo camera.")
@@ -23,4 +23,5 @@ __all__ = ["app", "console", "err", "fail", "main", "progress_bar", "write_json"
 
 
 def main() -> None:
-    app()
+    """The console script: library chatter off, Ctrl-C -> one line saying what was kept, exit code 130."""
+    run_cli(app)

@@ -28,8 +28,8 @@ def register(app: typer.Typer) -> None:
         pattern: str = typer.Option("9x6", "--pattern", help="Inner corners per row x per column, e.g. 9x6."),
         stereo: bool = typer.Option(False, "--stereo", help="Calibrate a stereo rig from left<N>.<ext> / "
                                                             "right<N>.<ext> pairs: both cameras, R, T, rectification."),
-        square: float = typer.Option(1.0, "--square", help="Side of a board square in metres (sets the units of the "
-                                                           "stereo baseline; 1 = board squares)."),
+        square: float = typer.Option(1.0, "--square", help="Side of a board square in metres, 0.0001 to 10 (sets the "
+                                                           "units of the stereo baseline; 1 = board squares)."),
         out: Optional[Path] = typer.Option(None, "--out", help="Calibration file to write (default DIR/calib.json, "
                                                                "DIR/stereo_calib.json with --stereo)."),
         json_path: Optional[Path] = typer.Option(None, "--json", help="Also write the figures to this JSON file."),
@@ -38,23 +38,23 @@ def register(app: typer.Typer) -> None:
 
         One camera: the file is what `percept lanes --calib` reads. Stereo: both cameras, the right camera's
         rotation and translation in the left one's frame (baseline in metres with --square), the rectified
-        projections, and the mean epipolar error as a check.
+        projections, and the mean epipolar error as a check. The files are written complete or not at all.
         """
-        from rich.markup import escape
-        from rich.table import Table
-
-        from percept.cli.common import console, fail, progress_bar, write_json
+        from percept.cli.common import check_outputs, console, fail, on_interrupt, progress_bar, write_error, write_json
+        from percept.cli.options import check_number
         from percept.sensors.chessboard import calibrate_chessboards, chessboard_images, parse_pattern
         from percept.sensors.stereo_calibration import calibrate_stereo, stereo_pairs
 
-        if not square > 0:
-            fail(f"--square must be positive (metres), got {square}")
+        check_number("--square", square, 1e-4, 10.0)
         try:
             size = parse_pattern(pattern)
             items = stereo_pairs(folder) if stereo else chessboard_images(folder)
         except ValueError as e:
             fail(str(e))
         target = out if out is not None else folder / ("stereo_calib.json" if stereo else "calib.json")
+        photos = [p for item in items for p in (item if stereo else (item,))]
+        check_outputs([target, json_path], photos)
+        on_interrupt(f"nothing was written; {target} keeps what it held" if target.exists() else None)
         problem = None
         with progress_bar() as bar:
             what = "pairs" if stereo else "photos"
@@ -71,29 +71,37 @@ def register(app: typer.Typer) -> None:
             target.parent.mkdir(parents=True, exist_ok=True)
             cal.save(target)
         except OSError as e:
-            fail(f"cannot write {target}: {e.strerror or e}")
-        t = Table(title=f"{'stereo rig' if stereo else 'camera'} calibration from {folder}")
-        t.add_column("quantity")
-        t.add_column("value", justify="right")
-        if stereo:
-            unit = "m" if square != 1.0 else "squares"
-            rows = [("stereo RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
-                    ("mean epipolar error [px]", f"{cal.epipolar_px:.3f}"),
-                    ("pairs with the board in both", f"{cal.pairs_used} of {cal.pairs_total}"),
-                    (f"baseline [{unit}]", f"{cal.baseline_m:.4f}"),
-                    (f"T [{unit}]", " ".join(f"{v:+.4f}" for v in cal.T)),
-                    ("left / right RMS [px]", f"{cal.left.rms_px:.3f} / {cal.right.rms_px:.3f}"),
-                    ("image size [px]", f"{cal.left.camera.width}x{cal.left.camera.height}"),
-                    *_cam_rows("left ", cal.left), *_cam_rows("right ", cal.right)]
-        else:
-            skipped = cal.images_found - cal.images_used
-            rows = [("RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
-                    ("photos with the board", f"{cal.images_found} of {cal.images_total}"),
-                    ("photos used",
-                     f"{cal.images_used}" + (f" ({skipped} of another size skipped)" if skipped else "")),
-                    ("image size [px]", f"{cal.camera.width}x{cal.camera.height}"), *_cam_rows("", cal)]
-        for k, v in rows:
-            t.add_row(escape(k), v)
-        console.print(t)
+            fail(write_error(target, e))
+        console.print(_table(cal, stereo, square, folder))
         console.print(f"wrote {target}")
         write_json(json_path, {**cal.to_dict(), "file": str(target), "folder": str(folder)})
+
+
+def _table(cal, stereo: bool, square: float, folder: Path):
+    """The figures of a camera (or stereo rig) calibration as a table."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    t = Table(title=f"{'stereo rig' if stereo else 'camera'} calibration from {folder}")
+    t.add_column("quantity")
+    t.add_column("value", justify="right")
+    if stereo:
+        unit = "m" if square != 1.0 else "squares"
+        rows = [("stereo RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
+                ("mean epipolar error [px]", f"{cal.epipolar_px:.3f}"),
+                ("pairs with the board in both", f"{cal.pairs_used} of {cal.pairs_total}"),
+                (f"baseline [{unit}]", f"{cal.baseline_m:.4f}"),
+                (f"T [{unit}]", " ".join(f"{v:+.4f}" for v in cal.T)),
+                ("left / right RMS [px]", f"{cal.left.rms_px:.3f} / {cal.right.rms_px:.3f}"),
+                ("image size [px]", f"{cal.left.camera.width}x{cal.left.camera.height}"),
+                *_cam_rows("left ", cal.left), *_cam_rows("right ", cal.right)]
+    else:
+        skipped = cal.images_found - cal.images_used
+        rows = [("RMS reprojection error [px]", f"{cal.rms_px:.3f}"),
+                ("photos with the board", f"{cal.images_found} of {cal.images_total}"),
+                ("photos used",
+                 f"{cal.images_used}" + (f" ({skipped} of another size skipped)" if skipped else "")),
+                ("image size [px]", f"{cal.camera.width}x{cal.camera.height}"), *_cam_rows("", cal)]
+    for k, v in rows:
+        t.add_row(escape(k), v)
+    return t

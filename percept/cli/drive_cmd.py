@@ -12,7 +12,7 @@ from rich.table import Table
 from percept.sensors.records import Source
 
 from . import options as opt
-from .common import check_outputs, console, fail, fmt, progress_bar, write_json
+from .common import check_outputs, console, fail, fmt, on_interrupt, progress_bar, write_json
 
 
 def drive(
@@ -27,6 +27,12 @@ def drive(
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd).")] = None,
     no_record: Annotated[bool, typer.Option("--no-record", help="Do not write a Rerun recording.")] = False,
+    camera_hz: Annotated[float, typer.Option("--camera-hz", help="Camera images stored per simulated second in "
+                                             "the recording (15 = every frame).")] = 5.0,
+    camera_quality: Annotated[int, typer.Option("--camera-quality", help="JPEG quality of the recorded camera "
+                                                "images, 1 to 100.")] = 70,
+    camera_scale: Annotated[float, typer.Option("--camera-scale", help="Recorded image size relative to the "
+                                                "camera's, 0.1 to 1.")] = 0.75,
     json_path: opt.JsonOut = None,
 ):
     """Drive a scenario in closed loop from the cameras, score it against ground truth and record it to Rerun."""
@@ -41,32 +47,48 @@ def drive(
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
     check_outputs([rec_path, json_path])
-    holder = {}
-
-    def make_recorder(world):
-        from percept.review import RunRecorder
-
-        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
-        holder["r"] = RunRecorder(rec_path, world.cfg.rig, lines, cfg.tasks)
-        return holder["r"]
-
+    recording = Recording(rec_path, cfg.tasks, camera_hz, camera_quality, camera_scale)
     with progress_bar() as bar:
         task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)
         try:
             # frames are rendered when a slot or the recording needs them
-            result = run_drive(cfg, recorder_factory=make_recorder if rec_path else None,
+            result = run_drive(cfg, recorder_factory=recording.open if rec_path else None,
                                progress=lambda i, n: bar.update(task, completed=i, total=n),
                                render=rec_path is not None or cfg.needs_cameras)
         except BaseException:
-            if "r" in holder:
-                holder["r"].close(complete=False)
+            recording.close(complete=False)
             raise
-    if "r" in holder:
-        holder["r"].close()
+    recording.close()
     write_json(json_path, result)
     console.print(summary_table(cfg, result))
     if rec_path:
         console.print(f"recording: {rec_path}  (open it with `percept view {rec_path}`)")
+
+
+class Recording:
+    """The run's recording: options checked before the run, the recorder made once the world exists
+    (``open``), closed complete or partial; says what Ctrl-C keeps."""
+
+    def __init__(self, path: Optional[Path], tasks, camera_hz: float, quality: int, scale: float):
+        from percept.review import RecordOptions, partial_path
+
+        opt.check_number("--camera-hz", camera_hz, 0.01, 1000)
+        opt.check_number("--camera-quality", quality, 1, 100)
+        opt.check_number("--camera-scale", scale, 0.1, 1)
+        self.path, self.tasks, self.options, self.recorder = path, tasks, RecordOptions(camera_hz, quality, scale), None
+        on_interrupt(f"the recording so far is kept as {partial_path(path)}; no JSON was written" if path else
+                     "nothing was written")
+
+    def open(self, world):
+        from percept.review import RunRecorder
+
+        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
+        self.recorder = RunRecorder(self.path, world.cfg.rig, lines, self.tasks, self.options)
+        return self.recorder
+
+    def close(self, complete: bool = True) -> None:
+        if self.recorder is not None:
+            self.recorder.close(complete=complete)
 
 
 def summary_table(cfg, result: dict) -> Table:
@@ -86,6 +108,6 @@ def summary_table(cfg, result: dict) -> Table:
     if task_stops := result.get("pedestrians", {}).get("stops"):
         t.add_row("pedestrians", "stopped for crossings", f"{sum(task_stops)} of {len(task_stops)}")
     timing = result["timing_ms"]
-    t.add_row("timing", "render [ms/frame]", fmt(timing["render"]))
-    t.add_row("", "perception [ms/frame]", fmt(timing["perception_total"]))
+    t.add_row("timing", escape("render [ms/frame]"), fmt(timing["render"]))
+    t.add_row("", escape("perception [ms/frame]"), fmt(timing["perception_total"]))
     return t

@@ -13,13 +13,14 @@ from rich.table import Table
 from percept.sensors.records import Source
 
 from . import options as opt
-from .common import check_outputs, console, fail, fmt, progress_bar, write_json
+from .common import check_outputs, console, err, fail, fmt, on_interrupt, progress_bar, write_json
 
 
 def eval_(
     scenario: Annotated[List[str], typer.Option("--scenario", help="Scenario name; repeat for several, or 'all'.")],
     out: Annotated[Path, typer.Option("--out", file_okay=False, help="Output folder: runs/<scenario>-<condition>-"
-                                      "<seed>.json and summary.json. Runs already there are reused (resume).")],
+                                      "<seed>.json and summary.json. Runs already there with the same settings are "
+                                      "reused (resume); runs made with other settings stop the batch (see --redo).")],
     seeds: Annotated[str, typer.Option("--seeds", help="Seeds: A-B (inclusive), N, or A,B,C.")] = "0-4",
     condition: Annotated[List[str], typer.Option("--condition", help="Condition; repeat for several.")] = ["clear"],
     workers: Annotated[int, typer.Option("--workers", help="Parallel runs on this machine (local engine), 1 to "
@@ -33,17 +34,23 @@ def eval_(
     pedestrians: opt.Pedestrians = Source.PRIVILEGED,
     odometry: opt.Odometry = Source.PRIVILEGED,
     json_path: opt.JsonOut = None,
+    redo: Annotated[bool, typer.Option("--redo", help="Drive again the runs in --out that were made with other "
+                                                      "settings (other slots, duration or percept version).")] = False,
 ):
     """Drive every (scenario, condition, seed) and summarise the metrics per scenario and condition.
 
-    Each finished run is written at once, so an interrupted batch keeps its runs and the same command
-    resumes it; a run that fails is listed with its error and the others go on.
+    Each finished run is written at once (complete or absent), so an interrupted batch keeps its runs and the
+    same command resumes it. A run is reused only if it was made with the same settings (slots, duration, percept
+    version); a damaged run file is listed and driven again. A run that fails is listed with its error, the others
+    go on, and the exit code is 1.
     """
     from percept.drive import TASKS
-    from percept.drive.batch import Engine, EvalPlan, evaluate, parse_seeds
+    from percept.drive.batch import Engine, EvalPlan, parse_seeds, refuse_other_settings, scan_runs
+    from percept.drive.config import MAX_DURATION_S
     from percept.sims import SCENARIOS
 
     opt.check_number("--workers", workers, 1, 256)
+    opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
     names = list(SCENARIOS) if "all" in scenario else scenario
     try:
         eng = Engine(engine)
@@ -52,22 +59,53 @@ def eval_(
     try:
         plan = EvalPlan(tuple(dict.fromkeys(names)), tuple(dict.fromkeys(condition)), tuple(parse_seeds(seeds)),
                         opt.slot_sources(lateral, longitudinal, pedestrians, odometry), duration)
+        files = scan_runs(plan, out)
+        if not redo:
+            refuse_other_settings(files, out)
     except ValueError as e:
         fail(str(e))
-    check_outputs([out / "summary.json", json_path])
+    check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
+    for path, why in files.damaged:
+        err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
+    summary = _run(plan, out, workers, eng, address, redo, files)
+    console.print(summary_table(summary, TASKS))
+    console.print(f"all metrics per scenario and condition (mean / max / min): {out / 'summary.json'}")
+    write_json(json_path, summary)
+    _report_failures(summary, len(plan.jobs), out)
+
+
+def _report_failures(summary: dict, total: int, out: Path) -> None:
+    """List the failed runs, then exit with code 1 saying how many failed (nothing when none did)."""
+    failed = [(g, f) for g in summary["groups"] for f in g["failed"]]
+    for g, f in failed:
+        console.print(f"[red]failed[/] {escape(g['scenario'])}/{g['condition']}/seed {f['seed']}: "
+                      f"{escape(f['error'])}", soft_wrap=True)
+    if failed:
+        err.print(f"[bold red]error:[/] {len(failed)} of {total} runs failed (listed above); the others are kept in "
+                  f"{escape(str(out / 'runs'))} and the same command drives the failed ones again",
+                  highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
+
+
+def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict:
+    """The batch under a progress bar; Ctrl-C says how many finished runs are kept."""
+    from percept.drive.batch import evaluate
+
+    kept = [0]
+
+    def advance(r: dict) -> None:
+        kept[0] += "error" not in r
+        bar.advance(task)
+
+    on_interrupt(lambda: f"{kept[0]} finished runs kept in {out / 'runs'}; run the same command to resume")
     with progress_bar() as bar:
         task = bar.add_task(f"eval {len(plan.jobs)} runs", total=len(plan.jobs))
         try:
-            summary = evaluate(plan, out, workers, eng, address, progress=lambda r: bar.advance(task))
-        except RuntimeError as e:
+            return evaluate(plan, out, workers, eng, address, progress=advance, redo=redo, files=files)
+        except (RuntimeError, ValueError) as e:
             fail(str(e))
-    console.print(summary_table(summary, TASKS))
-    console.print(f"all metrics per scenario and condition (mean / max / min): {out / 'summary.json'}")
-    for g in summary["groups"]:
-        for f in g["failed"]:
-            console.print(f"[red]failed[/] {escape(g['scenario'])}/{g['condition']}/seed {f['seed']}: "
-                          f"{escape(f['error'])}")
-    write_json(json_path, summary)
+        except OSError as e:
+            fail(f"cannot write into {out}: {e.strerror or e}; the finished runs are kept, the same command resumes")
 
 
 def summary_table(summary: dict, tasks) -> Table:

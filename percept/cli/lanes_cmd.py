@@ -5,12 +5,15 @@ Registered on the main typer app by ``percept.cli.app``; parses options, calls `
 
 from __future__ import annotations
 
+import contextlib
+import itertools
 import math
 import time
 from pathlib import Path
 from typing import Optional
 
 import typer
+from rich.markup import escape
 
 
 def register(app: typer.Typer) -> None:
@@ -25,39 +28,53 @@ def register(app: typer.Typer) -> None:
                                                                "NAME.lanes.mp4 for a video."),
         calib: Optional[Path] = typer.Option(None, "--calib", help="Calibration JSON from `percept calibrate`: "
                                                                    "undistort and use its intrinsics."),
-        mount_height: float = typer.Option(1.2, "--mount-height", help="Camera height above the road in metres; "
-                                                                       "scales the metric values."),
-        hfov: float = typer.Option(60.0, "--hfov", help="Horizontal field of view in degrees, used without --calib."),
-        speed: float = typer.Option(0.0, "--speed", help="Assumed speed in m/s for tracking through a video "
-                                                         "(0: no motion model)."),
-        max_frames: Optional[int] = typer.Option(None, "--max-frames", help="Process at most this many video frames."),
+        mount_height: float = typer.Option(1.2, "--mount-height", help="Camera height above the road in metres, 0.2 "
+                                                                       "to 10; scales the metric values."),
+        hfov: float = typer.Option(60.0, "--hfov", help="Horizontal field of view in degrees (3 to 177), used "
+                                                        "without --calib."),
+        speed: float = typer.Option(0.0, "--speed", help="Assumed speed in m/s (0 to 100) for tracking through a "
+                                                         "video (0: no motion model)."),
+        max_frames: Optional[int] = typer.Option(None, "--max-frames", help="Process at most this many video frames "
+                                                                          "(at least 1)."),
     ):
-        """Fit the ego lane on recorded footage; pitch and horizon come from the lane lines' vanishing point."""
-        from percept.cli.common import fail
+        """Fit the ego lane on recorded footage; pitch and horizon come from the lane lines' vanishing point.
+
+        The JSON and every overlay are written complete or not at all: an error, a full disk or Ctrl-C leaves the
+        files that were there untouched. Overlays of a folder are written one by one as each image is done.
+        """
+        from percept.cli.common import check_outputs, fail
+        from percept.cli.options import check_number
         from percept.lanes.realworld import FootageLanes, RealLaneConfig
         from percept.sensors import CameraCalibration, FootageKind, list_footage
 
-        if max_frames is not None and max_frames < 1:
-            fail(f"--max-frames must be at least 1, got {max_frames}")
+        check_number("--mount-height", mount_height, 0.2, 10.0)
+        check_number("--hfov", hfov, 3.0, 177.0)
+        check_number("--speed", speed, 0.0, 100.0)
+        check_number("--max-frames", max_frames, 1, 10**7)
         try:
             cfg = RealLaneConfig(hfov_rad=math.radians(hfov), mount_height_m=mount_height, speed_mps=speed)
             cal = CameraCalibration.load(calib) if calib is not None else None
             kind, files = list_footage(source)
         except ValueError as e:
             fail(str(e))
-        if out is not None:
-            try:
-                out.mkdir(parents=True, exist_ok=True)
-            except OSError as e:
-                fail(f"cannot create {out}: {e.strerror or e}")
+        video = kind is FootageKind.VIDEO
+        overlays = [] if out is None else [_overlay_path(out, p, video) for p in files]
+        if out is not None and out.exists() and not out.is_dir():
+            fail(f"--out {out} is a file; give a folder for the overlays")
+        check_outputs([json_path, *overlays], [*files, calib])
         runner = FootageLanes(cfg, cal)
         header = {"source": str(source), "kind": kind.value, "calibration": None if calib is None else str(calib),
                   "mount_height_m": mount_height, "hfov_deg": None if cal is not None else hfov,
                   "assumed_speed_mps": speed}
-        if kind is FootageKind.VIDEO:
+        if video:
             _run_video(runner, files[0], out, json_path, max_frames, header)
         else:
             _run_images(runner, files, out, json_path, header, single=source.is_file())
+
+
+def _overlay_path(out: Path, source: Path, video: bool) -> Path:
+    return out / f"{source.stem}.lanes{'.mp4' if video else '.png'}"
+
 
 def _record(result, **keys) -> dict:
     return {**keys, **result.to_dict()}
@@ -72,25 +89,36 @@ def _summary(records: list[dict], ms: list[float]) -> dict:
 
 
 def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
-    from percept.cli.common import console
+    from percept.cli.common import console, fmt
 
+    ms = summary["ms_per_frame_median"]
     console.print(f"{title}: lane found in {summary['lane_found']} of {summary['count']}, both boundaries in "
                   f"{summary['both_boundaries']}" + (f", {summary['errors']} unreadable" if summary["errors"] else "")
-                  + (f"; {summary['ms_per_frame_median']:.0f} ms each (median)"
-                     if summary["ms_per_frame_median"] else ""))
+                  + (f"; {fmt(ms, '{:.0f}')} ms each (median)" if ms else ""))
     if out is not None:
         console.print(f"overlays in {out}")
 
 
-def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,
-                single: bool) -> None:
+def _write_overlay(target: Path, image) -> None:
+    """One overlay PNG, complete or absent (encoded in memory, then written atomically)."""
     import cv2
 
-    from percept.cli.common import err, fail, progress_bar, write_json
+    from percept.outputs import write_bytes_atomic
+
+    ok, buf = cv2.imencode(".png", image)
+    if not ok:
+        raise OSError(f"cannot encode the overlay {target.name} as PNG")
+    write_bytes_atomic(target, buf.tobytes())
+
+
+def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,
+                single: bool) -> None:
+    from percept.cli.common import err, fail, on_interrupt, progress_bar, write_error, write_json
     from percept.lanes.overlay import draw_overlay
     from percept.sensors import read_image
 
-    records, ms, problem = [], [], None
+    records, ms, done = [], [], []
+    on_interrupt(lambda: f"{len(done)} overlay(s) kept in {out}; no JSON was written" if done else None)
     with progress_bar() as bar:
         task = bar.add_task("lanes on images", total=len(files))
         for path in files:
@@ -101,89 +129,97 @@ def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optio
                 ms.append(1000 * (time.perf_counter() - t0))
             except ValueError as e:
                 if single:
-                    problem = str(e)
-                    break
-                err.print(f"[yellow]skipped:[/] {e}", highlight=False)
+                    fail(str(e))
+                err.print(f"[yellow]skipped:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
                 records.append({"file": str(path), "error": str(e)})
                 bar.advance(task)
                 continue
             records.append(_record(result, file=str(path)))
             if out is not None:
-                target = out / f"{path.stem}.lanes.png"
-                if not cv2.imwrite(str(target), draw_overlay(runner.prepare(image), result, path.name)):
-                    problem = f"cannot write {target}"
-                    break
+                target = _overlay_path(out, path, video=False)
+                try:
+                    _write_overlay(target, draw_overlay(runner.prepare(image), result, path.name))
+                except OSError as e:
+                    kept = f"; {len(done)} overlay(s) before it are kept" if done else ""
+                    fail(f"{write_error(target, e)}{kept}; no JSON was written")
+                done.append(target)
             bar.advance(task)
     summary = _summary(records, ms)
-    write_json(json_path, {**header, "results": records, "summary": summary})
-    if problem is not None:
-        fail(problem)
     if summary["count"] == 0:
-        fail(f"none of the {len(files)} images could be read")
+        fail(f"none of the {len(files)} images could be read; no JSON was written")
+    write_json(json_path, {**header, "results": records, "summary": summary})
     _print_summary(f"{len(files)} image(s)", summary, out)
 
 
-def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict) -> None:
-    from percept.cli.common import err, fail, progress_bar, write_json
+def _lanes_on_video(runner, video, path: Path, writer) -> tuple[list[dict], list[float]]:
+    """Records and per-frame times of the lane module over ``video``; ValueError naming ``path`` when a frame
+    cannot be used (e.g. another size than the calibration)."""
+    from percept.cli.common import progress_bar
     from percept.lanes.overlay import draw_overlay
+
+    records, ms, fps = [], [], video.fps
+    with progress_bar() as bar:
+        task = bar.add_task(f"lanes on {path.name}", total=video.expected_frames)
+        stream = runner.video(video, fps)
+        for i in itertools.count():
+            t0 = time.perf_counter()
+            try:
+                item = next(stream, None)
+            except ValueError as e:
+                raise ValueError(f"{path}: {e}") from None
+            if item is None:
+                return records, ms
+            ms.append(1000 * (time.perf_counter() - t0))
+            image, result = item
+            records.append(_record(result, file=str(path), frame=i, time_s=round(i / fps, 4)))
+            if writer is not None:
+                writer.write(draw_overlay(image, result, f"{path.name} #{i}"))
+            bar.advance(task)
+
+
+def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict) -> None:
+    from percept.cli.common import console, err, fail, on_interrupt, write_error, write_json
+    from percept.outputs import atomic_path
     from percept.sensors import open_video
 
     try:
         video = open_video(path, max_frames)
     except ValueError as e:
         fail(str(e))
-    fps = video.fps
-    writer, target = _open_writer(out, path.stem, fps, video.size) if out is not None else (None, None)
-    records, ms, problem = [], [], None
+    target = None if out is None else _overlay_path(out, path, video=True)
+    on_interrupt("nothing was written (the overlay video and the JSON are written only when complete)")
     try:
-        with progress_bar() as bar:
-            task = bar.add_task(f"lanes on {path.name}", total=video.expected_frames)
-            stream = runner.video(video, fps)
-            i = 0
-            while True:
-                t0 = time.perf_counter()
-                try:
-                    item = next(stream, None)
-                except ValueError as e:
-                    problem = f"{path}: {e}"
-                    break
-                if item is None:
-                    break
-                ms.append(1000 * (time.perf_counter() - t0))
-                image, result = item
-                records.append(_record(result, file=str(path), frame=i, time_s=round(i / fps, 4)))
+        with contextlib.ExitStack() as stack:
+            tmp = None if target is None else stack.enter_context(atomic_path(target))
+            writer = None if tmp is None else _open_writer(tmp, video.fps, video.size)
+            try:
+                records, ms = _lanes_on_video(runner, video, path, writer)
+            finally:
+                video.close()
                 if writer is not None:
-                    writer.write(draw_overlay(image, result, f"{path.name} #{i}"))
-                i += 1
-                bar.advance(task)
-    finally:
-        video.close()
-        if writer is not None:
-            writer.release()
+                    writer.release()
+    except ValueError as e:
+        fail(f"{e}; nothing was written")
+    except OSError as e:
+        fail(write_error(target, e))
     if video.ended_early:
-        err.print(f"[yellow]warning:[/] {path} ended after {video.frames_read} of the {video.declared_frames} frames "
-                  "its header declares (truncated or damaged?)", highlight=False)
+        err.print(f"[yellow]warning:[/] {escape(str(path))} ended after {video.frames_read} of the "
+                  f"{video.declared_frames} frames its header declares (truncated or damaged?)", highlight=False,
+                  soft_wrap=True)
     summary = _summary(records, ms)
-    write_json(json_path, {**header, "fps": fps, "frames": len(records), "frames_declared": video.declared_frames,
-                           "ended_early": video.ended_early,
+    write_json(json_path, {**header, "fps": video.fps, "frames": len(records),
+                           "frames_declared": video.declared_frames, "ended_early": video.ended_early,
                            "overlay": None if target is None else str(target), "results": records, "summary": summary})
-    if problem is not None:
-        fail(problem)
     _print_summary(f"{len(records)} frame(s) of {path.name}", summary, None)
     if target is not None:
-        from percept.cli.common import console
         console.print(f"overlay video: {target}")
 
 
-def _open_writer(out: Path, stem: str, fps: float, size: tuple[int, int]):
-    """An mp4v .mp4 writer, or MJPG .avi when this OpenCV build cannot write mp4."""
+def _open_writer(tmp: Path, fps: float, size: tuple[int, int]):
+    """An mp4v writer on the temporary ``tmp`` (.mp4); OSError when this OpenCV build cannot write mp4v."""
     import cv2
 
-    from percept.cli.common import fail
-
-    for fourcc, ext in (("mp4v", ".mp4"), ("MJPG", ".avi")):
-        target = out / f"{stem}.lanes{ext}"
-        w = cv2.VideoWriter(str(target), cv2.VideoWriter_fourcc(*fourcc), fps, size)
-        if w.isOpened():
-            return w, target
-    fail(f"cannot write a video into {out} (neither mp4v nor MJPG is available)")
+    w = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), fps, size)
+    if not w.isOpened():
+        raise OSError(f"this OpenCV build cannot write mp4v video into {tmp.parent}")
+    return w

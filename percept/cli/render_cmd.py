@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from . import options as opt
-from .common import console, fail, progress_bar
+from .common import console, fail, on_interrupt, progress_bar
 
 
 def render(
@@ -19,27 +19,35 @@ def render(
     seed: opt.Seed = 0,
     condition: opt.Condition = "clear",
     scenery: Annotated[bool, typer.Option(help="Roadside clutter (rails, poles, trees, buildings).")] = True,
+    force: Annotated[bool, typer.Option("--force", help="Replace an earlier render in --out (its files are removed "
+                                                        "first; other files still refuse the folder).")] = False,
 ):
     """Render stereo PNGs, depth and ground truth of a scenario; the ego is driven by highway-env's IDM autopilot.
 
     Writes for frame i: DIR/{i:06d}_left.png, _right.png (absent when the frame was dropped), _depth.npy
     (float32 metres, inf for sky), _gt.json; plus DIR/camera.json and, with landmark signs, DIR/landmarks.json.
+    Each frame's files are complete or absent, also when the render is stopped; a folder that already holds files
+    is refused unless --force.
     """
     from percept.sims import SimWorld, WorldConfig
-    from percept.sims.export import prepare_out_dir, render_run
+    from percept.sims.export import prepare_out_dir, render_run, written
 
     opt.check_number("--frames", frames, 1, 10**6)
     opt.check_number("--seed", seed, 0, opt.MAX_SEED)
     try:
         cfg = WorldConfig(scenario=scenario, seed=seed, condition=condition, autopilot=True, scenery=scenery)
-        prepare_out_dir(out)
+        prepare_out_dir(out, force)
     except ValueError as e:
         fail(str(e))
+    kept = lambda: f"{written(out)} complete frames kept in {out}; --force starts over in the same folder"  # noqa: E731
+    on_interrupt(kept)
     world = SimWorld(cfg)
     with progress_bar() as bar:
         task = bar.add_task(f"rendering {scenario}/{cfg.condition.value}/seed {seed}", total=frames)
         try:
             render_run(world, frames, out, progress=lambda: bar.advance(task))
-        except (ValueError, OSError) as e:
+        except ValueError as e:
             fail(str(e))
+        except OSError as e:
+            fail(f"cannot write into {out}: {e.strerror or e}; {kept()}")
     console.print(f"wrote {frames} frames to {out}")

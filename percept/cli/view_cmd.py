@@ -1,10 +1,13 @@
 """`percept view RUN.rrd`: open a recording in the Rerun viewer (the one installed with rerun-sdk).
 
-Registered on the main typer app by ``percept.cli.app``.
+Registered on the main typer app by ``percept.cli.app``. The recording is checked first (``rerun rrd verify``), so
+that an empty or corrupt file is reported as such rather than as a viewer or display failure. The viewer's servers
+listen on 127.0.0.1 unless ``--bind`` says otherwise.
 """
 
 from __future__ import annotations
 
+import ipaddress
 import os
 import shutil
 import subprocess
@@ -13,11 +16,53 @@ from pathlib import Path
 
 import typer
 
+from .common import fail
+
+RRD_MAGIC = b"RRF"
+"""Every .rrd file starts with these bytes (then the format version)."""
+
 
 def rerun_executable() -> str | None:
     """The ``rerun`` viewer beside this Python (the rerun-sdk wheel installs it there), else on PATH."""
     exe = Path(sys.executable).with_name("rerun")
     return str(exe) if exe.exists() else shutil.which("rerun")
+
+
+def rerun_env() -> dict:
+    return {**os.environ, "RERUN_ANALYTICS": os.environ.get("RERUN_ANALYTICS", "0")}
+
+
+def recording_problem(exe: str, recording: Path) -> str | None:
+    """Why ``recording`` is not a valid Rerun recording (one line), or None when ``rerun rrd verify`` accepts it."""
+    with open(recording, "rb") as f:
+        head = f.read(len(RRD_MAGIC))
+    if not head:
+        return "the file is empty"
+    if head != RRD_MAGIC:
+        return "it does not start like a Rerun recording"
+    try:
+        r = subprocess.run([exe, "rrd", "verify", str(recording)], env=rerun_env(), capture_output=True, text=True)
+    except OSError as e:
+        return f"cannot run `rerun rrd verify` ({e.strerror or e})"
+    # verify exits 0 on files it cannot read at all ("0 files verified"), so its count is checked too
+    if r.returncode == 0 and "1 file verified" in r.stdout + r.stderr:
+        return None
+    lines = [ln.strip() for ln in (r.stdout + r.stderr).splitlines() if ln.strip() and "INFO" not in ln]
+    why = next((ln for ln in lines if not ln.startswith("Error: Verification failed")), "it cannot be read")
+    why = why.removeprefix("Error: ")
+    if why.startswith('"'):  # '"FILE": what is wrong'
+        why = why.split(": ", 1)[-1]
+    return why if len(why) <= 120 else why[:119] + "…"
+
+
+def check_bind(bind: str) -> str:
+    """The bind address as given, if it is an IP address (what the rerun CLI's --bind takes)."""
+    try:
+        ipaddress.ip_address(bind)
+    except ValueError:
+        fail(f"--bind must be an IP address such as 127.0.0.1 (this machine only) or 0.0.0.0 (every interface), "
+             f"got '{bind}'")
+    return bind
 
 
 def register(app: typer.Typer) -> None:
@@ -28,10 +73,12 @@ def register(app: typer.Typer) -> None:
         recording: Path = typer.Argument(..., help="A recording from `percept drive` (RUN.rrd)."),
         web: bool = typer.Option(False, "--web", help="Serve the web viewer instead of opening a window (for a "
                                                       "machine without a display; open the printed address)."),
+        bind: str = typer.Option("127.0.0.1", "--bind", metavar="ADDR",
+                                 help="IP address the viewer's servers listen on (0.0.0.0: every interface, to "
+                                      "open --web from another machine)."),
     ):
         """Open a recording in the Rerun viewer, with the blueprint it was recorded with."""
-        from percept.cli.app import fail
-
+        bind = check_bind(bind)
         if not recording.is_file():
             fail(f"{recording} does not exist; record one with `percept drive --record {recording}`")
         if recording.suffix != ".rrd":
@@ -39,10 +86,12 @@ def register(app: typer.Typer) -> None:
         exe = rerun_executable()
         if exe is None:
             fail("the Rerun viewer is not installed: pip install rerun-sdk")
-        cmd = [exe, *(["--web-viewer"] if web else []), str(recording)]
+        problem = recording_problem(exe, recording)
+        if problem is not None:
+            fail(f"{recording} is not a valid Rerun recording ({problem}); record it again with `percept drive`")
+        cmd = [exe, "--bind", bind, *(["--web-viewer"] if web else []), str(recording)]
         try:
-            code = subprocess.run(cmd, env={**os.environ, "RERUN_ANALYTICS": os.environ.get("RERUN_ANALYTICS", "0")}
-                                  ).returncode
+            code = subprocess.run(cmd, env=rerun_env()).returncode
         except OSError as e:
             fail(f"cannot start the Rerun viewer ({e.strerror or e})")
         if code != 0:

@@ -25,7 +25,7 @@ MAX_ACCEL_MPS2 = 2.5
 @dataclass(frozen=True)
 class EmergencyBrakingDebug:
     """terms: every active term [m/s²] by name (follow, yield, emergency, hold, commitment); limited_by: the one
-    that set the command (or "speed_limit"/"brake_limit" when clipped); stop_in_m: distance left to a committed
+    that set the command (or "brake_limit"/"accel_limit" when clipped); stop_in_m: distance left to a committed
     stop [m] (None without one); command_mps2: the final command."""
 
     terms: dict
@@ -75,7 +75,7 @@ class EmergencyBraking(Controller):
             a = max(a, 0.0) if a > -1e-3 else a
         out = float(np.clip(a, -MAX_BRAKE_MPS2, MAX_ACCEL_MPS2))
         if out != a:
-            name = "speed_limit" if out > a else "brake_limit"
+            name = "brake_limit" if out > a else "accel_limit"
         return out, EmergencyBrakingDebug(terms, name, stop_in, out)
 
     def _commit(self, target: Target | None, v: float) -> None:

@@ -1,15 +1,18 @@
 """Batch evaluation: the closed loop over scenarios x conditions x seeds, one run JSON each, and a summary.
 
 Runs go to worker processes (``workers``, one OpenCV thread each) or to a Ray cluster. Each finished run is
-written at once to ``OUT/runs/<scenario>-<condition>-<seed>.json`` (a temporary name, then renamed), so an
-interrupted batch keeps what it finished, and running the same batch again reuses those files. A run that
-fails is reported in the summary with its error; the others go on.
+written at once (atomically) to ``OUT/runs/<scenario>-<condition>-<seed>.json``, so an interrupted batch keeps
+what it finished and the same batch again reuses it. A failed run is reported in the summary (not written: the
+next batch drives it again); the others go on. Resume never mixes settings: each run file and the summary carry
+``settings`` (everything but the scenario, condition and seed that changes a result); damaged run files are
+redone, runs made with other settings refused before any work unless ``redo``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
-import os
+import signal
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -21,6 +24,7 @@ from typing import Callable, Iterator
 import cv2
 import numpy as np
 
+from percept.outputs import write_json_atomic
 from percept.sims import WorldConfig
 
 from .config import DriveConfig
@@ -93,6 +97,38 @@ class EvalPlan:
         return [Job(sc, c, s) for sc in self.scenarios for c in self.conditions for s in self.seeds]
 
 
+def run_settings(plan: EvalPlan) -> dict:
+    """Everything besides the scenario, condition and seed that changes a run's result (a JSON object; two runs
+    are comparable only if theirs are equal): percept version, duration, slot sources, rendering, world options."""
+    from importlib.metadata import version
+
+    cfg = plan.config(plan.jobs[0])
+    return {"percept": version("percept"), "duration_s": plan.duration_s,
+            "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
+            "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
+                      "autopilot": cfg.world.autopilot}}
+
+
+def differences(now: dict, then) -> list[str]:
+    """How the settings ``then`` of a stored run differ from ``now``: 'slots lateral=vision (now privileged)'."""
+    if not isinstance(then, dict):
+        return ["no settings recorded (made by an older percept)"]
+    diff = []
+    for k, v in now.items():
+        old = then.get(k)
+        if isinstance(v, dict) and isinstance(old, dict):
+            diff += [f"{k} {n}={old.get(n)} (now {x})" for n, x in v.items() if old.get(n) != x]
+        elif old != v:
+            diff.append(f"{k} {'default' if old is None else old} (now {'default' if v is None else v})")
+    return diff
+
+
+def _worker_init() -> None:
+    """A worker process: one OpenCV thread; Ctrl-C is the parent's to handle (it terminates the workers)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    cv2.setNumThreads(1)
+
+
 def run_job(plan: EvalPlan, job: Job) -> dict:
     """Run one job (in a worker); the run JSON, or {"scenario", "condition", "seed", "error", "traceback"}."""
     cv2.setNumThreads(1)
@@ -108,11 +144,61 @@ def _run_path(out_dir: Path, job: Job) -> Path:
     return out_dir / "runs" / f"{job.name}.json"
 
 
-def _write(path: Path, data: dict) -> None:
-    """Write under a temporary name, then rename: a reader never sees half a file."""
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(data, indent=2))
-    os.replace(tmp, path)
+@dataclass
+class RunFiles:
+    """What ``OUT/runs`` holds for a plan: ``done`` runs to reuse (job -> run JSON), ``damaged`` files to redo
+    ((path, why)), runs made under ``other`` settings ((path, differing settings))."""
+
+    done: dict = field(default_factory=dict)
+    damaged: list = field(default_factory=list)
+    other: list = field(default_factory=list)
+
+
+def _read_run(path: Path, job: Job) -> tuple[dict | None, str | None]:
+    """(run JSON, None) or (None, why the file is not a finished run of ``job``)."""
+    try:
+        data = json.loads(path.read_text())
+    except UnicodeDecodeError:
+        return None, "not text"
+    except json.JSONDecodeError:
+        return None, "empty" if path.stat().st_size == 0 else "not JSON (truncated?)"
+    except OSError as e:
+        return None, f"unreadable ({e.strerror or e})"
+    if not isinstance(data, dict) or "error" in data or "frames" not in data:
+        return None, "not a percept run"
+    if (data.get("scenario"), data.get("condition"), data.get("seed")) != (job.scenario, job.condition, job.seed):
+        return None, f"a run of another job ({data.get('scenario')}-{data.get('condition')}-{data.get('seed')})"
+    return data, None
+
+
+def scan_runs(plan: EvalPlan, out_dir: Path) -> RunFiles:
+    """Sort the run files of ``plan`` in ``out_dir/runs``; ValueError when a folder (or the runs folder itself is a
+    file) is in the way."""
+    runs, found, settings = Path(out_dir) / "runs", RunFiles(), run_settings(plan)
+    if runs.exists() and not runs.is_dir():
+        raise ValueError(f"{runs} is a file where the runs folder belongs; move it away or choose another --out")
+    for job in plan.jobs:
+        path = _run_path(out_dir, job)
+        if not path.exists():
+            continue
+        if path.is_dir():
+            raise ValueError(f"{path} is a folder where a run file belongs; move it away or choose another --out")
+        data, why = _read_run(path, job)
+        if data is None:
+            found.damaged.append((path, why))
+        elif diff := differences(settings, data.get("settings")):
+            found.other.append((path, diff))
+        else:
+            found.done[job] = data
+    return found
+
+
+def refuse_other_settings(files: RunFiles, out_dir: Path) -> None:
+    """ValueError naming the settings that differ when ``files`` holds runs made with other settings."""
+    if files.other:
+        path, diff = files.other[0]
+        raise ValueError(f"{len(files.other)} run(s) in {Path(out_dir) / 'runs'} were made with other settings "
+                         f"(e.g. {path.name}: {'; '.join(diff)}); give a new --out, or --redo to drive them again")
 
 
 def _local(plan: EvalPlan, jobs: list[Job], workers: int) -> Iterator[tuple[Job, dict]]:
@@ -121,10 +207,28 @@ def _local(plan: EvalPlan, jobs: list[Job], workers: int) -> Iterator[tuple[Job,
             yield job, run_job(plan, job)
         return
     # spawned workers: no state (OpenCV threads, pygame) copied from this process
-    with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=_worker_init)
+    finished = False
+    try:
         futures = {pool.submit(run_job, plan, job): job for job in jobs}
         for f in as_completed(futures):
             yield futures[f], f.result()
+        finished = True
+    finally:
+        if finished:
+            pool.shutdown()
+        else:
+            _stop_pool(pool)
+
+
+def _stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Ctrl-C or an error: drop the queued runs and end the running ones now (a run takes seconds to finish)."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        p.terminate()
+    for p in processes:
+        p.join(timeout=1.0)
 
 
 def _ray(plan: EvalPlan, jobs: list[Job], address: str | None) -> Iterator[tuple[Job, dict]]:
@@ -137,35 +241,45 @@ def _ray(plan: EvalPlan, jobs: list[Job], address: str | None) -> Iterator[tuple
     # results travel back to this process, which writes them (cluster nodes need not share its disk)
     remote = ray.remote(num_cpus=1)(run_job)
     pending = {remote.remote(plan, job): job for job in jobs}
-    while pending:
-        done, _ = ray.wait(list(pending), num_returns=1)
-        job = pending.pop(done[0])
-        yield job, ray.get(done[0])
+    try:
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            job = pending.pop(done[0])
+            yield job, ray.get(done[0])
+    finally:
+        for ref in pending:  # Ctrl-C or an error: cancel what has not finished
+            with contextlib.suppress(Exception):
+                ray.cancel(ref, force=True)
 
 
 def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = Engine.LOCAL,
-             address: str | None = None, progress: Callable[[dict], None] | None = None) -> dict:
-    """Run every job of ``plan`` not already in ``out_dir/runs``; write and return the summary."""
+             address: str | None = None, progress: Callable[[dict], None] | None = None,
+             redo: bool = False, files: RunFiles | None = None) -> dict:
+    """Run every job of ``plan`` without a finished run of the same settings in ``out_dir/runs``; write and return
+    the summary. Damaged run files are redone; runs made under other settings raise ValueError before any work,
+    or are redone with ``redo``. ``files``: a ``scan_runs`` already made (the CLI reports it first)."""
     out_dir = Path(out_dir)
+    files = files if files is not None else scan_runs(plan, out_dir)
+    if not redo:
+        refuse_other_settings(files, out_dir)
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
-    results, todo = [], []
-    for job in plan.jobs:
-        done = _run_path(out_dir, job)
-        if done.exists():
-            results.append(json.loads(done.read_text()))
-            if progress:
-                progress(results[-1])
-        else:
-            todo.append(job)
-    stream = _local(plan, todo, workers) if Engine(engine) is Engine.LOCAL else _ray(plan, todo, address)
-    for job, r in stream:
-        if "error" not in r:
-            _write(_run_path(out_dir, job), r)
-        results.append(r)
+    settings = run_settings(plan)
+    results = list(files.done.values())
+    for r in results:
         if progress:
             progress(r)
-    summary = summarize(plan, results)
-    _write(out_dir / "summary.json", summary)
+    todo = [job for job in plan.jobs if job not in files.done]
+    stream = _local(plan, todo, workers) if Engine(engine) is Engine.LOCAL else _ray(plan, todo, address)
+    with contextlib.closing(stream):
+        for job, r in stream:
+            if "error" not in r:
+                r = {**r, "settings": settings}
+                write_json_atomic(_run_path(out_dir, job), r)
+            results.append(r)
+            if progress:
+                progress(r)
+    summary = {"settings": settings, **summarize(plan, results)}
+    write_json_atomic(out_dir / "summary.json", summary)
     return summary
 
 

@@ -28,7 +28,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     lm = world.landmark_map()
     agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed),
                   world.cruise_speed_mps)
-    scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.crossing_pedestrians,
+    scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians, world.crossing_pedestrians,
                                              agent.following.time_gap, world.dt)) for t in cfg.tasks}
     safety = SafetyScorer()
     recorder = recorder_factory(world) if recorder_factory else None

@@ -26,10 +26,11 @@ PHANTOM_DECEL_MPS2 = -3.0
 
 @dataclass(frozen=True)
 class ScoreContext:
-    """vision: the task's slot is a vision one (its estimates are scored); crossing_pedestrians: how many the
-    scenario has; time_gap_setting_s: the following law's setting; dt_s: frame period [s]."""
+    """vision: the task's slot is a vision one (its estimates are scored); pedestrians, crossing_pedestrians: how
+    many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting; dt_s: frame period [s]."""
 
     vision: bool
+    pedestrians: int
     crossing_pedestrians: int
     time_gap_setting_s: float
     dt_s: float
@@ -168,7 +169,9 @@ class PedestrianScorer:
     def result(self) -> dict:
         stops = [bool(self.crossing_stopped.get(k, False)) for k in sorted(self.crossing_seen)]
         return {"recall": None, "precision": None, "fppi": None, "first_detection_range_m": None,
-                "stops": stops if self.ctx.crossing_pedestrians else None, "false_stops": self.false_stops}
+                "stops": stops if self.ctx.crossing_pedestrians else None,
+                # false stops (for a person on the verge, or for nothing) are scored where there are pedestrians
+                "false_stops": self.false_stops if self.ctx.pedestrians else None}
 
 
 class OdometryScorer:

@@ -1,5 +1,7 @@
 """Review: Rerun recordings and blueprints (the only place that imports rerun)."""
 
-from .recorder import RunRecorder, blueprint
+from .blueprint import blueprint
+from .context import Part, PartContext, Plot, RecordOptions
+from .recorder import RunRecorder, partial_path
 
-__all__ = ["RunRecorder", "blueprint"]
+__all__ = ["Part", "PartContext", "Plot", "RecordOptions", "RunRecorder", "blueprint", "partial_path"]

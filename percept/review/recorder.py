@@ -1,139 +1,197 @@
-"""Rerun recording of a drive: calibration, camera image, 3D world, ego trajectory and time series.
+"""Rerun recording of a drive: what every run has, then one part per task (``percept.review.parts``).
 
-Timeline ``sim_time`` in simulation seconds. Entities: ``world/road`` (lane lines, static), ``world/ego``
-(pose), ``world/ego/camera/left`` (mount and pinhole, static; the JPEG image), ``world/objects`` (true 3D
-boxes), ``world/trajectory``, and ``plots/*`` scalars. With the vision lateral slot also what the lanes module
-saw: ``world/ego/camera/left/lanes`` (fitted boundaries in the image), ``.../evidence`` (marking points by
-side), ``world/ego/lanes`` (the boundaries on the ground) and ``plots/lane/*/{truth,vision}``. The file is
-written to a temporary name and moved into place when the recording closes, so a failed run never leaves a
-truncated file under the final name.
+Timeline ``sim_time`` in simulation seconds. Every recording has ``world`` (z up; object-kind annotation
+context), ``world/road`` (lane lines, static), ``world/ego`` (the ego pose, per frame; ``world/ego/body`` its
+box, static), ``world/ego/camera/left`` (mount and pinhole, static; the JPEG image at ``RecordOptions.camera_hz``),
+``world/ego/objects`` (true 3D boxes in the vehicle frame), ``world/ego/camera/left/objects`` (their true boxes in
+the image), ``world/trajectory`` (one true position per frame; the 3D view shows its whole past) and the control
+part's ``control/*``. Each task part adds ``<task>/*`` scalars and its drawings (see ``percept.review.context``).
+The file is written to a temporary name beside the target (``.RUN.rrd.part``) and moved into place by ``close``: a
+finished run becomes ``RUN.rrd``, an interrupted or failed one ``RUN.partial.rrd``, so a finished recording is
+never replaced by a truncated one.
 """
 
 from __future__ import annotations
 
+import importlib
+import math
 import os
+from dataclasses import replace
+from datetime import timedelta
 from pathlib import Path
 
 import cv2
 import numpy as np
 import rerun as rr
-import rerun.blueprint as rrb
 
-from percept.lanes.realworld import boundary_points_px
-from percept.sensors import Side, StereoRig
+from percept.sensors import ObjectKind, Side, StereoRig
+from percept.sensors.vehicle import EGO_LENGTH_M, EGO_WIDTH_M
 
-KIND_COLORS = {"vehicle": (70, 130, 230), "pedestrian": (240, 80, 60), "landmark": (250, 220, 60)}
-SIDE_COLORS = {1: (255, 220, 0), -1: (0, 160, 255), 0: (150, 150, 150)}
-"""Lane boundaries and their evidence: left, right, unassigned (RGB)."""
-LANE_DRAW_M = (4.0, 50.0)
-"""Range ahead over which fitted boundaries are drawn [m]."""
+from . import parts
+from .blueprint import TRAJECTORY, blueprint
+from .context import CAMERA, EGO, TIMELINE, Part, PartContext, RecordOptions
+
+OBJECTS = f"{EGO}/objects"
+KIND_CLASSES = {ObjectKind.VEHICLE: (1, (70, 130, 230)), ObjectKind.PEDESTRIAN: (2, (240, 80, 60)),
+                ObjectKind.LANDMARK: (3, (250, 220, 60))}
+"""Class id and RGB of each object kind (the annotation context at ``world``)."""
+TRAJECTORY_RGB = (60, 220, 90)
+EGO_HEIGHT_M = 1.5
+"""Height of the ego's box as drawn [m]."""
+BATCHING = dict(flush_tick=timedelta(seconds=5), flush_num_bytes=8 << 20)
+"""Few, large chunks: each chunk carries its own schema (about 2 KB), which the default batching (a chunk per
+entity every 200 ms of wall time) would repeat thousands of times in a file."""
 
 
-def blueprint() -> rrb.Blueprint:
-    return rrb.Blueprint(
-        rrb.Horizontal(
-            rrb.Vertical(rrb.Spatial2DView(name="left camera", origin="world/ego/camera/left"),
-                         rrb.TimeSeriesView(name="signals", origin="plots")),
-            rrb.Spatial3DView(name="world", origin="world"),
-            column_shares=[3, 2],
-        ),
-        collapse_panels=True,
-    )
+def resolve_part(spec):
+    """A task's ``recorder``: a callable, or "module:function" imported here."""
+    if callable(spec):
+        return spec
+    module, sep, name = str(spec).partition(":")
+    if not sep or not module or not name:
+        raise ValueError(f"a recorder part must be a callable or 'module:function', got {spec!r}")
+    try:
+        part = getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError) as e:
+        raise ValueError(f"cannot load the recorder part {spec!r}: {e}") from None
+    if not callable(part):
+        raise ValueError(f"the recorder part {spec!r} is not callable")
+    return part
+
+
+def partial_path(path: Path) -> Path:
+    """Where an interrupted recording of ``path`` is kept: RUN.rrd -> RUN.partial.rrd."""
+    return path.with_name(f"{path.stem}.partial{path.suffix or '.rrd'}")
 
 
 class RunRecorder:
-    """Logs one run. ``log_step`` per frame; ``close`` finalises the file."""
+    """Logs one run: ``log_step(frame, truth, step)`` per frame (Frame, StepTruth, AgentStep), then ``close``.
 
-    def __init__(self, path: Path, rig: StereoRig, lane_lines: list[np.ndarray], app_id: str = "percept",
-                 jpeg_quality: int = 70):
+    path: the recording (RUN.rrd); rig: the stereo rig; lane_lines: (N, 2) world polylines of the road's lane
+    lines [m]; tasks: the slot table entries to draw (each with a ``recorder`` part, or None for none);
+    options: what is stored of the camera. Also a context manager (an exception closes it as partial).
+    """
+
+    def __init__(self, path: Path, rig: StereoRig, lane_lines: list[np.ndarray], tasks,
+                 options: RecordOptions = RecordOptions(), app_id: str = "percept"):
         self.path = Path(path)
-        self.tmp = self.path.with_name(self.path.name + ".part")
-        self.rec = rr.RecordingStream(app_id)
-        self.rec.save(str(self.tmp), default_blueprint=blueprint())
-        self.quality = jpeg_quality
+        if not self.path.parent.is_dir():
+            raise ValueError(f"cannot record to {self.path}: the folder {self.path.parent} does not exist")
+        self.tmp = self.path.with_name(f".{self.path.name}.part")
+        self.options = options
+        self.parts = [(t.name, resolve_part(t.recorder)) for t in tasks if t.recorder is not None]
+        if any(name == "control" for name, _ in self.parts):
+            raise ValueError("a task may not be named 'control': the control part records under that name")
+        self.parts.append(("control", parts.control))
+        self.contexts = {name: PartContext(name, rig, image_scale=options.image_scale) for name, _ in self.parts}
         self.rig = rig
-        self.trajectory: list[list[float]] = []
-        rec = self.rec
+        self.closed_as: Path | None = None
+        self._bucket: int | None = None
+        self.tmp.unlink(missing_ok=True)  # left over from a run that was killed
+        self.rec = rr.RecordingStream(app_id, batcher_config=rr.ChunkBatcherConfig(**BATCHING))
+        self.rec.save(str(self.tmp), default_blueprint=blueprint(self.parts))
+        try:
+            self._log_static(lane_lines)
+        except BaseException:
+            self.rec.disconnect()
+            self.tmp.unlink(missing_ok=True)
+            raise
+
+    def _log_static(self, lane_lines: list[np.ndarray]) -> None:
+        rec, rig = self.rec, self.rig
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        rec.log("world", rr.AnnotationContext([(cid, kind.value, rgb) for kind, (cid, rgb) in KIND_CLASSES.items()]),
+                static=True)
         strips = [np.column_stack([p, np.zeros(len(p))]) for p in lane_lines]
         rec.log("world/road", rr.LineStrips3D(strips, colors=[(200, 200, 200)], radii=0.08), static=True)
-        cam = rig.camera
         # camera mount: vehicle_from_camera rotation is the transpose of cam_from_vehicle
-        R = rig.rotation_cam_from_vehicle().T
-        rec.log("world/ego/camera/left", rr.Transform3D(translation=rig.camera_position(Side.LEFT), mat3x3=R),
+        rec.log(CAMERA, rr.Transform3D(translation=rig.camera_position(Side.LEFT),
+                                       mat3x3=rig.rotation_cam_from_vehicle().T), static=True)
+        cam, s = rig.camera, self.options.image_scale
+        rec.log(CAMERA, rr.Pinhole(focal_length=[cam.fx * s, cam.fy * s], principal_point=[cam.cx * s, cam.cy * s],
+                                   resolution=[round(cam.width * s), round(cam.height * s)],
+                                   camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=2.0), static=True)
+        rec.log(TRAJECTORY, rr.Points3D.from_fields(colors=[TRAJECTORY_RGB], radii=[0.3]), static=True)
+        rec.log(f"{EGO}/body", rr.Boxes3D(centers=[[0, 0, EGO_HEIGHT_M / 2]],
+                                          sizes=[[EGO_LENGTH_M, EGO_WIDTH_M, EGO_HEIGHT_M]], colors=[TRAJECTORY_RGB]),
                 static=True)
-        rec.log("world/ego/camera/left", rr.Pinhole(focal_length=[cam.fx, cam.fy], principal_point=[cam.cx, cam.cy],
-                                                    resolution=[cam.width, cam.height],
-                                                    camera_xyz=rr.ViewCoordinates.RDF), static=True)
+        for name, part in self.parts:
+            if isinstance(part, Part):
+                part.style(rec, self.contexts[name])
 
-    def log_step(self, t_s: float, frame, gt, action: np.ndarray, lead_gap_m: float | None) -> None:
+    def log_step(self, frame, truth, step) -> None:
+        """One frame: ``frame`` (Frame), ``truth`` (StepTruth), ``step`` (AgentStep)."""
         rec = self.rec
-        rec.set_time("sim_time", duration=t_s)
+        rec.set_time(TIMELINE, duration=frame.timestamp_s)
+        gt = truth.truth
         e = gt.ego
-        rec.log("world/ego", rr.Transform3D(translation=[e.x_m, e.y_m, 0.0],
-                                            rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=e.yaw_rad)))
-        if frame.left is not None:
-            ok, jpg = cv2.imencode(".jpg", frame.left, [cv2.IMWRITE_JPEG_QUALITY, self.quality])
-            if ok:
-                rec.log("world/ego/camera/left", rr.EncodedImage(contents=jpg.tobytes(), media_type="image/jpeg"))
-        if gt.objects:
-            c, s = np.cos(e.yaw_rad), np.sin(e.yaw_rad)
-            centers, sizes, quats, colors, labels = [], [], [], [], []
-            for o in gt.objects:
-                x, y, z = o.position_m
-                centers.append([e.x_m + c * x - s * y, e.y_m + s * x + c * y, z])
-                sizes.append(list(o.size_m))
-                yaw = e.yaw_rad + o.yaw_rad
-                quats.append([0.0, 0.0, np.sin(yaw / 2), np.cos(yaw / 2)])
-                colors.append(KIND_COLORS.get(o.kind, (200, 200, 200)))
-                labels.append(f"{o.kind} {o.obj_id}")
-            rec.log("world/objects", rr.Boxes3D(centers=centers, sizes=sizes, quaternions=quats, colors=colors,
-                                                labels=labels))
-        else:
-            rec.log("world/objects", rr.Clear(recursive=False))
-        self.trajectory.append([e.x_m, e.y_m, 0.05])
-        if len(self.trajectory) % 5 == 1:
-            rec.log("world/trajectory", rr.LineStrips3D([self.trajectory], colors=[(60, 220, 90)], radii=0.15))
-        rec.log("plots/speed_mps", rr.Scalars(gt.speed_mps))
-        rec.log("plots/accel_cmd_mps2", rr.Scalars(float(action[0])))
-        rec.log("plots/steering_rad", rr.Scalars(float(action[1])))
-        for name in ("offset_m", "heading_rad", "curvature_1pm"):
-            rec.log(f"plots/lane/{name}/truth", rr.Scalars(getattr(gt.lane, name)))
-        if lead_gap_m is not None:
-            rec.log("plots/lead_gap_m", rr.Scalars(lead_gap_m))
+        rec.log(EGO, rr.Transform3D(translation=[e.x_m, e.y_m, 0.0],
+                                    rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=e.yaw_rad)))
+        image = self._log_image(frame)
+        self._log_objects(gt.objects, image)
+        rec.log(TRAJECTORY, rr.Points3D([[e.x_m, e.y_m, 0.05]]))
+        for name, part in self.parts:
+            ctx = replace(self.contexts[name], image=image)
+            if name == "control":
+                part(rec, ctx, step, step.control, truth)
+            else:
+                part(rec, ctx, step.estimates.get(name), step.debug.get(name), truth)
 
-    def log_lanes(self, est, debug) -> None:
-        """What the lanes module made of this frame (call after ``log_step``): ``est`` a LaneEstimate, ``debug`` a
-        LaneDebug (evidence None for a dropped frame, fit None when evidence was too thin)."""
+    def _log_image(self, frame) -> bool:
+        """Store the left image if this frame starts a new 1 / camera_hz interval; whether it was stored."""
+        bucket = math.floor(frame.timestamp_s * self.options.camera_hz + 1e-6)
+        if frame.left is None or bucket == self._bucket:
+            return False
+        img, s = frame.left, self.options.image_scale
+        if s != 1:
+            h, w = img.shape[:2]
+            img = cv2.resize(img, (round(w * s), round(h * s)), interpolation=cv2.INTER_AREA)
+        ok, jpg = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(self.options.jpeg_quality)])
+        if not ok:
+            return False
+        self.rec.log(CAMERA, rr.EncodedImage(contents=jpg.tobytes(), media_type="image/jpeg"))
+        self._bucket = bucket
+        return True
+
+    def _log_objects(self, objects, image: bool) -> None:
+        """True boxes: 3D in the vehicle frame (under the ego's transform) and, with an image, 2D on it."""
         rec = self.rec
-        cam = "world/ego/camera/left"
-        ev, fit = debug.evidence, debug.fit
-        if ev is not None and len(ev.uv_px):
-            side = fit.side if fit is not None else np.zeros(len(ev.uv_px), int)
-            colors = np.where(side[:, None] == 1, SIDE_COLORS[1], np.where(side[:, None] == -1, SIDE_COLORS[-1],
-                                                                              SIDE_COLORS[0]))
-            rec.log(f"{cam}/evidence", rr.Points2D(ev.uv_px, colors=colors, radii=1.5))
+        if objects:
+            rec.log(OBJECTS, rr.Boxes3D(
+                centers=[o.position_m for o in objects], sizes=[o.size_m for o in objects],
+                rotation_axis_angles=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=o.yaw_rad) for o in objects],
+                class_ids=[KIND_CLASSES[o.kind][0] for o in objects], show_labels=False))
         else:
-            rec.log(f"{cam}/evidence", rr.Clear(recursive=False))
-        if est.valid:
-            ground = est.boundary_points_m(*LANE_DRAW_M, n=30)
-            px = boundary_points_px(self.rig, est, *LANE_DRAW_M, n=30)
-            colors = [SIDE_COLORS[1], SIDE_COLORS[-1]]
-            rec.log("world/ego/lanes", rr.LineStrips3D([ground["left"], ground["right"]], colors=colors, radii=0.1))
-            rec.log(f"{cam}/lanes", rr.LineStrips2D([px["left"], px["right"]], colors=colors, radii=2.0))
-            for name, value in (("offset_m", est.offset_m), ("heading_rad", est.heading_rad),
-                                ("curvature_1pm", est.curvature_1pm)):
-                rec.log(f"plots/lane/{name}/vision", rr.Scalars(value))
+            rec.log(OBJECTS, rr.Clear(recursive=False))
+        if not image:
+            return
+        seen = [o for o in objects if o.box_px is not None]
+        if seen:
+            rec.log(f"{CAMERA}/objects", rr.Boxes2D(
+                array=np.asarray([o.box_px for o in seen], dtype=float) * self.options.image_scale,
+                array_format=rr.Box2DFormat.XYXY, class_ids=[KIND_CLASSES[o.kind][0] for o in seen],
+                show_labels=False))
         else:
-            rec.log("world/ego/lanes", rr.Clear(recursive=False))
-            rec.log(f"{cam}/lanes", rr.Clear(recursive=False))
-        rec.log("plots/lane/confidence", rr.Scalars(est.confidence))
+            rec.log(f"{CAMERA}/objects", rr.Clear(recursive=False))
 
-    def close(self) -> Path:
-        """Flush and move the recording to its final name."""
-        if self.trajectory:
-            self.rec.log("world/trajectory", rr.LineStrips3D([self.trajectory], colors=[(60, 220, 90)], radii=0.15))
-        self.rec.flush()
-        self.rec.disconnect()
-        os.replace(self.tmp, self.path)
-        return self.path
+    def close(self, complete: bool = True) -> Path:
+        """Flush and move the recording into place: ``path`` when ``complete``, else ``RUN.partial.rrd`` beside it
+        (an interrupted or failed run; a finished ``RUN.rrd`` is never touched). Returns where it went; a second
+        call does nothing."""
+        if self.closed_as is not None:
+            return self.closed_as
+        target = self.path if complete else partial_path(self.path)
+        try:
+            self.rec.flush()
+        finally:
+            self.rec.disconnect()
+            if self.tmp.exists():
+                os.replace(self.tmp, target)
+            self.closed_as = target
+        return target
+
+    def __enter__(self) -> "RunRecorder":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close(complete=exc_type is None)

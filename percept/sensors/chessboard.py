@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
 from collections import Counter
 from dataclasses import dataclass
@@ -23,6 +22,8 @@ from typing import Callable, Sequence
 
 import cv2
 import numpy as np
+
+from percept.outputs import write_json_atomic
 
 from .camera import PinholeCamera
 from .footage import Undistorter, list_images, read_image
@@ -34,16 +35,17 @@ MAX_CORNERS = 100
 
 
 def parse_pattern(text: str) -> tuple[int, int]:
-    """'9x6' -> (9, 6): inner corners per row and per column of the chessboard (each at least 2)."""
+    """'9x6' -> (9, 6): inner corners per row and per column of the chessboard (each at least 3)."""
     m = re.fullmatch(r"\s*(\d+)\s*[xX×]\s*(\d+)\s*", str(text))
     if m is None:
         raise ValueError(f"pattern {text!r} is not COLSxROWS of inner corners, e.g. 9x6")
     cols, rows = int(m.group(1)), int(m.group(2))
-    if cols < 2 or rows < 2:
-        raise ValueError(f"pattern {text!r} needs at least 2x2 inner corners")
     if cols > MAX_CORNERS or rows > MAX_CORNERS:
         raise ValueError(f"pattern {text!r} has more than {MAX_CORNERS} inner corners a side; count the corners "
                          "where four squares meet, e.g. 9x6")
+    if cols < 3 or rows < 3:
+        raise ValueError(f"pattern {text!r} needs at least 3x3 inner corners (OpenCV finds no smaller board); "
+                         "count the corners where four squares meet, e.g. 9x6")
     return cols, rows
 
 
@@ -97,7 +99,7 @@ class CameraCalibration:
                    parse_pattern(d.get("pattern", "9x6")))
 
     def save(self, path: Path) -> None:
-        write_text_atomic(Path(path), json.dumps(self.to_dict(), indent=2))
+        write_json_atomic(path, self.to_dict())
 
     @classmethod
     def load(cls, path: Path) -> "CameraCalibration":
@@ -110,16 +112,6 @@ class CameraCalibration:
         except (KeyError, TypeError, ValueError, AttributeError) as e:
             raise ValueError(f"{path} is not a percept calibration file ({e}); "
                              "make one with `percept calibrate DIR`") from None
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to a temporary file beside ``path``, then rename it: ``path`` is never left half-written."""
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    try:
-        tmp.write_text(text)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def chessboard_images(folder: Path) -> list[Path]:

@@ -15,7 +15,6 @@ distance of a corner to the epipolar line of its partner, both ways) and the rec
 
 from __future__ import annotations
 
-import json
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,8 +23,10 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from percept.outputs import write_json_atomic
+
 from .chessboard import (MIN_VIEWS, CameraCalibration, board_points, calibrate_points, chessboard_images,
-                         find_corners, read_gray, write_text_atomic)
+                         find_corners, read_gray)
 
 
 def stereo_pairs(folder: Path) -> list[tuple[Path, Path]]:
@@ -66,7 +67,7 @@ class StereoCalibration:
                 "pairs_used": self.pairs_used, "pairs_total": self.pairs_total}
 
     def save(self, path: Path) -> None:
-        write_text_atomic(Path(path), json.dumps(self.to_dict(), indent=2))
+        write_json_atomic(path, self.to_dict())
 
 
 def _epipolar_error(pl: np.ndarray, pr: np.ndarray, left: CameraCalibration, right: CameraCalibration,

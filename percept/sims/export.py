@@ -1,60 +1,101 @@
-"""Writing rendered runs to disk: stereo PNGs, depth, ground truth JSON, camera and landmark files."""
+"""Writing rendered runs to disk: stereo PNGs, depth, ground truth JSON, camera and landmark files.
+
+Every file goes through ``percept.outputs``: a frame's files (images, depth, ground truth) are written to
+temporaries and renamed together, so each frame on disk is complete or absent, whatever stops the run (an error,
+a full disk, Ctrl-C). A folder holds one run: ``prepare_out_dir`` refuses a folder with files unless told to clear
+it, and then removes only files a render writes.
+"""
 
 from __future__ import annotations
 
+import io
 import json
+import re
 from pathlib import Path
 from typing import Callable
 
 import cv2
 import numpy as np
 
+from percept.outputs import write_files_atomic, write_json_atomic
 from percept.sensors import Frame
 
 from .ground_truth import GroundTruth
 from .world import SimWorld
 
+RENDER_FILE = re.compile(r"\d{6}_(left\.png|right\.png|depth\.npy|gt\.json)|camera\.json|landmarks\.json"
+                         r"|\.(\d{6}_\w+|camera|landmarks)\.\w+\.tmp\.\w+")
+"""Names of the files a render writes (and of its temporaries, left by a killed process)."""
 
-def prepare_out_dir(out: Path) -> Path:
-    """Create ``out`` (and parents) and check it is writable; ValueError saying what is wrong otherwise."""
+
+def prepare_out_dir(out: Path, force: bool = False) -> Path:
+    """Create ``out`` (and parents) and check it is writable. A folder with files is refused (a render must not mix
+    with another one) unless ``force``: then the files of an earlier render are removed, and a file that a render
+    does not write still refuses the folder. ValueError saying what is wrong and what to do otherwise."""
     out = Path(out)
     if out.exists() and not out.is_dir():
-        raise ValueError(f"output path {out} exists and is not a folder")
+        raise ValueError(f"output path {out} exists and is not a folder; give a folder path")
+    if out.is_dir() and (found := sorted(p.name for p in out.iterdir())):
+        foreign = [n for n in found if not RENDER_FILE.fullmatch(n)]
+        if foreign:
+            raise ValueError(f"{out} holds files that percept render did not write (e.g. {foreign[0]}); "
+                             "choose an empty or new folder")
+        if not force:
+            raise ValueError(f"{out} already holds a render ({len(found)} files); choose a new folder, or --force "
+                             "to replace it")
+        for name in found:
+            (out / name).unlink()
     try:
         out.mkdir(parents=True, exist_ok=True)
         probe = out / ".percept-write-test"
         probe.write_text("")
         probe.unlink()
     except OSError as e:
-        raise ValueError(f"cannot write to {out}: {e.strerror or e}") from None
+        raise ValueError(f"cannot write to {out}: {e.strerror or e}; choose a folder you can write to") from None
     return out
+
+
+def _png(image: np.ndarray) -> bytes:
+    ok, buf = cv2.imencode(".png", image)
+    if not ok:
+        raise ValueError(f"cannot encode a {image.shape} image as PNG")
+    return buf.tobytes()
+
+
+def _npy(array: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.save(buf, array)
+    return buf.getvalue()
 
 
 def write_frame(out: Path, i: int, frame: Frame, gt: GroundTruth) -> None:
     """``{i:06d}_left.png``, ``_right.png`` (absent for a dropped frame), ``_depth.npy`` (float32 m, inf sky),
-    ``_gt.json``."""
-    stem = out / f"{i:06d}"
-    if not frame.dropped:
-        cv2.imwrite(f"{stem}_left.png", frame.left)
-        cv2.imwrite(f"{stem}_right.png", frame.right)
-    np.save(f"{stem}_depth.npy", gt.depth_m.astype(np.float32))
+    ``_gt.json``: all of them or none."""
+    stem = f"{i:06d}"
     d = gt.to_dict()
     d["frame"] = i
     d["dropped"] = frame.dropped
     d["sensors"] = {"imu": {"accel_mps2": frame.imu.accel_mps2.tolist(), "gyro_rps": frame.imu.gyro_rps.tolist()},
                     "wheel_speed_mps": frame.wheel_speed_mps}
-    Path(f"{stem}_gt.json").write_text(json.dumps(d, indent=1))
+    files = {} if frame.dropped else {out / f"{stem}_left.png": _png(frame.left),
+                                      out / f"{stem}_right.png": _png(frame.right)}
+    files[out / f"{stem}_depth.npy"] = _npy(gt.depth_m.astype(np.float32))
+    # the ground truth last: a reader that finds it finds the whole frame
+    files[out / f"{stem}_gt.json"] = json.dumps(d, indent=1).encode()
+    write_files_atomic(files)
 
 
-def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], None] | None = None) -> None:
-    """Render ``frames`` consecutive frames of ``world`` into ``out`` with camera.json (and landmarks.json)."""
+def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], None] | None = None,
+               force: bool = False) -> int:
+    """Render ``frames`` consecutive frames of ``world`` into ``out`` with camera.json (and landmarks.json); the
+    number of frames written (also when stopped early: see ``written``)."""
     if frames < 1:
         raise ValueError(f"--frames must be at least 1, got {frames}")
-    out = prepare_out_dir(out)
-    world.cfg.rig.save(out / "camera.json")
+    out = prepare_out_dir(out, force)
+    write_json_atomic(out / "camera.json", world.cfg.rig.to_dict())
     landmarks = world.landmark_map()
     if len(landmarks):
-        (out / "landmarks.json").write_text(json.dumps(landmarks.to_dict(), indent=1))
+        write_json_atomic(out / "landmarks.json", landmarks.to_dict(), indent=1)
     for i in range(frames):
         frame, gt = world.observe()
         write_frame(out, i, frame, gt)
@@ -62,3 +103,9 @@ def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], N
             progress()
         if i + 1 < frames:
             world.step()
+    return frames
+
+
+def written(out: Path) -> int:
+    """Complete frames in a render folder (each has its ground truth file, renamed last)."""
+    return sum(1 for _ in Path(out).glob("[0-9]" * 6 + "_gt.json"))

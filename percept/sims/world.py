@@ -141,6 +141,11 @@ class SimWorld:
         return frame, gt
 
     @property
+    def pedestrians(self) -> int:
+        """How many pedestrians this scenario has (crossing the road or staying on the verge)."""
+        return sum(1 for o in self.env.road.objects if isinstance(o, Pedestrian))
+
+    @property
     def crossing_pedestrians(self) -> int:
         """How many pedestrians of this scenario cross the road (the others stay on the verge)."""
         return sum(1 for o in self.env.road.objects if isinstance(o, Pedestrian) and o.crossing)

@@ -59,8 +59,8 @@ def test_render_loop_writes_the_landmark_map(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--scenario", "motorway", "--frames", "2"], "unknown scenario 'motorway'; choose one of: highway"),
     (["--scenario", "highway", "--condition", "fog", "--frames", "2"], "unknown condition 'fog'; choose one of: clear"),
-    (["--scenario", "highway", "--frames", "0"], "--frames must be at least 1"),
-    (["--scenario", "highway", "--frames", "2", "--seed", "-1"], "seed must be >= 0"),
+    (["--scenario", "highway", "--frames", "0"], "--frames must be a finite number between 1"),
+    (["--scenario", "highway", "--frames", "2", "--seed", "-1"], "--seed must be a finite number"),
 ])
 def test_render_bad_input_is_one_line_exit_2(tmp_path, args, message):
     r = runner.invoke(app, ["render", *args, "--out", str(tmp_path / "o")])

@@ -1,44 +1,88 @@
-"""`percept view`: the viewer command it starts, and bad input."""
+"""`percept view`: the viewer command it starts, the bind address, and recordings that are not valid."""
 
 import subprocess
 
+import pytest
 from typer.testing import CliRunner
 
-from percept.cli import app
-from percept.cli.view_cmd import rerun_executable
+from percept.cli import app, view_cmd
+from percept.cli.view_cmd import recording_problem, rerun_executable
 
 runner = CliRunner()
+REAL_RUN = subprocess.run
 
 
-def test_view_starts_the_rerun_viewer_on_the_recording(tmp_path, monkeypatch):
-    rrd = tmp_path / "run.rrd"
-    rrd.write_bytes(b"")
+@pytest.fixture
+def rrd(tmp_path):
+    """A small valid recording."""
+    import rerun as rr
+
+    path = tmp_path / "run.rrd"
+    rec = rr.RecordingStream("percept-test")
+    rec.save(str(path))
+    rec.set_time("sim_time", duration=0.0)
+    rec.log("x", rr.Scalars(1.0))
+    rec.flush()
+    rec.disconnect()
+    return path
+
+
+@pytest.fixture
+def viewer_calls(monkeypatch):
+    """Viewer launches are recorded (and succeed); `rerun rrd verify` runs for real."""
     calls = []
 
-    def fake_run(cmd, env):
+    def fake_run(cmd, env, **kw):
+        if cmd[1:3] == ["rrd", "verify"]:
+            return REAL_RUN(cmd, env=env, **kw)
         calls.append(cmd)
         return subprocess.CompletedProcess(cmd, 0)
 
     monkeypatch.setattr(subprocess, "run", fake_run)
+    return calls
+
+
+def test_view_starts_the_rerun_viewer_on_the_recording(rrd, viewer_calls):
     assert runner.invoke(app, ["view", str(rrd)]).exit_code == 0
     assert runner.invoke(app, ["view", str(rrd), "--web"]).exit_code == 0
-    assert calls == [[rerun_executable(), str(rrd)], [rerun_executable(), "--web-viewer", str(rrd)]]
+    assert runner.invoke(app, ["view", str(rrd), "--web", "--bind", "0.0.0.0"]).exit_code == 0
+    exe = rerun_executable()
+    assert viewer_calls == [[exe, "--bind", "127.0.0.1", str(rrd)],
+                            [exe, "--bind", "127.0.0.1", "--web-viewer", str(rrd)],
+                            [exe, "--bind", "0.0.0.0", "--web-viewer", str(rrd)]]
 
 
-def test_view_reports_a_viewer_that_fails(tmp_path, monkeypatch):
-    rrd = tmp_path / "run.rrd"
-    rrd.write_bytes(b"")
+def test_view_reports_a_viewer_that_fails(rrd, monkeypatch):
+    monkeypatch.setattr(view_cmd, "recording_problem", lambda exe, path: None)
     monkeypatch.setattr(subprocess, "run", lambda cmd, env: subprocess.CompletedProcess(cmd, 1))
     r = runner.invoke(app, ["view", str(rrd)])
     assert r.exit_code == 2 and "try `percept view --web" in r.output
 
 
-def test_view_bad_input(tmp_path):
+def test_view_bad_input(tmp_path, rrd):
     r = runner.invoke(app, ["view", str(tmp_path / "missing.rrd")])
     assert r.exit_code == 2 and "does not exist" in r.output and "Traceback" not in r.output
     (tmp_path / "notes.txt").write_text("x")
     r = runner.invoke(app, ["view", str(tmp_path / "notes.txt")])
     assert r.exit_code == 2 and "is not a Rerun recording" in r.output
+    r = runner.invoke(app, ["view", str(rrd), "--web", "--bind", "localhost:80"])
+    assert r.exit_code == 2 and "--bind must be an IP address" in r.output
+
+
+@pytest.mark.parametrize("content", [b"", b"not a recording", "truncated"])
+def test_view_refuses_an_invalid_recording(tmp_path, rrd, viewer_calls, content):
+    bad = tmp_path / "bad.rrd"
+    bad.write_bytes(rrd.read_bytes()[:200] if content == "truncated" else content)
+    for args in (["view", str(bad)], ["view", str(bad), "--web"]):
+        r = runner.invoke(app, args)
+        assert r.exit_code == 2 and "is not a valid Rerun recording" in r.output, r.output
+        assert "display" not in r.output and "Traceback" not in r.output
+        assert len(r.output.strip().splitlines()) == 1
+    assert viewer_calls == []  # never started, never served
+
+
+def test_recording_problem_accepts_a_valid_recording(rrd):
+    assert recording_problem(rerun_executable(), rrd) is None
 
 
 def test_the_viewer_is_installed():

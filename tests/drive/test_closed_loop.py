@@ -56,6 +56,6 @@ def test_same_seed_same_metrics():
 
 def test_metrics_that_do_not_apply_are_null():
     r = drive("lead-brake", 0, duration=3.0)
-    assert r["pedestrians"]["stops"] is None
+    assert r["pedestrians"]["stops"] is None and r["pedestrians"]["false_stops"] is None  # no pedestrians
     assert r["lane"]["offset_rmse_m"] is None  # privileged lateral: no estimate to score
     assert r["odometry"]["ate_rmse_fused_m"] is None

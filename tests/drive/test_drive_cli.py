@@ -41,8 +41,8 @@ def test_vision_lateral_recording_shows_what_the_lanes_module_saw(tmp_path):
     p = subprocess.run([rerun_bin(), "rrd", "print", str(rrd)], capture_output=True, text=True,
                        env={"RERUN_ANALYTICS": "0", "PATH": ""})
     assert p.returncode == 0, p.stderr
-    for entity in ("world/ego/camera/left/lanes", "world/ego/camera/left/evidence", "world/ego/lanes",
-                   "plots/lane/offset_m/vision", "plots/lane/curvature_1pm/truth"):
+    for entity in ("world/ego/camera/left/lateral/boundaries", "world/ego/camera/left/lateral/evidence",
+                   "world/ego/lateral/path", "lateral/offset_m/estimate", "lateral/curvature_1pm/truth"):
         assert entity in p.stdout, entity
 
 

@@ -47,7 +47,9 @@ def test_eval_writes_runs_and_a_summary_and_resumes(tmp_path):
     assert {p: p.stat().st_mtime_ns for p in (tmp_path / "runs").iterdir()} == stamp
 
 
-def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, monkeypatch):
+@pytest.fixture
+def seed_1_crashes(monkeypatch):
+    """Every run with seed 1 raises RuntimeError("simulated crash")."""
     real = ev.run_drive
 
     def flaky(cfg, render=True):
@@ -56,6 +58,9 @@ def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, monkeypatch
         return real(cfg, render=render)
 
     monkeypatch.setattr(ev, "run_drive", flaky)
+
+
+def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, seed_1_crashes):
     plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0)
     s = ev.evaluate(plan, tmp_path)
     g = s["groups"][0]
@@ -82,6 +87,8 @@ def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
     (["--scenario", "highway", "--engine", "spark"], "--engine must be local or ray"),
     (["--scenario", "highway", "--condition", "fog"], "condition"),
     (["--scenario", "highway", "--longitudinal", "vision"], "no vision implementation yet"),
+    (["--scenario", "highway", "--duration", "inf"], "--duration must be a finite number"),
+    (["--scenario", "highway", "--duration", "0"], "--duration must be a finite number"),
 ])
 def test_eval_bad_input_is_one_line_exit_2(tmp_path, args, message):
     r = runner.invoke(app, ["eval", "--out", str(tmp_path / "o"), *args])
@@ -119,3 +126,58 @@ def test_ray_engine_without_ray_says_how_to_get_it(tmp_path, monkeypatch):
 def test_jobs_cover_the_plan():
     plan = EvalPlan(("highway", "curves"), ("clear", "rain"), (0, 1, 2))
     assert len(plan.jobs) == 12 and Job("curves", "rain", 2) in plan.jobs
+
+
+def _files(folder) -> dict:
+    return {p.name: p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_resume_never_mixes_runs_made_with_other_settings(tmp_path):
+    base = ["eval", "--scenario", "lead-brake", "--scenario", "lead-brake", "--seeds", "0", "--out", str(tmp_path)]
+    r = runner.invoke(app, [*base, "--duration", "2"])
+    assert r.exit_code == 0, r.output
+    assert [p.name for p in (tmp_path / "runs").iterdir()] == ["lead-brake-clear-0.json"]  # duplicates dropped
+    run = json.loads((tmp_path / "runs" / "lead-brake-clear-0.json").read_text())
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert run["settings"] == summary["settings"] and run["settings"]["duration_s"] == 2.0
+    assert run["settings"]["slots"]["lateral"] == "privileged" and run["settings"]["percept"]
+    before = _files(tmp_path)
+    for args, diff in ((["--duration", "1"], "duration_s 2.0 (now 1.0)"),
+                       (["--duration", "2", "--lateral", "vision"], "slots lateral=privileged (now vision)")):
+        r = runner.invoke(app, [*base, *args])
+        assert r.exit_code == 2 and "Traceback" not in r.output
+        assert "made with other settings" in r.output and diff in r.output and "--redo" in r.output
+        assert _files(tmp_path) == before  # refused before any work
+    r = runner.invoke(app, [*base, "--duration", "1", "--redo"])
+    assert r.exit_code == 0, r.output
+    run = json.loads((tmp_path / "runs" / "lead-brake-clear-0.json").read_text())
+    assert run["settings"]["duration_s"] == 1.0 and run["duration_s"] == 1.0
+
+
+def test_damaged_run_files_are_listed_and_redone(tmp_path):
+    args = ["eval", "--scenario", "lead-brake", "--seeds", "0-3", "--duration", "1", "--out", str(tmp_path)]
+    runs = tmp_path / "runs"
+    runs.mkdir()
+    (runs / "lead-brake-clear-0.json").write_text('{"scenario": "lead-br')
+    (runs / "lead-brake-clear-1.json").write_text("")
+    (runs / "lead-brake-clear-2.json").write_text('{"hello": "world"}')
+    (runs / "lead-brake-clear-3.json").write_bytes(b"\xff\xfe\x00")
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    lines = [ln for ln in r.output.splitlines() if ln.startswith("redoing")]
+    assert len(lines) == 4 and "Traceback" not in r.output
+    assert "not JSON" in lines[0] and "empty" in lines[1] and "not a percept run" in lines[2]
+    assert all(json.loads(p.read_text())["frames"] == 15 for p in runs.iterdir())
+    (runs / "lead-brake-clear-0.json").unlink()
+    (runs / "lead-brake-clear-0.json").mkdir()
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2 and "is a folder where a run file belongs" in r.output and "Traceback" not in r.output
+
+
+def test_eval_exits_1_and_says_how_many_runs_failed(tmp_path, seed_1_crashes):
+    r = runner.invoke(app, ["eval", "--scenario", "lead-brake", "--seeds", "0-1", "--duration", "1",
+                            "--out", str(tmp_path), "--json", str(tmp_path / "s.json")])
+    assert r.exit_code == 1
+    assert "1 of 2 runs failed" in r.output and "RuntimeError: simulated crash" in r.output
+    assert json.loads((tmp_path / "s.json").read_text())["groups"][0]["failed"][0]["seed"] == 1
+    assert [p.name for p in (tmp_path / "runs").iterdir()] == ["lead-brake-clear-0.json"]

@@ -32,7 +32,8 @@ def test_pattern_strings(text, expected):
     assert parse_pattern(text) == expected
 
 
-@pytest.mark.parametrize("text, match", [("9by6", "not COLSxROWS"), ("9x", "not COLSxROWS"), ("1x6", "at least 2x2"),
+@pytest.mark.parametrize("text, match", [("9by6", "not COLSxROWS"), ("9x", "not COLSxROWS"), ("1x6", "at least 3x3"),
+                                         ("2x2", "at least 3x3"),
                                          ("99999999999x2", "more than 100 inner corners")])
 def test_bad_pattern_strings(text, match):
     with pytest.raises(ValueError, match=match):

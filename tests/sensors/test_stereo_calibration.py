@@ -86,5 +86,5 @@ def test_percept_calibrate_stereo_bad_input(tmp_path):
     r = runner.invoke(app, ["calibrate", str(tmp_path), "--stereo"])
     assert r.exit_code == 2 and "found in both images of only 0 of 3 pairs" in r.output
     r = runner.invoke(app, ["calibrate", str(tmp_path), "--stereo", "--square", "0"])
-    assert r.exit_code == 2 and "--square must be positive" in r.output
+    assert r.exit_code == 2 and "--square must be a finite number" in r.output
     assert not (tmp_path / "stereo_calib.json").exists()

@@ -1,0 +1,41 @@
+"""Pedestrians part: the braking request. Its stop-before distance beside the true in-path pedestrian's range, a
+log line when a request starts, changes reason or ends, and the stop line around the car and on the image."""
+
+from __future__ import annotations
+
+import rerun as rr
+
+from percept.sensors import ObjectKind
+
+from ..context import Part, PartContext, Plot, cross_line, log_on_change
+
+STOP_RGB = (240, 50, 50)
+LOG = "pedestrians/requests"
+
+
+def draw(rec: rr.RecordingStream, ctx: PartContext, request, debug, truth) -> None:
+    """``request``: BrakingRequest or None."""
+    obstacle = truth.in_path
+    true_m = (ctx.range_from_gap_m(obstacle.gap_m)
+              if obstacle is not None and obstacle.kind is ObjectKind.PEDESTRIAN else None)
+    ctx.scalars(rec, "stop_before_m", truth=true_m, estimate=request.stop_before_m if request else None)
+    if request is None:
+        log_on_change(rec, ctx, LOG, None, "braking request ended")
+        rec.log(ctx.around_ego("stop"), rr.Clear(recursive=False))
+        if ctx.image:
+            rec.log(ctx.on_image("stop"), rr.Clear(recursive=False))
+        return
+    text = f"{request.reason}: stop before {request.stop_before_m:.1f} m"
+    log_on_change(rec, ctx, LOG, request.reason, text, level=rr.TextLogLevel.WARN)
+    line = cross_line(ctx.camera_x_m() + request.stop_before_m, n=9)
+    rec.log(ctx.around_ego("stop"), rr.LineStrips3D([line], colors=[STOP_RGB], radii=0.15, labels=[text]))
+    if ctx.image:
+        uv, z = ctx.rig.project_vehicle_points(line)
+        if (z > 0.1).sum() >= 2:
+            rec.log(ctx.on_image("stop"), rr.LineStrips2D([ctx.px(uv[z > 0.1])], colors=[STOP_RGB], radii=2.0,
+                                                          labels=[text]))
+        else:
+            rec.log(ctx.on_image("stop"), rr.Clear(recursive=False))
+
+
+PART = Part(draw, plots=(Plot("stop_before_m", "stop before [m]"),), texts=(LOG,))

@@ -1,0 +1,110 @@
+"""Analytic checks of the control laws: each reads records only and returns (command, debug)."""
+
+import math
+
+import pytest
+
+from percept.control import (EmergencyBraking, Following, LaneKeeping, Target, nearest_target,
+                             sideslip_for_curvature, steering_for_curvature)
+from percept.sensors import BrakingRequest, EgoPath, LaneEstimate, Lead, ObjectKind
+from percept.sensors.vehicle import CAMERA_MOUNT_X_M, EGO_LENGTH_M, MAX_BRAKE_MPS2
+
+
+def path(offset=0.0, heading=0.0, curvature=0.0, speed=20.0):
+    return EgoPath(LaneEstimate(offset, heading, curvature, 3.7, 1.0), speed)
+
+
+def test_lane_keeping_feeds_the_curvature_forward_and_corrects_offset_and_heading():
+    law = LaneKeeping(time_constant_s=0.8)
+    steer, dbg = law.update(path())
+    assert steer == 0.0 and dbg.limited_by == "none"
+    # on the lane centre, the body turned out by the steady turn's sideslip (velocity along the lane): the lane's
+    # own curvature, nothing else
+    steer, dbg = law.update(path(heading=-sideslip_for_curvature(0.002), curvature=0.002))
+    assert steer == pytest.approx(steering_for_curvature(0.002)) and dbg.offset_1pm == 0.0
+    # left of the centre: steer right, by w^2 y / v^2 in curvature
+    steer, dbg = law.update(path(offset=0.5))
+    assert steer < 0 and dbg.offset_1pm == pytest.approx(-(1 / 0.8) ** 2 * 0.5 / 20.0 ** 2)
+    # heading to the left: steer right, by 2 w sin(theta) / v
+    steer, dbg = law.update(path(heading=0.01))
+    assert steer < 0 and dbg.heading_1pm == pytest.approx(-2 / 0.8 * math.sin(0.01) / 20.0)
+
+
+def test_lane_keeping_without_a_lane_holds_straight_and_says_why():
+    steer, dbg = LaneKeeping().update(EgoPath.straight(20.0))
+    assert steer == 0.0 and dbg.limited_by == "path"
+    with pytest.raises(ValueError, match="time_constant_s must be positive"):
+        LaneKeeping(0.0)
+
+
+def test_following_cruises_without_a_target_and_holds_the_time_gap_behind_a_vehicle():
+    law = Following(set_speed_mps=30.0, time_gap_s=1.8, gap_time_constant_s=2.5, speed_time_constant_s=2.5)
+    a, dbg = law.update(None, 25.0)
+    assert a == pytest.approx((30.0 - 25.0) / 2.5) and dbg.limited_by == "cruise"
+    # at the target gap (v h) and not closing: the follow term is zero and limits the command
+    a, dbg = law.update(Target(25.0 * 1.8, 0.0, ObjectKind.VEHICLE, "lead"), 25.0)
+    assert a == pytest.approx(0.0) and dbg.limited_by == "follow" and dbg.target_gap_m == pytest.approx(45.0)
+    # closing at 5 m/s at that gap: a = -2 c / Td
+    a, _ = law.update(Target(45.0, 5.0, ObjectKind.VEHICLE, "lead"), 25.0)
+    assert a == pytest.approx(-2 * 5.0 / 2.5)
+    # behind anything that is not a vehicle the gap aimed at is the standstill distance
+    _, dbg = law.update(Target(10.0, 0.0, ObjectKind.PEDESTRIAN, "request"), 10.0)
+    assert dbg.target_gap_m == 4.0
+    with pytest.raises(ValueError, match="time_gap_s must be positive"):
+        Following(30.0, time_gap_s=0.0)
+
+
+def test_following_settles_at_the_time_gap_in_closed_loop():
+    # a point-mass ego behind a lead at a constant 20 m/s: the gap error is critically damped to v h
+    law, dt = Following(30.0, time_gap_s=1.8), 1 / 15
+    v, gap = 28.0, 80.0
+    for _ in range(int(60 / dt)):
+        a, _ = law.update(Target(gap, v - 20.0, ObjectKind.VEHICLE, "lead"), v)
+        v += a * dt
+        gap += (20.0 - v) * dt
+    assert v == pytest.approx(20.0, abs=0.05) and gap / v == pytest.approx(1.8, abs=0.02)
+
+
+def test_emergency_braking_brakes_in_proportion_to_the_required_deceleration():
+    law = EmergencyBraking(standstill_m=4.0, trigger_mps2=2.0, gain=1.3)
+    # closing at 10 m/s with 20 m of room: a_req = 100 / 40 = 2.5 > 2 -> -1.3 * 2.5
+    a, dbg = law.update(Target(24.0, 10.0, ObjectKind.VEHICLE, "lead"), 20.0, follow_mps2=0.0)
+    assert a == pytest.approx(-3.25) and dbg.limited_by == "emergency"
+    # far more than the car can do: clipped to the braking limit, and it says so
+    a, dbg = law.update(Target(6.0, 20.0, ObjectKind.VEHICLE, "lead"), 20.0, follow_mps2=0.0)
+    assert a == -MAX_BRAKE_MPS2 and dbg.limited_by == "brake_limit"
+    # below the trigger the following law's command stands
+    a, dbg = law.update(Target(60.0, 2.0, ObjectKind.VEHICLE, "lead"), 20.0, follow_mps2=-0.5)
+    assert a == -0.5 and dbg.limited_by == "follow"
+
+
+def test_emergency_braking_commits_to_stop_before_a_pedestrian_and_releases_once_stopped():
+    law = EmergencyBraking(ped_margin_m=4.0)
+    v, dt = 10.0, 1 / 15
+    a, dbg = law.update(Target(30.0, 10.0, ObjectKind.PEDESTRIAN, "request"), v, follow_mps2=1.0, dt=dt)
+    # the constant deceleration that stops 4 m before the person: -v^2 / (2 (30 - 4))
+    assert a == pytest.approx(-v * v / (2 * 26.0), rel=0.05) and dbg.stop_in_m == pytest.approx(26.0, abs=0.01)
+    travelled = 0.0
+    for _ in range(15 * 20):
+        # the person steps out of sight: the commitment alone brings the car to a stop before their line
+        a, dbg = law.update(None, v, follow_mps2=1.0, dt=dt)
+        v = max(v + a * dt, 0.0)
+        travelled += v * dt
+        if v < 0.3:
+            break
+    assert v < 0.3 and travelled < 26.0 + 0.5
+    a, dbg = law.update(None, 0.0, follow_mps2=1.0, dt=dt)
+    assert dbg.stop_in_m is None and a == 1.0  # released: free to go
+
+
+def test_nearest_target_compares_bumper_gaps_of_the_lead_and_the_request():
+    offset = EGO_LENGTH_M / 2 - CAMERA_MOUNT_X_M
+    lead = Lead(30.0, -2.0, ObjectKind.VEHICLE)
+    req = BrakingRequest(20.0, -8.0, "pedestrian stepping into the path")
+    t = nearest_target(lead, req)
+    assert t.source == "request" and t.gap_m == pytest.approx(20.0 - offset) and t.closing_mps == 8.0
+    assert t.is_pedestrian
+    t = nearest_target(lead, None)
+    assert t.source == "lead" and t.gap_m == pytest.approx(30.0 - offset) and t.closing_mps == 2.0
+    assert nearest_target(None, None) is None
+    assert nearest_target(Lead(1.0, 0.0), None).gap_m == 0.0  # inside the bumper: no negative gaps

@@ -1,0 +1,100 @@
+"""The slot table: a task added through the table alone runs, is timed, scored and recorded; behaviour pinned."""
+
+import subprocess
+
+import pytest
+import rerun as rr
+
+from percept.cli.view_cmd import rerun_executable
+from percept.drive import TASKS, DriveConfig, Source, Task, run_drive, task_order
+from percept.review import RunRecorder
+from percept.sensors import EgoPath
+from percept.sims import WorldConfig
+
+
+class CountingSlot:
+    """A fifth slot: counts frames and checks that it reads the ego path of the lateral slot."""
+
+    def __init__(self, ctx):
+        self.frames = 0
+
+    def reset(self) -> None:
+        self.frames = 0
+
+    def step(self, frame, upstream):
+        assert isinstance(upstream["lateral"], EgoPath)
+        self.frames += 1
+        return self.frames, {"left_mean": float(frame.left.mean())}
+
+
+class CountingScorer:
+    def __init__(self, ctx):
+        self.ctx, self.seen = ctx, 0
+
+    def update(self, estimate, debug, step):
+        self.seen = estimate
+
+    def result(self):
+        return {"frames_seen": self.seen, "scored_as_vision": self.ctx.vision}
+
+
+def log_counter(rec, ctx, estimate, debug, truth):
+    rec.log("counter/frames/estimate", rr.Scalars(estimate))
+
+
+FAKE = Task("counter", "counter", "counter_ms", CountingSlot, CountingScorer, vision=CountingSlot,
+            recorder=log_counter, upstream=("lateral",))
+
+
+def test_a_fifth_task_added_through_the_table_alone_runs_is_timed_scored_and_recorded(tmp_path):
+    tasks = TASKS + (FAKE,)
+    cfg = DriveConfig(WorldConfig("highway", 0, scenery=False), 1.0, {"counter": "vision"}, tasks=tasks)
+    rrd = tmp_path / "five.rrd"
+
+    def recorder(world):
+        lines = [s.left for s in world.road_geometry.strips]
+        return RunRecorder(rrd, world.cfg.rig, lines, tasks)
+
+    holder = {}
+    r = run_drive(cfg, recorder_factory=lambda w: holder.setdefault("r", recorder(w)))
+    holder["r"].close()
+    assert r["counter"] == {"frames_seen": 15, "scored_as_vision": True}
+    assert r["slots"]["counter"] == "vision" and r["timing_ms"]["counter_ms"] > 0
+    assert r["timing_ms"]["perception_total"] == r["timing_ms"]["counter_ms"]
+    p = subprocess.run([rerun_executable(), "rrd", "print", str(rrd)], capture_output=True, text=True,
+                       env={"RERUN_ANALYTICS": "0", "PATH": ""})
+    assert p.returncode == 0 and "counter/frames/estimate" in p.stdout
+
+
+def test_the_table_runs_upstream_first_and_rejects_cycles_and_unknown_tasks():
+    order = [t.name for t in task_order(TASKS + (FAKE,))]
+    assert order.index("lateral") < order.index("counter")
+    assert order.index("lateral") < order.index("longitudinal")
+    loop = Task("a", "a", "a", CountingSlot, CountingScorer, upstream=("b",))
+    with pytest.raises(ValueError, match="unknown task b"):
+        task_order((loop,))
+    with pytest.raises(ValueError, match="cycle"):
+        task_order((loop, Task("b", "b", "b", CountingSlot, CountingScorer, upstream=("a",))))
+
+
+def test_drive_config_names_the_bad_task_or_source():
+    with pytest.raises(ValueError, match="unknown task 'steering'"):
+        DriveConfig(sources={"steering": "vision"})
+    with pytest.raises(ValueError, match="--odometry must be vision or privileged"):
+        DriveConfig(sources={"odometry": "magic"})
+    assert DriveConfig(sources={"lateral": "vision"}).source("lateral") is Source.VISION
+
+
+@pytest.mark.parametrize("scenario, seed, group, key, value", [
+    # measured at the commit before the slot table (03a7a61); the refactor must not change a single bit
+    ("lead-brake", 0, "longitudinal", "time_gap_min_s", 1.6547846749285815),
+    ("lead-brake", 0, "longitudinal", "time_gap_mean_s", 1.913668277135849),
+    ("cut-in", 1, "longitudinal", "time_gap_min_s", 0.4406380047332286),
+    ("cut-in", 1, "longitudinal", "time_gap_mean_s", 1.1790070424420107),
+    ("curves", 0, "lane", "centering_rms_m", 0.04320886960024342),
+    ("crossing", 2, "pedestrians", "stops", [True, True, True]),
+])
+def test_privileged_metrics_are_those_of_the_commit_before_the_slot_table(scenario, seed, group, key, value):
+    r = run_drive(DriveConfig(WorldConfig(scenario, seed)), render=False)
+    assert r[group][key] == value
+    assert r["collisions"] == 0 and r["lane_departures"] == 0

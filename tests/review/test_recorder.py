@@ -1,0 +1,187 @@
+"""The run recording: every task's part is recorded, objects ride under the ego, the camera options change what is
+stored, and an interrupted recording never replaces a finished one. Checked with the rerun CLI (`rrd verify`,
+`rrd print`)."""
+
+import os
+import re
+import subprocess
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from percept.cli.view_cmd import rerun_executable
+from percept.drive import TASKS, DriveConfig, Task, run_drive
+from percept.review import RecordOptions, RunRecorder, partial_path
+from percept.review.recorder import resolve_part
+from percept.sensors import StereoRig
+from percept.sims import WorldConfig
+
+ENV = {**os.environ, "RERUN_ANALYTICS": "0"}
+CHUNK = re.compile(r"with (\d+) rows .* - (\S+) - data columns: \[([^\]]*)\]")
+COMMON = ["/world/road", "/world/ego", "/world/ego/body", "/world/ego/camera/left", "/world/ego/objects",
+          "/world/ego/camera/left/objects", "/world/trajectory", "/control/speed_mps/truth",
+          "/control/accel_mps2/command", "/control/steering_rad/command", "/control/limits"]
+TASK_ENTITIES = {
+    "lateral": ["/lateral/offset_m/truth", "/lateral/offset_m/estimate", "/lateral/heading_rad/estimate",
+                "/lateral/curvature_1pm/truth", "/world/ego/lateral/path", "/world/ego/camera/left/lateral/boundaries"],
+    "longitudinal": ["/longitudinal/range_m/truth", "/longitudinal/range_m/estimate",
+                     "/longitudinal/range_rate_mps/estimate", "/longitudinal/ttc_s/estimate",
+                     "/world/ego/longitudinal/lead"],
+    "pedestrians": ["/pedestrians/stop_before_m/estimate", "/pedestrians/stop_before_m/truth",
+                    "/world/ego/pedestrians/stop"],
+    "odometry": ["/odometry/position_error_m/error", "/odometry/speed_mps/estimate", "/world/odometry/trail",
+                 "/world/odometry/pose"],
+}
+
+
+def rerun(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([rerun_executable(), *args], env=ENV, capture_output=True, text=True, timeout=120)
+
+
+def verify(path: Path) -> None:
+    r = rerun("rrd", "verify", str(path))
+    assert r.returncode == 0 and "1 file verified" in r.stdout + r.stderr, r.stdout + r.stderr
+
+
+def columns_by_entity(path: Path) -> dict[str, dict[str, int]]:
+    """entity -> {column: rows} over the recording's data chunks (`rerun rrd print`)."""
+    r = rerun("rrd", "print", str(path))
+    assert r.returncode == 0, r.stderr
+    out: dict[str, dict[str, int]] = defaultdict(lambda: defaultdict(int))
+    for rows, entity, cols in CHUNK.findall(r.stdout):
+        for col in cols.split():
+            out[entity][col] += int(rows)
+    return out
+
+
+def record(path: Path, sources: dict, options: RecordOptions = RecordOptions(), duration_s: float = 1.0) -> dict:
+    cfg = DriveConfig(WorldConfig("highway", 0), duration_s, sources)
+    holder = {}
+
+    def factory(world):
+        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
+        holder["r"] = RunRecorder(path, world.cfg.rig, lines, cfg.tasks, options)
+        return holder["r"]
+
+    result = run_drive(cfg, recorder_factory=factory, render=True)
+    assert holder["r"].close() == path
+    verify(path)
+    return result
+
+
+@pytest.fixture(scope="module")
+def privileged(tmp_path_factory):
+    path = tmp_path_factory.mktemp("priv") / "run.rrd"
+    return path, record(path, {})
+
+
+@pytest.fixture(scope="module")
+def vision(tmp_path_factory):
+    path = tmp_path_factory.mktemp("vision") / "run.rrd"
+    return path, record(path, {"lateral": "vision"})
+
+
+def images(cols: dict) -> int:
+    return cols["/world/ego/camera/left"].get("EncodedImage:blob", 0)
+
+
+def test_every_task_is_recorded_with_all_slots_privileged(privileged):
+    path, result = privileged
+    cols = columns_by_entity(path)
+    missing = [e for e in COMMON + [e for es in TASK_ENTITIES.values() for e in es] if e not in cols]
+    assert not missing, f"missing entities: {missing}"
+    assert not [f for f in os.listdir(path.parent) if f != path.name], "temporaries left behind"
+    # one trajectory point and one ego pose per frame, never re-sent
+    assert cols["/world/trajectory"]["Points3D:positions"] == result["frames"]
+    assert cols["/world/ego"]["Transform3D:translation"] == result["frames"]
+
+
+def test_objects_are_under_the_ego_in_its_frame(privileged):
+    cols = columns_by_entity(privileged[0])
+    assert cols["/world/ego/objects"].get("Boxes3D:centers", 0) > 0
+    assert not [e for e in cols if e.startswith("/world/objects")]
+
+
+def test_the_vision_lateral_slot_draws_its_evidence(vision):
+    cols = columns_by_entity(vision[0])
+    for entity in TASK_ENTITIES["lateral"] + ["/world/ego/camera/left/lateral/evidence"]:
+        assert entity in cols, entity
+    # drawings on the image are stored with the image, not every frame
+    assert cols["/world/ego/camera/left/lateral/boundaries"]["LineStrips2D:strips"] <= images(cols)
+
+
+def test_the_camera_rate_sets_how_many_images_are_stored(privileged, tmp_path):
+    frames = privileged[1]["frames"]
+    assert images(columns_by_entity(privileged[0])) == 5  # default 5 Hz over 1 s
+    every = tmp_path / "every.rrd"
+    record(every, {}, RecordOptions(camera_hz=15.0, image_scale=0.5))
+    assert images(columns_by_entity(every)) == frames == 15
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"jpeg_quality": 0}, "jpeg_quality must be a whole number from 1 to 100, got 0"),
+    ({"jpeg_quality": 101}, "jpeg_quality"), ({"jpeg_quality": 70.5}, "jpeg_quality"),
+    ({"camera_hz": 0}, "camera_hz must be a positive number"), ({"camera_hz": float("nan")}, "camera_hz"),
+    ({"image_scale": 0.0}, "image_scale must be from 0.1 to 1"), ({"image_scale": 2}, "image_scale"),
+])
+def test_record_options_are_validated(kwargs, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        RecordOptions(**kwargs)
+
+
+def test_an_interrupted_recording_is_kept_beside_a_finished_one(tmp_path):
+    final = tmp_path / "X.rrd"
+    final.write_bytes(b"a finished recording")
+    (tmp_path / ".X.rrd.part").write_bytes(b"left over from a killed run")
+    rec = RunRecorder(final, StereoRig(), [np.array([[0.0, 0.0], [100.0, 0.0]])], TASKS)
+    assert rec.close(complete=False) == partial_path(final) == tmp_path / "X.partial.rrd"
+    assert final.read_bytes() == b"a finished recording"
+    verify(tmp_path / "X.partial.rrd")
+    assert sorted(os.listdir(tmp_path)) == ["X.partial.rrd", "X.rrd"]
+    assert rec.close() == tmp_path / "X.partial.rrd"  # closing twice changes nothing
+
+
+def test_a_run_interrupted_midway_keeps_what_was_recorded(tmp_path):
+    final = tmp_path / "W.rrd"
+    holder = {}
+
+    class Interrupted(RunRecorder):
+        def log_step(self, frame, truth, step):
+            if frame.index == 5:
+                raise KeyboardInterrupt
+            super().log_step(frame, truth, step)
+
+    def factory(world):
+        holder["r"] = Interrupted(final, world.cfg.rig, [], TASKS)
+        return holder["r"]
+
+    with pytest.raises(KeyboardInterrupt):
+        run_drive(DriveConfig(WorldConfig("highway", 0), 1.0), recorder_factory=factory, render=True)
+    kept = holder["r"].close(complete=False)
+    verify(kept)
+    assert columns_by_entity(kept)["/world/trajectory"]["Points3D:positions"] == 5
+    assert sorted(os.listdir(tmp_path)) == ["W.partial.rrd"]
+
+
+def test_a_recording_that_raises_is_closed_as_partial(tmp_path):
+    final = tmp_path / "Y.rrd"
+    with pytest.raises(RuntimeError):
+        with RunRecorder(final, StereoRig(), [], TASKS):
+            raise RuntimeError("the run failed")
+    assert sorted(os.listdir(tmp_path)) == ["Y.partial.rrd"]
+
+
+def test_parts_are_resolved_from_the_table(tmp_path):
+    def part(rec, ctx, estimate, debug, truth):
+        pass
+
+    assert resolve_part(part) is part
+    assert resolve_part("percept.review.parts:lateral").plots
+    for bad in ("percept.review.parts", "percept.review.parts:nothing", "no.such.module:x"):
+        with pytest.raises(ValueError, match="recorder part"):
+            resolve_part(bad)
+    task = Task("extra", "extra", "extra", privileged=None, scorer=None, recorder=part)
+    RunRecorder(tmp_path / "Z.rrd", StereoRig(), [], (*TASKS, task)).close()
+    verify(tmp_path / "Z.rrd")
