@@ -1,0 +1,97 @@
+"""Subpixel disparity of an obstacle: one disparity for all its pixels, by direct alignment of its left-image
+patch with the right image (1-D Lucas-Kanade along the rows, Gauss-Newton with Huber weights).
+
+For a fronto-parallel surface the right image is the left one shifted: L(u, v) = R(u - d, v). With the residual
+r = L - R(u - d) and g = dR/du (u - d), one Gauss-Newton step is delta = -sum(w g r) / sum(w g^2)
+(Lucas & Kanade 1981; Baker & Matthews 2004). Averaging over the hundreds of pixels of a car's back gets the
+disparity to a few hundredths of a pixel, below the 0.1 px a single match achieves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Refined:
+    """disparity_px: the patch's disparity [px]; sigma_px: its standard error [px]; pixels: used pixels;
+    converged: the last step was below the tolerance."""
+
+    disparity_px: float
+    sigma_px: float
+    pixels: int
+    converged: bool
+
+
+def surface_mask(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int], d0: float,
+                 radius: int = 3, block: int = 5, tol_px: float = 1.0, min_contrast: float = 3.0,
+                 max_cost_ratio: float = 0.5) -> np.ndarray | None:
+    """Which pixels of ``box`` lie on the surface at disparity ``d0``: full-resolution block matching over the
+    integer disparities within ``radius`` of d0 (box-filtered absolute differences), keeping the pixels whose
+    best disparity (parabola-interpolated) is within ``tol_px`` of d0 and whose cost curve has a clear minimum
+    (at least ``min_contrast`` grey levels below the mean cost, and below ``max_cost_ratio`` times it).
+    (v1-v0, u1-u0) bool, or None when the box leaves the image."""
+    u0, v0, u1, v1 = box
+    w = right.shape[1]
+    lo = int(np.floor(d0)) - radius
+    if u0 - lo - radius - 1 < 0 or lo < 1 or u1 - lo + 1 > w:
+        return None
+    L = left[v0:v1, u0:u1]
+    costs = []
+    for d in range(lo, lo + 2 * radius + 2):
+        # SAD_d(u, v) = box_filter(|L(u, v) - R(u - d, v)|)
+        costs.append(cv2.blur(np.abs(L - right[v0:v1, u0 - d:u1 - d]), (block, block)))
+    c = np.stack(costs)
+    k = np.clip(np.argmin(c, axis=0), 1, len(costs) - 2)
+    c0 = np.take_along_axis(c, (k - 1)[None], 0)[0]
+    c1 = np.take_along_axis(c, k[None], 0)[0]
+    c2 = np.take_along_axis(c, (k + 1)[None], 0)[0]
+    den = c0 - 2 * c1 + c2
+    # parabola through three costs: offset = (c0 - c2) / (2 (c0 - 2 c1 + c2))
+    best = lo + k + np.where(den > 1e-6, (c0 - c2) / (2 * np.maximum(den, 1e-6)), 0.0)
+    # texture: how much worse the other disparities match (grey levels); flat sky or paint has none. A real match
+    # is far better than the average candidate; the best of candidates that all miss is not
+    mean = np.mean(c, axis=0)
+    return ((np.abs(best - d0) < tol_px) & (den > 1e-6) & (mean - c1 > min_contrast)
+            & (c1 < max_cost_ratio * mean))
+
+
+def refine_disparity(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int], mask: np.ndarray | None,
+                     d0: float, iterations: int = 10, huber: float = 6.0, tol: float = 1e-3) -> Refined | None:
+    """Disparity [px] of the pixels of ``box`` (u0, v0, u1, v1) in ``mask`` ((v1-v0, u1-u0) bool, None = all),
+    starting from ``d0``; float32 grey images of one size. None when the patch has no texture or leaves the image."""
+    u0, v0, u1, v1 = box
+    h, w = right.shape
+    if u1 - u0 < 3 or v1 - v0 < 3 or not np.isfinite(d0):
+        return None
+    L = left[v0:v1, u0:u1]
+    gx_full = cv2.Sobel(right, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
+    vv, uu = np.mgrid[v0:v1, u0:u1].astype(np.float32)
+    keep = np.ones(L.shape, bool) if mask is None else mask[:L.shape[0], :L.shape[1]]
+    d, converged, step = float(d0), False, np.inf
+    for _ in range(iterations):
+        mx = uu - d
+        if mx.min() < 1 or mx.max() > w - 2:
+            return None
+        Rw = cv2.remap(right, mx, vv, cv2.INTER_CUBIC)
+        g = cv2.remap(gx_full, mx, vv, cv2.INTER_CUBIC)
+        r = L - Rw
+        # Huber weights: w = 1 inside the threshold, k / |r| outside
+        a = np.abs(r)
+        wts = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-6)) * keep
+        H = float(np.sum(wts * g * g))
+        if H < 1e-3:
+            return None
+        # Gauss-Newton: delta = -sum(w g r) / sum(w g^2)
+        step = -float(np.sum(wts * g * r)) / H
+        d += float(np.clip(step, -1.0, 1.0))
+        if abs(step) < tol:
+            converged = True
+            break
+    n = int(keep.sum())
+    # standard error of the estimate: sigma^2 = sum(w r^2) / (n - 1) / sum(w g^2)
+    s2 = float(np.sum(wts * r * r)) / max(n - 1, 1) / H
+    return Refined(d, float(np.sqrt(s2)), n, converged)
