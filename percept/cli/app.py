@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import typer
 
-from . import bench_cmd, calibrate_cmd, drive_cmd, eval_cmd, lanes_cmd, render_cmd, scenarios_cmd, view_cmd
+from . import (bench_cmd, calibrate_cmd, drive_cmd, eval_cmd, lanes_cmd, render_cmd, scenarios_cmd, stereo_cmd,
+               view_cmd)
 from .common import console, err, fail, progress_bar, run_cli, write_json
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
@@ -15,6 +16,7 @@ app.command("drive")(drive_cmd.drive)
 app.command("render")(render_cmd.render)
 app.command("eval")(eval_cmd.eval_)
 app.command("bench")(bench_cmd.bench)
+app.command("stereo")(stereo_cmd.stereo)
 lanes_cmd.register(app)
 calibrate_cmd.register(app)
 view_cmd.register(app)

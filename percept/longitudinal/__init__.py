@@ -1,14 +1,17 @@
 """Longitudinal: range, range rate and time to contact of what is ahead; following and emergency braking inputs.
 
-So far: the scoring formulas (``metrics``), the in-path obstacle finder (``obstacles``: coarse stereo in the
+So far: the scoring formulas (``metrics``), dense stereo for ``percept stereo`` (``dense``), the in-path obstacle finder (``obstacles``: coarse stereo in the
 band the path can hold an obstacle, pixels that stand up in the corridor, the nearest group) and the subpixel
 range of a surface (``refine``: full-resolution surface mask and 1-D direct alignment). The vision slot that
 tracks them (Kalman filter over range and range rate, ground contact and flow cues) is not wired yet.
 """
 
-from .metrics import RANGE_BINS_M, bin_key, range_abs_rel_err, range_abs_rel_err_by_bin, ttc_abs_err_s
+from .dense import DenseConfig, dense_disparity, row_misalignment_px, sgbm_disparity
+from .metrics import (BAD_PIXEL_PX, RANGE_BINS_M, bin_key, disparity_metrics, disparity_summary, range_abs_rel_err,
+                      range_abs_rel_err_by_bin, ttc_abs_err_s)
 from .obstacles import Obstacle, ObstacleConfig, ObstacleFinder
 from .refine import Refined, refine_disparity, surface_mask
 
-__all__ = ["RANGE_BINS_M", "Obstacle", "ObstacleConfig", "ObstacleFinder", "Refined", "bin_key",
-           "range_abs_rel_err", "range_abs_rel_err_by_bin", "refine_disparity", "surface_mask", "ttc_abs_err_s"]
+__all__ = ["BAD_PIXEL_PX", "DenseConfig", "RANGE_BINS_M", "Obstacle", "ObstacleConfig", "ObstacleFinder", "Refined", "bin_key",
+           "dense_disparity", "disparity_metrics", "disparity_summary", "range_abs_rel_err", "range_abs_rel_err_by_bin", "refine_disparity", "row_misalignment_px", "sgbm_disparity", "surface_mask",
+           "ttc_abs_err_s"]
