@@ -66,6 +66,12 @@ class Task:
     budget_ms: float | None = None
 
 
+def _longitudinal_slot(ctx: SlotContext) -> Slot:
+    from percept.longitudinal.slot import LongitudinalSlot
+
+    return LongitudinalSlot(ctx.rig, ctx.dt_s)
+
+
 def _lane_slot(ctx: SlotContext) -> Slot:
     from percept.lanes import LaneSlot
 
@@ -81,12 +87,13 @@ TASKS: tuple[Task, ...] = (
                    Headline("centering RMS [m]", "centering_rms_m"), Headline("centering max [m]", "centering_max_m")),
          help="lane markings -> the ego path (steering)", bench_scenario="curves", budget_ms=3.0),
     Task("longitudinal", "longitudinal", "longitudinal", priv.PrivilegedLongitudinal,
-         LongitudinalScorer, recorder="percept.review.parts:longitudinal", upstream=("lateral",),
+         LongitudinalScorer, vision=_longitudinal_slot, recorder="percept.review.parts:longitudinal",
+         upstream=("lateral",),
          headline=(Headline("range error (median)", "range_abs_rel_err", "{:.3f}"),
                    Headline("time gap mean [s]", "time_gap_mean_s", "{:.2f}"),
                    Headline("time gap min [s]", "time_gap_min_s", "{:.2f}"),
                    Headline("phantom brakes", "phantom_brakes", "{}")),
-         help="the lead ahead (following, emergency braking)"),
+         help="the lead ahead (following, emergency braking)", budget_ms=3.0),
     Task("pedestrians", "pedestrians", "pedestrians", priv.PrivilegedPedestrians,
          PedestrianScorer, recorder="percept.review.parts:pedestrians", upstream=("lateral",),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}")),

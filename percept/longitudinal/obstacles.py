@@ -23,7 +23,9 @@ class ObstacleConfig:
     """scale: image scale the coarse disparity is computed at; num_disparities / block_size: StereoBM's at that
     scale; min_range_m, max_range_m: ranges searched [m]; half_width_m: corridor half-width about the path
     centre [m]; min_height_m, max_height_m: a pixel between these heights above the road stands up [m];
-    min_area_m2: smallest frontal area that counts as an obstacle [m²]; bin_rel: relative width of a range bin."""
+    min_area_m2: smallest frontal area that counts as an obstacle [m²]; bin_rel: relative width of a range bin;
+    grounded_m: a group's lowest pixels must be below this height (obstacles stand on the road; a patch of sky
+    or glare matched by chance floats) [m]; texture_threshold: StereoBM's (flat regions are not matched)."""
 
     scale: float = 0.5
     num_disparities: int = 48
@@ -35,6 +37,8 @@ class ObstacleConfig:
     max_height_m: float = 3.5
     min_area_m2: float = 0.25
     bin_rel: float = 0.04
+    grounded_m: float = 1.0
+    texture_threshold: int = 12
 
     def __post_init__(self) -> None:
         if not 0.1 <= self.scale <= 1.0:
@@ -71,7 +75,7 @@ class ObstacleFinder:
         self.row0 = max(int(np.floor(min(top, rig.horizon_row) * s)) - cfg.block_size, 0)
         self.matcher = cv2.StereoBM_create(cfg.num_disparities, cfg.block_size)
         self.matcher.setMinDisparity(0)
-        self.matcher.setTextureThreshold(5)
+        self.matcher.setTextureThreshold(cfg.texture_threshold)
         self.matcher.setUniquenessRatio(10)
         h, w = self.size[1] - self.row0, self.size[0]
         vv, uu = np.mgrid[0:h, 0:w]
@@ -118,7 +122,7 @@ class ObstacleFinder:
         need = cfg.min_area_m2 * (cam.fx * cfg.scale / np.exp(bins * np.log1p(cfg.bin_rel))) ** 2
         for b in bins[np.argsort(bins)]:
             near = np.abs(k - b) <= 1
-            if near.sum() >= max(need[bins == b][0], 6):
+            if near.sum() >= max(need[bins == b][0], 6) and np.percentile(pv[near, 2], 5) < cfg.grounded_m:
                 sel = near
                 break
         else:
