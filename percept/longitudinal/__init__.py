@@ -1,9 +1,9 @@
 """Longitudinal: range, range rate and time to contact of what is ahead; following and emergency braking inputs.
 
-So far: the scoring formulas (``metrics``), dense stereo for ``percept stereo`` (``dense``), the in-path obstacle finder (``obstacles``: coarse stereo in the
-band the path can hold an obstacle, pixels that stand up in the corridor, the nearest group) and the subpixel
-range of a surface (``refine``: full-resolution surface mask and 1-D direct alignment). The vision slot that
-tracks them (Kalman filter over range and range rate, ground contact and flow cues) is not wired yet.
+The vision slot (``slot``): the in-path obstacle finder (``obstacles``: coarse stereo in the band the path can
+hold an obstacle, pixels that stand up in the corridor, the nearest group), the subpixel range of the surface
+facing the ego (``refine``: full-resolution surface mask, 1-D direct alignment), and a Kalman filter over range
+and range rate. Also the scoring formulas (``metrics``) and dense stereo for ``percept stereo`` (``dense``).
 """
 
 from .dense import DenseConfig, dense_disparity, row_misalignment_px, sgbm_disparity
