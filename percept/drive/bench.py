@@ -119,5 +119,19 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     slot = task.vision(ctx)
     shot = _cycle(shots, progress)
     ms = median_ms(lambda: slot.step(*shot()), frames)
-    return StageCost(task.timing_key, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms,
-                     target_ms=task.budget_ms)
+    peer, peer_ms = None, None
+    if task.bench_peer is not None:
+        peer, run = task.bench_peer([f for f, _ in shots])
+        peer_ms = median_ms(lambda: run(shot()[0]), frames)
+    return StageCost(task.timing_key, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms, peer,
+                     peer_ms, task.budget_ms)
+
+
+def sgbm_full_frame(frames: list) -> tuple[str, Callable]:
+    """The stock way to range what is ahead: OpenCV's StereoSGBM over the whole grey frame (96 disparities, 5x5
+    blocks, the usual P1 = 8 c b^2, P2 = 32 c b^2 smoothness penalties)."""
+    sgbm = cv2.StereoSGBM_create(0, 96, 5, P1=8 * 5 * 5, P2=32 * 5 * 5)
+
+    def run(frame) -> None:
+        sgbm.compute(cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY), cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY))
+    return "OpenCV StereoSGBM, full frame", run

@@ -50,7 +50,8 @@ class Task:
     ``timing_ms`` and in ``percept bench``; privileged / vision: slot factories (vision None = not built yet);
     scorer: ScoreContext -> scorer; recorder: "module:function" of its part in ``percept.review`` (None = none);
     upstream: tasks whose estimates it reads; headline: metrics the tables show; help: one line for --help;
-    bench_scenario: where ``percept bench`` times its vision slot; budget_ms: its per-frame budget [ms]."""
+    bench_scenario: where ``percept bench`` times its vision slot; budget_ms: its per-frame budget [ms];
+    bench_peer: frames -> (name, run(frame)), the stock way to do the same job, timed in the same run."""
 
     name: str
     group: str
@@ -64,12 +65,19 @@ class Task:
     help: str = ""
     bench_scenario: str = "highway"
     budget_ms: float | None = None
+    bench_peer: Callable | None = None
 
 
 def _longitudinal_slot(ctx: SlotContext) -> Slot:
     from percept.longitudinal.slot import LongitudinalSlot
 
     return LongitudinalSlot(ctx.rig, ctx.dt_s)
+
+
+def _sgbm_peer(frames: list):
+    from .bench import sgbm_full_frame
+
+    return sgbm_full_frame(frames)
 
 
 def _lane_slot(ctx: SlotContext) -> Slot:
@@ -93,7 +101,7 @@ TASKS: tuple[Task, ...] = (
                    Headline("time gap mean [s]", "time_gap_mean_s", "{:.2f}"),
                    Headline("time gap min [s]", "time_gap_min_s", "{:.2f}"),
                    Headline("phantom brakes", "phantom_brakes", "{}")),
-         help="the lead ahead (following, emergency braking)", budget_ms=3.0),
+         help="the lead ahead (following, emergency braking)", budget_ms=3.0, bench_peer=_sgbm_peer),
     Task("pedestrians", "pedestrians", "pedestrians", priv.PrivilegedPedestrians,
          PedestrianScorer, recorder="percept.review.parts:pedestrians", upstream=("lateral",),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}")),
