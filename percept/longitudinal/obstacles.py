@@ -80,9 +80,12 @@ class ObstacleFinder:
         h, w = self.size[1] - self.row0, self.size[0]
         vv, uu = np.mgrid[0:h, 0:w]
         # full-resolution pixel centres of the coarse grid
-        self.u_full = (uu + 0.5) / s - 0.5
-        self.v_full = (vv + self.row0 + 0.5) / s - 0.5
-        self.R_vc = rig.rotation_cam_from_vehicle().T
+        self.u_full = ((uu + 0.5) / s - 0.5).astype(np.float32)
+        self.v_full = ((vv + self.row0 + 0.5) / s - 0.5).astype(np.float32)
+        # a pixel at depth Z is at p_v = c + Z ray, ray = R^T ((u - cx) / fx, (v - cy) / fy, 1): precomputed
+        rays_c = np.stack([(self.u_full - cam.cx) / cam.fx, (self.v_full - cam.cy) / cam.fy, np.ones_like(self.u_full)],
+                          axis=-1)
+        self.rays = (rays_c @ rig.rotation_cam_from_vehicle()).astype(np.float32)
         self.c = rig.camera_position(Side.LEFT)
 
     def coarse_disparity(self, left_gray: np.ndarray, right_gray: np.ndarray) -> np.ndarray:
@@ -97,15 +100,14 @@ class ObstacleFinder:
 
     def find(self, left_gray: np.ndarray, right_gray: np.ndarray, path: EgoPath) -> tuple[Obstacle | None, dict]:
         """The nearest obstacle in the path, and debug data (the coarse disparity, the standing pixels)."""
-        cfg, cam = self.cfg, self.rig.camera
+        cfg = self.cfg
         d = self.coarse_disparity(left_gray, right_gray)
         ok = np.isfinite(d) & (d > 0)
-        z = np.where(ok, cam.fx * self.rig.baseline_m / np.where(ok, d, 1.0), np.inf)
+        z = np.where(ok, self.rig.camera.fx * self.rig.baseline_m / np.where(ok, d, 1.0), np.inf).astype(np.float32)
         ok &= (z > cfg.min_range_m) & (z < cfg.max_range_m)
         u, v, zc = self.u_full[ok], self.v_full[ok], z[ok]
-        # camera frame: X = (u - cx) Z / fx, Y = (v - cy) Z / fy; vehicle frame: p_v = R^T p_c + c
-        pc = np.stack([(u - cam.cx) * zc / cam.fx, (v - cam.cy) * zc / cam.fy, zc], axis=1)
-        pv = pc @ self.R_vc.T + self.c
+        # camera frame: (X, Y, Z) = Z ((u - cx) / fx, (v - cy) / fy, 1); vehicle frame: p_v = R^T p_c + c
+        pv = self.rays[ok] * zc[:, None] + self.c
         lateral = np.abs(pv[:, 1] - path.centre_y(pv[:, 0]))
         stand = (pv[:, 2] > cfg.min_height_m) & (pv[:, 2] < cfg.max_height_m) & (lateral < cfg.half_width_m)
         debug = {"disparity": d, "row0": self.row0, "standing": int(stand.sum())}

@@ -92,8 +92,12 @@ class LongitudinalSlot:
         # rows of heights hi..lo at range Z: v = cy + fy (h - z) / Z
         v0 = int(max(cam.cy + cam.fy * (h - hi) / z0, 0))
         v1 = int(min(cam.cy + cam.fy * (h - lo) / z0, cam.height))
-        box = (ob.box_px[0], v0, ob.box_px[2], max(v1, v0 + 3))
-        L, R = left.astype(np.float32), right.astype(np.float32)
+        v1 = max(v1, v0 + 3)
+        # only the crop the matching needs: the face, and the right image up to its disparity further left
+        c0 = max(ob.box_px[0] - int(d0) - 8, 0)
+        c1 = min(ob.box_px[2] + 2, cam.width)
+        L, R = left[v0:v1, c0:c1].astype(np.float32), right[v0:v1, c0:c1].astype(np.float32)
+        box = (ob.box_px[0] - c0, 0, ob.box_px[2] - c0, v1 - v0)
         m = surface_mask(L, R, box, d0)
         if m is None or m.sum() < 12:
             return None
