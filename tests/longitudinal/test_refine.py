@@ -71,4 +71,4 @@ def test_the_finder_reports_a_wall_standing_in_the_path_at_its_range():
     # its lowest standing pixels are min_height_m above the road: f h_min / Z rows above the foot
     assert ob.box_px[3] == pytest.approx(foot - cam.fy * ObstacleConfig().min_height_m / z_wall, abs=3)
     with pytest.raises(ValueError, match="num_disparities must be a positive multiple of 16"):
-        ObstacleConfig(num_disparities=40)
+        ObstacleConfig(num_disparities=(40, 32))
