@@ -6,17 +6,17 @@ import typer
 
 from . import (bench_cmd, calibrate_cmd, drive_cmd, eval_cmd, lanes_cmd, render_cmd, scenarios_cmd, stereo_cmd,
                view_cmd)
-from .common import console, err, fail, progress_bar, run_cli, write_json
+from .common import Command, Group, console, err, fail, progress_bar, run_cli, write_json
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+app = typer.Typer(add_completion=False, no_args_is_help=True, cls=Group,
                   help="percept: a camera-only driving stack on highway-env, with a simulated stereo camera.")
 
-app.command("scenarios")(scenarios_cmd.scenarios)
-app.command("drive")(drive_cmd.drive)
-app.command("render")(render_cmd.render)
-app.command("eval")(eval_cmd.eval_)
-app.command("bench")(bench_cmd.bench)
-app.command("stereo")(stereo_cmd.stereo)
+app.command("scenarios", cls=Command)(scenarios_cmd.scenarios)
+app.command("drive", cls=Command)(drive_cmd.drive)
+app.command("render", cls=Command)(render_cmd.render)
+app.command("eval", cls=Command)(eval_cmd.eval_)
+app.command("bench", cls=Command)(bench_cmd.bench)
+app.command("stereo", cls=Command)(stereo_cmd.stereo)
 lanes_cmd.register(app)
 calibrate_cmd.register(app)
 view_cmd.register(app)

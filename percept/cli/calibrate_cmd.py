@@ -6,9 +6,12 @@ Registered on the main typer app by ``percept.cli.app``; parses options, calls `
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Annotated, Optional
 
 import typer
+
+from .common import Command
+from .options import flag
 
 
 def _cam_rows(name: str, cal) -> list[tuple[str, str]]:
@@ -21,13 +24,13 @@ def _cam_rows(name: str, cal) -> list[tuple[str, str]]:
 def register(app: typer.Typer) -> None:
     """Add the ``calibrate`` command to ``app``."""
 
-    @app.command("calibrate")
+    @app.command("calibrate", cls=Command)
     def calibrate(
         folder: Path = typer.Argument(..., help="Folder of chessboard photos (one camera), or of left<N>/right<N> "
                                                 "photo pairs with --stereo."),
         pattern: str = typer.Option("9x6", "--pattern", help="Inner corners per row x per column, e.g. 9x6."),
-        stereo: bool = typer.Option(False, "--stereo", help="Calibrate a stereo rig from left<N>.<ext> / "
-                                                            "right<N>.<ext> pairs: both cameras, R, T, rectification."),
+        stereo: Annotated[bool, flag("--stereo", help="Calibrate a stereo rig from left<N>.<ext> / right<N>.<ext> "
+                                                      "pairs: both cameras, R, T, rectification.")] = False,
         square: float = typer.Option(1.0, "--square", help="Side of a board square in metres, 0.0001 to 10 (sets the "
                                                            "units of the stereo baseline; 1 = board squares)."),
         out: Optional[Path] = typer.Option(None, "--out", help="Calibration file to write (default DIR/calib.json, "

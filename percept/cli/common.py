@@ -15,20 +15,39 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from typer.core import TyperCommand, TyperGroup
 
 console = Console()
 err = Console(stderr=True)
 
 
+def error_line(message: str) -> None:
+    """Print ``error: message`` as one line on stderr (line breaks in ``message`` become spaces)."""
+    err.print(f"[bold red]error:[/] {escape(message.strip().replace(chr(10), ' '))}", highlight=False,
+              soft_wrap=True)
+
+
 def fail(message: str) -> None:
     """Print ``error: message`` on one line and exit with code 2."""
-    err.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
+    error_line(message)
     raise typer.Exit(2)
 
 
+class _Bar(Progress):
+    """A progress bar that disappears when its command fails, so that the error stays the last line (after
+    Ctrl-C it stays: it shows how far the work got)."""
+
+    def __exit__(self, kind, value, traceback) -> None:
+        failed = kind is not None and not issubclass(kind, KeyboardInterrupt) and getattr(value, "exit_code", 1) != 0
+        if not failed:
+            return super().__exit__(kind, value, traceback)
+        self.live.transient = True
+        self.live.stop()  # cleared, and no line ending the bar (Progress.stop would print one)
+
+
 def progress_bar() -> Progress:
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                    console=err, transient=False)
+    return _Bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                console=err, transient=False)
 
 
 def check_outputs(outputs: Iterable[Optional[Path]], inputs: Iterable[Optional[Path]] = ()) -> None:
@@ -47,7 +66,7 @@ def check_outputs(outputs: Iterable[Optional[Path]], inputs: Iterable[Optional[P
         seen[r] = Path(p)
         if r.is_dir():
             fail(f"output {p} is a folder; give a file path")
-        parent = r.parent
+        parent = Path(p).parent  # as the user wrote it, for the message
         while not parent.exists():
             parent = parent.parent
         if not parent.is_dir():
@@ -91,8 +110,29 @@ def fmt(x, spec: str = "{:.2f}") -> str:
     return spec.format(x)
 
 
+class _HelpWithoutType:
+    """--help listed without a value type: typer prints ``<bool>`` beside it, as if it took a value."""
+
+    def get_help_option(self, ctx):
+        option = super().get_help_option(ctx)
+        if option is not None:
+            option.metavar = ""
+        return option
+
+
+class Command(_HelpWithoutType, TyperCommand):
+    """The class of every percept command (``app.command(NAME, cls=Command)``)."""
+
+
+class Group(_HelpWithoutType, TyperGroup):
+    """The class of the percept app (``typer.Typer(cls=Group)``)."""
+
+
 Note = Union[str, Callable[[], str], None]
-_interrupt = {"note": None, "hit": False}
+_interrupt = {"note": None, "signal": None}
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+"""Ctrl-C, and the polite stop of `kill`, `timeout`, CI cancels and service managers: both stop a command the same
+way (workers ended, partial outputs kept, temporaries removed); the exit code is 128 + the signal (130, 143)."""
 
 
 def on_interrupt(note: Note) -> None:
@@ -110,8 +150,8 @@ def _interrupt_line() -> str:
     return f"interrupted: {text or 'stopped before finishing; no output was written or replaced'}"
 
 
-def _on_sigint(signum, frame) -> None:
-    _interrupt["hit"] = True
+def _on_stop_signal(signum, frame) -> None:
+    _interrupt["signal"] = signum
     raise KeyboardInterrupt
 
 
@@ -164,23 +204,41 @@ def quiet_libraries() -> None:
             logging.setLogLevel(logging.LOG_LEVEL_ERROR)
 
 
-def run_cli(app: Callable[[], None]) -> None:
-    """Run the typer ``app`` as the console script: quiet libraries; Ctrl-C (SIGINT) stops the command (typer turns
-    KeyboardInterrupt into exit code 130), then ONE line says what was kept (see ``on_interrupt``)."""
+def _usage_error(e: typer.TyperException) -> int:
+    """A command line typer cannot parse (unknown option, bad value, missing argument): one line naming what was
+    wrong and where the help is; the error's exit code (2). Without any arguments typer has printed the help."""
+    if type(e).__name__ != "NoArgsIsHelpError":
+        ctx = getattr(e, "ctx", None)
+        error_line(e.format_message() + (f" (see `{ctx.command_path} --help`)" if ctx is not None else ""))
+    return getattr(e, "exit_code", 2)
+
+
+def run_cli(app: Callable[..., None]) -> None:
+    """Run the typer ``app`` as the console script: quiet libraries; usage errors as one line; Ctrl-C (SIGINT) or
+    SIGTERM stops the command as a KeyboardInterrupt, then ONE line says what was kept (see ``on_interrupt``) and
+    the exit code is 130 (143 for SIGTERM)."""
     quiet_libraries()
     restore = _filter_native_stderr()
-    signal.signal(signal.SIGINT, _on_sigint)
+    for sig in STOP_SIGNALS:
+        signal.signal(sig, _on_stop_signal)
     code = 0
     try:
-        app()
+        # not standalone: usage errors come back here to be printed as one line; Exit codes are returned
+        returned = app(standalone_mode=False)
+        code = returned if isinstance(returned, int) else 0
+    except typer.TyperException as e:
+        code = _usage_error(e)
+    except typer.Abort:
+        code = 1
     except SystemExit as e:
         code = e.code
     except KeyboardInterrupt:
         code = 130
     finally:
-        if _interrupt["hit"]:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)  # the line and the exit are not interrupted in turn
+        if _interrupt["signal"] is not None:
+            for sig in STOP_SIGNALS:  # the line and the exit are not interrupted in turn
+                signal.signal(sig, signal.SIG_IGN)
             err.print(escape(_interrupt_line()), style="yellow", highlight=False, soft_wrap=True)
-            code = 130
+            code = 128 + int(_interrupt["signal"])
         restore()
     sys.exit(code)

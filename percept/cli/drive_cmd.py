@@ -12,7 +12,7 @@ from rich.table import Table
 from percept.sensors.records import Source
 
 from . import options as opt
-from .common import check_outputs, console, fail, fmt, on_interrupt, progress_bar, write_json
+from .common import check_outputs, console, fail, fmt, on_interrupt, progress_bar, write_error, write_json
 
 
 def drive(
@@ -25,8 +25,9 @@ def drive(
     pedestrians: opt.Pedestrians = Source.PRIVILEGED,
     odometry: opt.Odometry = Source.PRIVILEGED,
     record: Annotated[Optional[Path], typer.Option(
-        "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd).")] = None,
-    no_record: Annotated[bool, typer.Option("--no-record", help="Do not write a Rerun recording.")] = False,
+        "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
+                                         "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,
+    no_record: Annotated[bool, opt.flag("--no-record", help="Do not write a Rerun recording.")] = False,
     camera_hz: Annotated[float, typer.Option("--camera-hz", help="Camera images stored per simulated second in "
                                              "the recording (15 = every frame).")] = 5.0,
     camera_quality: Annotated[int, typer.Option("--camera-quality", help="JPEG quality of the recorded camera "
@@ -37,16 +38,19 @@ def drive(
 ):
     """Drive a scenario in closed loop from the cameras, score it against ground truth and record it to Rerun."""
     from percept.drive import DriveConfig, run_drive
+    from percept.drive.config import MAX_DURATION_S
+    from percept.review import partial_path
     from percept.sims import WorldConfig
 
     opt.check_number("--seed", seed, 0, opt.MAX_SEED)
+    opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
                           opt.slot_sources(lateral, longitudinal, pedestrians, odometry))
     except ValueError as e:
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
-    check_outputs([rec_path, json_path])
+    check_outputs([rec_path, rec_path and partial_path(rec_path), json_path])
     recording = Recording(rec_path, cfg.tasks, camera_hz, camera_quality, camera_scale)
     with progress_bar() as bar:
         task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)
@@ -70,14 +74,21 @@ class Recording:
     (``open``), closed complete or partial; says what Ctrl-C keeps."""
 
     def __init__(self, path: Optional[Path], tasks, camera_hz: float, quality: int, scale: float):
-        from percept.review import RecordOptions, partial_path
+        from percept.review import RecordOptions
 
         opt.check_number("--camera-hz", camera_hz, 0.01, 1000)
         opt.check_number("--camera-quality", quality, 1, 100)
         opt.check_number("--camera-scale", scale, 0.1, 1)
         self.path, self.tasks, self.options, self.recorder = path, tasks, RecordOptions(camera_hz, quality, scale), None
-        on_interrupt(f"the recording so far is kept as {partial_path(path)}; no JSON was written" if path else
-                     "nothing was written")
+        on_interrupt(self.kept)
+
+    def kept(self) -> str:
+        """What an interrupted run leaves: the partial recording, if one was made."""
+        where = self.recorder and self.recorder.closed_as
+        if not where:
+            return "nothing was written or replaced"
+        return f"{'the finished recording is' if where == self.path else 'the recording so far is kept as'} " \
+               f"{where}; no JSON was written or replaced"
 
     def open(self, world):
         from percept.review import RunRecorder
@@ -87,8 +98,15 @@ class Recording:
         return self.recorder
 
     def close(self, complete: bool = True) -> None:
-        if self.recorder is not None:
+        """Move the recording into place; a one-line error if the disk refuses a finished one. An interrupted or
+        failed run's partial recording is best effort: the interrupt or error itself is what gets reported."""
+        if self.recorder is None:
+            return
+        try:
             self.recorder.close(complete=complete)
+        except OSError as e:
+            if complete:
+                fail(write_error(self.path, e))
 
 
 def summary_table(cfg, result: dict) -> Table:

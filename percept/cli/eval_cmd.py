@@ -34,7 +34,7 @@ def eval_(
     pedestrians: opt.Pedestrians = Source.PRIVILEGED,
     odometry: opt.Odometry = Source.PRIVILEGED,
     json_path: opt.JsonOut = None,
-    redo: Annotated[bool, typer.Option("--redo", help="Drive again the runs in --out that were made with other "
+    redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
                                                       "settings (other slots, duration or percept version).")] = False,
 ):
     """Drive every (scenario, condition, seed) and summarise the metrics per scenario and condition.
@@ -45,12 +45,15 @@ def eval_(
     go on, and the exit code is 1.
     """
     from percept.drive import TASKS
-    from percept.drive.batch import Engine, EvalPlan, parse_seeds, refuse_other_settings, scan_runs
+    from percept.drive.batch import Engine, EvalPlan, parse_seeds
     from percept.drive.config import MAX_DURATION_S
+    from percept.drive.resume import refuse_other_settings, scan_runs
     from percept.sims import SCENARIOS
 
     opt.check_number("--workers", workers, 1, 256)
     opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
+    if "all" in scenario and len(set(scenario)) > 1:
+        fail("--scenario all already means every scenario; give either all or scenario names, not both")
     names = list(SCENARIOS) if "all" in scenario else scenario
     try:
         eng = Engine(engine)
@@ -97,7 +100,8 @@ def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict
         kept[0] += "error" not in r
         bar.advance(task)
 
-    on_interrupt(lambda: f"{kept[0]} finished runs kept in {out / 'runs'}; run the same command to resume")
+    on_interrupt(lambda: f"{kept[0]} finished run{'' if kept[0] == 1 else 's'} kept in {out / 'runs'}; run the same "
+                         "command to resume")
     with progress_bar() as bar:
         task = bar.add_task(f"eval {len(plan.jobs)} runs", total=len(plan.jobs))
         try:

@@ -15,11 +15,13 @@ from typing import Optional
 import typer
 from rich.markup import escape
 
+from .common import Command
+
 
 def register(app: typer.Typer) -> None:
     """Add the ``lanes`` command to ``app``."""
 
-    @app.command("lanes")
+    @app.command("lanes", cls=Command)
     def lanes(
         source: Path = typer.Argument(..., help="An image, a video or a folder of images (dash camera, road ahead)."),
         json_path: Optional[Path] = typer.Option(None, "--json",

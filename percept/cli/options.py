@@ -13,6 +13,7 @@ from percept.sensors.records import Source
 
 
 MAX_SEED = 2**31 - 1
+"""Largest --seed; the same as ``percept.drive.batch.MAX_SEED`` (not imported from there: --help stays fast)."""
 _SLOT = "{task} slot: vision (its perception module) or privileged (ground truth, the baseline)."
 
 Scenario = Annotated[str, typer.Option("--scenario", help="Scenario name (see `percept scenarios`).")]
@@ -30,6 +31,12 @@ JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the 
                                                  dir_okay=False)]
 
 
+def flag(*names: str, help: str):
+    """An on/off option (``Annotated[bool, flag("--force", help=...)]``): --help shows it without a value type,
+    where typer would print ``<bool>`` as if it took one."""
+    return typer.Option(*names, help=help, metavar="")
+
+
 def check_number(flag: str, value, lo: float | None = None, hi: float | None = None):
     """The one place a number from the command line is checked by its meaning: finite and within [lo, hi]; a
     one-line error (exit 2) naming the option otherwise. Returns the value; None passes (option not given)."""
@@ -38,10 +45,15 @@ def check_number(flag: str, value, lo: float | None = None, hi: float | None = N
     if value is None:
         return None
     if not math.isfinite(value) or (lo is not None and value < lo) or (hi is not None and value > hi):
-        span = (f"between {lo:g} and {hi:g}" if lo is not None and hi is not None
-                else f"at least {lo:g}" if lo is not None else f"at most {hi:g}")
+        span = (f"between {_bound(lo)} and {_bound(hi)}" if lo is not None and hi is not None
+                else f"at least {_bound(lo)}" if lo is not None else f"at most {_bound(hi)}")
         fail(f"{flag} must be a finite number {span}, got {value}")
     return value
+
+
+def _bound(x: float) -> str:
+    """A limit as written in a message: whole numbers in full (2147483647, not 2.14748e+09), others short."""
+    return str(int(x)) if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
 
 
 def slot_sources(lateral: Source, longitudinal: Source, pedestrians: Source, odometry: Source) -> dict:

@@ -18,8 +18,8 @@ def render(
     scenario: opt.Scenario = "highway",
     seed: opt.Seed = 0,
     condition: opt.Condition = "clear",
-    scenery: Annotated[bool, typer.Option(help="Roadside clutter (rails, poles, trees, buildings).")] = True,
-    force: Annotated[bool, typer.Option("--force", help="Replace an earlier render in --out (its files are removed "
+    scenery: Annotated[bool, opt.flag(help="Roadside clutter (rails, poles, trees, buildings).")] = True,
+    force: Annotated[bool, opt.flag("--force", help="Replace an earlier render in --out (its files are removed "
                                                         "first; other files still refuse the folder).")] = False,
 ):
     """Render stereo PNGs, depth and ground truth of a scenario; the ego is driven by highway-env's IDM autopilot.

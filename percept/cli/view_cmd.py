@@ -7,23 +7,33 @@ listen on 127.0.0.1 unless ``--bind`` says otherwise.
 
 from __future__ import annotations
 
+import importlib.util
 import ipaddress
 import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Annotated
 
 import typer
 
-from .common import fail
+from .common import Command, fail, on_interrupt
+from .options import flag
 
 RRD_MAGIC = b"RRF"
 """Every .rrd file starts with these bytes (then the format version)."""
 
 
 def rerun_executable() -> str | None:
-    """The ``rerun`` viewer beside this Python (the rerun-sdk wheel installs it there), else on PATH."""
+    """The ``rerun`` viewer: the binary of the ``rerun_cli`` package (installed with rerun-sdk), else the ``rerun``
+    script beside this Python or on PATH. The binary itself, not the script that starts it: stopping the script
+    (Ctrl-C, a kill) would leave the viewer and its servers running."""
+    spec = importlib.util.find_spec("rerun_cli")
+    if spec is not None and spec.origin:
+        exe = Path(spec.origin).with_name("rerun.exe" if sys.platform.startswith("win") else "rerun")
+        if exe.is_file():
+            return str(exe)
     exe = Path(sys.executable).with_name("rerun")
     return str(exe) if exe.exists() else shutil.which("rerun")
 
@@ -47,8 +57,9 @@ def recording_problem(exe: str, recording: Path) -> str | None:
     # verify exits 0 on files it cannot read at all ("0 files verified"), so its count is checked too
     if r.returncode == 0 and "1 file verified" in r.stdout + r.stderr:
         return None
-    lines = [ln.strip() for ln in (r.stdout + r.stderr).splitlines() if ln.strip() and "INFO" not in ln]
-    why = next((ln for ln in lines if not ln.startswith("Error: Verification failed")), "it cannot be read")
+    lines = [ln.strip() for ln in (r.stdout + r.stderr).splitlines() if ln.strip() and "INFO" not in ln
+             and "files verified" not in ln and not ln.startswith("Error: Verification failed")]
+    why = next(iter(lines), "it is truncated or holds no recording")
     why = why.removeprefix("Error: ")
     if why.startswith('"'):  # '"FILE": what is wrong'
         why = why.split(": ", 1)[-1]
@@ -68,17 +79,19 @@ def check_bind(bind: str) -> str:
 def register(app: typer.Typer) -> None:
     """Add the ``view`` command to ``app``."""
 
-    @app.command("view")
+    @app.command("view", cls=Command)
     def view(
         recording: Path = typer.Argument(..., help="A recording from `percept drive` (RUN.rrd)."),
-        web: bool = typer.Option(False, "--web", help="Serve the web viewer instead of opening a window (for a "
-                                                      "machine without a display; open the printed address)."),
+        web: Annotated[bool, flag("--web", help="Serve the web viewer instead of opening a window (for a machine "
+                                                "without a display; open the printed address).")] = False,
         bind: str = typer.Option("127.0.0.1", "--bind", metavar="ADDR",
                                  help="IP address the viewer's servers listen on (0.0.0.0: every interface, to "
                                       "open --web from another machine)."),
     ):
         """Open a recording in the Rerun viewer, with the blueprint it was recorded with."""
         bind = check_bind(bind)
+        if recording.is_dir():
+            fail(f"{recording} is a folder; give a recording file (RUN.rrd)")
         if not recording.is_file():
             fail(f"{recording} does not exist; record one with `percept drive --record {recording}`")
         if recording.suffix != ".rrd":
@@ -90,6 +103,7 @@ def register(app: typer.Typer) -> None:
         if problem is not None:
             fail(f"{recording} is not a valid Rerun recording ({problem}); record it again with `percept drive`")
         cmd = [exe, "--bind", bind, *(["--web-viewer"] if web else []), str(recording)]
+        on_interrupt(f"the viewer was closed; {recording} is unchanged")
         try:
             code = subprocess.run(cmd, env=rerun_env()).returncode
         except OSError as e:

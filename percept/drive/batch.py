@@ -3,15 +3,14 @@
 Runs go to worker processes (``workers``, one OpenCV thread each) or to a Ray cluster. Each finished run is
 written at once (atomically) to ``OUT/runs/<scenario>-<condition>-<seed>.json``, so an interrupted batch keeps
 what it finished and the same batch again reuses it. A failed run is reported in the summary (not written: the
-next batch drives it again); the others go on. Resume never mixes settings: each run file and the summary carry
-``settings`` (everything but the scenario, condition and seed that changes a result); damaged run files are
-redone, runs made with other settings refused before any work unless ``redo``.
+next batch drives it again); the others go on. Resume never mixes settings (``percept.drive.resume``): each run
+file and the summary carry ``settings``; damaged run files are redone, runs made with other settings refused
+before any work unless ``redo``.
 """
 
 from __future__ import annotations
 
 import contextlib
-import json
 import signal
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -29,10 +28,18 @@ from percept.sims import WorldConfig
 
 from .config import DriveConfig
 from .loop import run_drive
+from .resume import (COUNTS, GROUPS, RunFiles, differences, refuse_other_settings, run_path, run_settings,
+                     scan_runs)
 from .tasks import TASKS, Source
 
-COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
-GROUPS = ("lane", "longitudinal", "pedestrians", "odometry", "timing_ms")
+__all__ = ["MAX_SEED", "MAX_SEEDS", "Engine", "EvalPlan", "Job", "RunFiles", "differences", "evaluate",
+           "parse_seeds", "refuse_other_settings", "run_job", "run_settings", "scan_runs", "summarize"]
+
+MAX_SEED = 2**31 - 1
+"""Largest seed (highway-env and numpy take 32-bit seeds); `percept drive --seed` has the same bound
+(``percept.cli.options.MAX_SEED``)."""
+MAX_SEEDS = 10_000
+"""Most seeds one batch takes; a range is counted before it is expanded, so '0-99999999999' is refused at once."""
 
 
 class Engine(str, Enum):
@@ -41,18 +48,27 @@ class Engine(str, Enum):
 
 
 def parse_seeds(text: str) -> list[int]:
-    """"A-B" (inclusive), "A,B,C" or "N" -> sorted unique seeds; ValueError with the expected forms."""
+    """"A-B" (inclusive), "A,B,C" or "N" -> sorted unique seeds, each 0 to MAX_SEED and at most MAX_SEEDS of
+    them; ValueError with the expected forms otherwise."""
+    spans = []
     try:
-        seeds: set[int] = set()
         for part in text.split(","):
             a, sep, b = part.strip().partition("-")
             lo, hi = int(a), int(b) if sep else int(a)
             if lo < 0 or hi < lo:
                 raise ValueError
-            seeds.update(range(lo, hi + 1))
-        return sorted(seeds)
+            spans.append((lo, hi))
     except ValueError:
         raise ValueError(f"--seeds must look like 0-9, 3 or 1,4,7 (non-negative, A <= B), got '{text}'") from None
+    if (top := max(hi for _, hi in spans)) > MAX_SEED:
+        raise ValueError(f"--seeds go from 0 to {MAX_SEED}, got {top}")
+    count, end = 0, -1  # seeds covered by the spans, overlaps counted once
+    for lo, hi in sorted(spans):
+        count += max(0, hi - max(lo, end + 1) + 1)
+        end = max(end, hi)
+    if count > MAX_SEEDS:
+        raise ValueError(f"--seeds '{text}' names {count} seeds; a batch takes at most {MAX_SEEDS} (split it)")
+    return sorted({s for lo, hi in spans for s in range(lo, hi + 1)})
 
 
 @dataclass(frozen=True)
@@ -97,32 +113,6 @@ class EvalPlan:
         return [Job(sc, c, s) for sc in self.scenarios for c in self.conditions for s in self.seeds]
 
 
-def run_settings(plan: EvalPlan) -> dict:
-    """Everything besides the scenario, condition and seed that changes a run's result (a JSON object; two runs
-    are comparable only if theirs are equal): percept version, duration, slot sources, rendering, world options."""
-    from importlib.metadata import version
-
-    cfg = plan.config(plan.jobs[0])
-    return {"percept": version("percept"), "duration_s": plan.duration_s,
-            "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
-            "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
-                      "autopilot": cfg.world.autopilot}}
-
-
-def differences(now: dict, then) -> list[str]:
-    """How the settings ``then`` of a stored run differ from ``now``: 'slots lateral=vision (now privileged)'."""
-    if not isinstance(then, dict):
-        return ["no settings recorded (made by an older percept)"]
-    diff = []
-    for k, v in now.items():
-        old = then.get(k)
-        if isinstance(v, dict) and isinstance(old, dict):
-            diff += [f"{k} {n}={old.get(n)} (now {x})" for n, x in v.items() if old.get(n) != x]
-        elif old != v:
-            diff.append(f"{k} {'default' if old is None else old} (now {'default' if v is None else v})")
-    return diff
-
-
 def _worker_init() -> None:
     """A worker process: one OpenCV thread; Ctrl-C is the parent's to handle (it terminates the workers)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -138,67 +128,6 @@ def run_job(plan: EvalPlan, job: Job) -> dict:
     except Exception as e:  # noqa: BLE001 - one failed run must not take the batch down; it is reported
         return {"scenario": job.scenario, "condition": job.condition, "seed": job.seed,
                 "error": f"{type(e).__name__}: {e}", "traceback": traceback.format_exc()}
-
-
-def _run_path(out_dir: Path, job: Job) -> Path:
-    return out_dir / "runs" / f"{job.name}.json"
-
-
-@dataclass
-class RunFiles:
-    """What ``OUT/runs`` holds for a plan: ``done`` runs to reuse (job -> run JSON), ``damaged`` files to redo
-    ((path, why)), runs made under ``other`` settings ((path, differing settings))."""
-
-    done: dict = field(default_factory=dict)
-    damaged: list = field(default_factory=list)
-    other: list = field(default_factory=list)
-
-
-def _read_run(path: Path, job: Job) -> tuple[dict | None, str | None]:
-    """(run JSON, None) or (None, why the file is not a finished run of ``job``)."""
-    try:
-        data = json.loads(path.read_text())
-    except UnicodeDecodeError:
-        return None, "not text"
-    except json.JSONDecodeError:
-        return None, "empty" if path.stat().st_size == 0 else "not JSON (truncated?)"
-    except OSError as e:
-        return None, f"unreadable ({e.strerror or e})"
-    if not isinstance(data, dict) or "error" in data or "frames" not in data:
-        return None, "not a percept run"
-    if (data.get("scenario"), data.get("condition"), data.get("seed")) != (job.scenario, job.condition, job.seed):
-        return None, f"a run of another job ({data.get('scenario')}-{data.get('condition')}-{data.get('seed')})"
-    return data, None
-
-
-def scan_runs(plan: EvalPlan, out_dir: Path) -> RunFiles:
-    """Sort the run files of ``plan`` in ``out_dir/runs``; ValueError when a folder (or the runs folder itself is a
-    file) is in the way."""
-    runs, found, settings = Path(out_dir) / "runs", RunFiles(), run_settings(plan)
-    if runs.exists() and not runs.is_dir():
-        raise ValueError(f"{runs} is a file where the runs folder belongs; move it away or choose another --out")
-    for job in plan.jobs:
-        path = _run_path(out_dir, job)
-        if not path.exists():
-            continue
-        if path.is_dir():
-            raise ValueError(f"{path} is a folder where a run file belongs; move it away or choose another --out")
-        data, why = _read_run(path, job)
-        if data is None:
-            found.damaged.append((path, why))
-        elif diff := differences(settings, data.get("settings")):
-            found.other.append((path, diff))
-        else:
-            found.done[job] = data
-    return found
-
-
-def refuse_other_settings(files: RunFiles, out_dir: Path) -> None:
-    """ValueError naming the settings that differ when ``files`` holds runs made with other settings."""
-    if files.other:
-        path, diff = files.other[0]
-        raise ValueError(f"{len(files.other)} run(s) in {Path(out_dir) / 'runs'} were made with other settings "
-                         f"(e.g. {path.name}: {'; '.join(diff)}); give a new --out, or --redo to drive them again")
 
 
 def _local(plan: EvalPlan, jobs: list[Job], workers: int) -> Iterator[tuple[Job, dict]]:
@@ -274,7 +203,7 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
         for job, r in stream:
             if "error" not in r:
                 r = {**r, "settings": settings}
-                write_json_atomic(_run_path(out_dir, job), r)
+                write_json_atomic(run_path(out_dir, job), r)
             results.append(r)
             if progress:
                 progress(r)

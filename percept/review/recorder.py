@@ -183,10 +183,17 @@ class RunRecorder:
         target = self.path if complete else partial_path(self.path)
         try:
             self.rec.flush()
+        except BaseException:  # Ctrl-C or a full disk while flushing: the file may lack its end, it is partial
+            target = partial_path(self.path)
+            raise
         finally:
             self.rec.disconnect()
-            if self.tmp.exists():
-                os.replace(self.tmp, target)
+            try:
+                if self.tmp.exists():
+                    os.replace(self.tmp, target)
+            except OSError:  # e.g. a folder in the way: no temporary is left behind, the target is untouched
+                self.tmp.unlink(missing_ok=True)
+                raise
             self.closed_as = target
         return target
 

@@ -20,8 +20,10 @@ VIDEO = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "udacit
     / "solidWhiteRight.mp4"
 
 
-def interrupt(args: list[str], ready, cwd: Path, timeout_s: float = 90.0) -> tuple[int, str, float]:
-    """Start ``python -m percept ARGS``, wait until ``ready()``, send SIGINT; (exit code, stderr, seconds to stop)."""
+def interrupt(args: list[str], ready, cwd: Path, timeout_s: float = 90.0, sig=signal.SIGINT,
+              children: list | None = None) -> tuple[int, str, float]:
+    """Start ``python -m percept ARGS``, wait until ``ready()``, send ``sig``; (exit code, stderr, seconds to stop).
+    ``children``: filled with the pids of the command's child processes at that moment."""
     p = subprocess.Popen([sys.executable, "-m", "percept", *args], cwd=cwd, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     try:
@@ -30,13 +32,48 @@ def interrupt(args: list[str], ready, cwd: Path, timeout_s: float = 90.0) -> tup
             assert p.poll() is None, p.communicate()
             assert time.monotonic() - t0 < timeout_s, "the command never got going"
             time.sleep(0.02)
-        p.send_signal(signal.SIGINT)
+        if children is not None:
+            children += child_pids(p.pid)
+        p.send_signal(sig)
         t1 = time.monotonic()
         _, err = p.communicate(timeout=10)
         return p.returncode, err, time.monotonic() - t1
     finally:
         if p.poll() is None:
             p.kill()
+
+
+def child_pids(pid: int) -> list[int]:
+    """The processes whose parent is ``pid`` (Linux /proc)."""
+    kids = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            kids.append(int(stat.parent.name))
+    return kids
+
+
+def running(pid: int) -> bool:
+    """Whether ``pid`` still runs (a zombie waiting for its parent to collect it does not)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def held_for(condition, seconds: float):
+    """A ``ready`` that turns true once ``condition()`` has been true for ``seconds``."""
+    since = []
+
+    def ready() -> bool:
+        if not since and condition():
+            since.append(time.monotonic())
+        return bool(since) and time.monotonic() - since[0] >= seconds
+
+    return ready
 
 
 def interrupted_line(err: str) -> str:
@@ -55,12 +92,50 @@ def test_ctrl_c_stops_eval_workers_fast_and_the_same_command_resumes(tmp_path, s
     assert code == 130 and stop_s < 3.0, (code, stop_s, err)
     line = interrupted_line(err)
     kept = snapshot(runs)
-    assert line == f"interrupted: {len(kept)} finished runs kept in {runs}; run the same command to resume"
+    runs_kept = f"{len(kept)} finished run{'' if len(kept) == 1 else 's'}"
+    assert line == f"interrupted: {runs_kept} kept in {runs}; run the same command to resume"
     assert not (out / "summary.json").exists() and temporaries(out) == []
     # the same command (one worker here) resumes: the kept runs are reused as they are
     r = runner.invoke(app, args)
     assert r.exit_code == 0, r.output
     assert {k: v for k, v in snapshot(runs).items() if k in kept} == kept and len(snapshot(runs)) == 4
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+def test_sigterm_stops_eval_and_its_workers_like_ctrl_c(tmp_path, temporaries):
+    """`kill`, `timeout` and CI cancels send SIGTERM; it once ended the command at once and left its workers
+    running. Now it stops like Ctrl-C: workers ended, finished runs kept, exit code 143."""
+    out = tmp_path / "ev"
+    kids: list[int] = []
+    runs = out / "runs"
+    code, err, stop_s = interrupt(["eval", "--scenario", "lead-brake", "--seeds", "0-5", "--duration", "2",
+                                   "--workers", "2", "--out", str(out)],
+                                  lambda: runs.is_dir() and any(runs.glob("*.json")), tmp_path, sig=signal.SIGTERM,
+                                  children=kids)
+    assert code == 143 and stop_s < 3.0, (code, stop_s, err)
+    assert "finished run" in interrupted_line(err) and temporaries(out) == []
+    deadline = time.monotonic() + 3.0  # multiprocessing's resource tracker leaves when it sees its parent gone
+    while [k for k in kids if running(k)] and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert len(kids) >= 2 and not [k for k in kids if running(k)], [Path(f"/proc/{k}/cmdline").read_bytes()
+                                                                   for k in kids if running(k)]
+
+
+def test_ctrl_c_during_drive_keeps_the_finished_recording_and_json(tmp_path, snapshot, temporaries):
+    out = tmp_path / "d"
+    args = ["drive", "--record", str(out / "run.rrd"), "--json", str(out / "run.json")]
+    r = runner.invoke(app, [*args, "--duration", "0.2"])
+    assert r.exit_code == 0, r.output
+    before = snapshot(out)
+    # the recorder's temporary exists from its start; a second later the run is under way
+    code, err, stop_s = interrupt([*args, "--duration", "60"], held_for((out / ".run.rrd.part").exists, 1.0),
+                                  tmp_path)
+    assert code == 130 and stop_s < 3.0, (code, stop_s, err)
+    assert interrupted_line(err) == (f"interrupted: the recording so far is kept as {out / 'run.partial.rrd'}; "
+                                     "no JSON was written or replaced")
+    after = snapshot(out)
+    assert {k: v for k, v in after.items() if k in before} == before
+    assert sorted(map(str, after)) == ["run.json", "run.partial.rrd", "run.rrd"] and temporaries(out) == []
 
 
 def test_ctrl_c_during_render_keeps_complete_frames(tmp_path, temporaries):

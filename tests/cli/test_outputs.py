@@ -183,6 +183,22 @@ def test_outputs_are_checked_before_the_work(tmp_path, grey_image):
     assert blocker.read_text() == "x" and grey_image.stat().st_size > 0
 
 
+def test_a_parent_that_is_a_file_is_named_as_given(tmp_path, grey_image, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    Path("afile").write_text("x")
+    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--json", "afile/deep/r.json"]),
+                   "cannot write afile/deep/r.json: afile is a file, not a folder")
+
+
+def test_a_failed_command_leaves_its_error_as_the_last_line(tmp_path):
+    """The progress bar was printed after the error (its final state); it now disappears when the command fails."""
+    jpg = cv2.imencode(".jpg", np.full((120, 160, 3), 90, np.uint8))[1].tobytes()
+    (tmp_path / "half.jpg").write_bytes(jpg[: len(jpg) // 2])
+    r = runner.invoke(app, ["lanes", str(tmp_path / "half.jpg")])
+    one_error_line(r, "truncated")
+    assert r.output.splitlines() == [ln for ln in r.output.splitlines() if ln.startswith("error:")], r.output
+
+
 @pytest.mark.parametrize("args, message", [
     (["--square", "inf"], "--square must be a finite number"),
     (["--square", "0"], "--square must be a finite number"),

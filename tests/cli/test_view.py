@@ -87,3 +87,23 @@ def test_recording_problem_accepts_a_valid_recording(rrd):
 
 def test_the_viewer_is_installed():
     assert rerun_executable() is not None
+
+
+def test_view_says_a_folder_is_a_folder(tmp_path):
+    r = runner.invoke(app, ["view", str(tmp_path)])
+    assert r.exit_code == 2 and "is a folder; give a recording file" in r.output and "does not exist" not in r.output
+
+
+def test_a_recording_cut_after_its_header_is_called_truncated(tmp_path, rrd):
+    """`rerun rrd verify` accepts such a file with '0 files verified'; that was once the whole explanation."""
+    bad = tmp_path / "cut.rrd"
+    bad.write_bytes(rrd.read_bytes()[:20])
+    problem = recording_problem(rerun_executable(), bad)
+    assert problem == "it is truncated or holds no recording"
+
+
+def test_the_viewer_is_started_as_itself_not_through_a_script():
+    """The `rerun` script starts the viewer as a child: stopping the script (Ctrl-C sent to percept alone, a kill)
+    left the viewer and its servers running. The viewer binary is run directly."""
+    with open(rerun_executable(), "rb") as f:
+        assert f.read(2) != b"#!"

@@ -57,7 +57,7 @@ def test_drive_default_recording_path(tmp_path, monkeypatch):
     (["--scenario", "motorway"], "unknown scenario 'motorway'"),
     (["--condition", "snow"], "unknown condition 'snow'"),
     (["--lateral", "magic"], "Invalid value for '--lateral'"),
-    (["--longitudinal", "vision"], "no vision implementation yet"),
+    (["--pedestrians", "vision"], "no vision implementation yet"),
     (["--duration", "-3"], "--duration must be a finite number"),
     (["--duration", "inf"], "--duration must be a finite number"),
     (["--duration", "1e308"], "--duration must be a finite number"),
@@ -77,3 +77,37 @@ def test_drive_unwritable_output(tmp_path):
     r = runner.invoke(app, ["drive", "--duration", "0.2", "--no-record", "--json", str(blocker / "r.json")])
     assert r.exit_code == 2
     assert "cannot write" in r.output
+
+
+def test_drive_checks_where_an_interrupted_recording_would_go(tmp_path):
+    """A folder at RUN.partial.rrd once made Ctrl-C end in a traceback and a left-over temporary; now it is
+    refused before the run."""
+    (tmp_path / "r.partial.rrd").mkdir()
+    r = runner.invoke(app, ["drive", "--duration", "0.2", "--record", str(tmp_path / "r.rrd")])
+    assert r.exit_code == 2 and "r.partial.rrd is a folder" in r.output and "Traceback" not in r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.partial.rrd"]
+
+
+def test_drive_says_what_ctrl_c_keeps_at_each_stage(tmp_path):
+    from percept.cli.drive_cmd import Recording
+    from percept.drive import TASKS
+
+    rec = Recording(tmp_path / "r.rrd", TASKS, 5.0, 70, 0.75)
+    assert rec.kept() == "nothing was written or replaced"  # before the world (and the recorder) exists
+    rec.recorder = type("Closed", (), {"closed_as": tmp_path / "r.partial.rrd"})()
+    assert rec.kept() == f"the recording so far is kept as {tmp_path / 'r.partial.rrd'}; no JSON was written or " \
+                         "replaced"
+    rec.recorder.closed_as = tmp_path / "r.rrd"  # Ctrl-C while the JSON is written, after the recording
+    assert rec.kept() == f"the finished recording is {tmp_path / 'r.rrd'}; no JSON was written or replaced"
+
+
+def test_drive_table_prints_no_python_values():
+    r = runner.invoke(app, ["drive", "--scenario", "crossing", "--duration", "2", "--no-record"])
+    assert r.exit_code == 0, r.output
+    for word in ("None", "True", "False", "[T", "[F", "[]", "nan"):
+        assert word not in r.output, word
+
+
+def test_drive_seed_bound_is_written_in_full():
+    r = runner.invoke(app, ["drive", "--seed", "99999999999", "--no-record"])
+    assert r.exit_code == 2 and "between 0 and 2147483647, got 99999999999" in r.output

@@ -7,6 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from percept.cli import app
+from percept.cli import options as opt
 from percept.drive import batch as ev
 from percept.drive import EvalPlan, Job, parse_seeds
 
@@ -20,6 +21,18 @@ def test_parse_seeds():
     for bad in ("3-1", "a", "-2", "1-", ""):
         with pytest.raises(ValueError, match="--seeds must look like"):
             parse_seeds(bad)
+
+
+def test_parse_seeds_counts_a_range_before_expanding_it():
+    """'0-99999999999' once took all memory (the range was expanded first); now it is refused at once."""
+    with pytest.raises(ValueError, match="--seeds go from 0 to 2147483647, got 99999999999"):
+        parse_seeds("0-99999999999")
+    with pytest.raises(ValueError, match="names 20001 seeds; a batch takes at most 10000"):
+        parse_seeds("0-20000")
+    assert len(parse_seeds("0-6000,3000-9999,9999")) == ev.MAX_SEEDS  # overlaps counted once
+    with pytest.raises(ValueError, match="names 10001 seeds"):
+        parse_seeds("0-6000,3000-10000")
+    assert ev.MAX_SEED == opt.MAX_SEED  # eval's seeds and drive's --seed have one bound
 
 
 def test_eval_writes_runs_and_a_summary_and_resumes(tmp_path):
@@ -86,9 +99,14 @@ def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
     (["--scenario", "highway", "--workers", "0"], "--workers must be a finite number between 1 and 256"),
     (["--scenario", "highway", "--engine", "spark"], "--engine must be local or ray"),
     (["--scenario", "highway", "--condition", "fog"], "condition"),
-    (["--scenario", "highway", "--longitudinal", "vision"], "no vision implementation yet"),
+    (["--scenario", "highway", "--odometry", "vision"], "no vision implementation yet"),
     (["--scenario", "highway", "--duration", "inf"], "--duration must be a finite number"),
     (["--scenario", "highway", "--duration", "0"], "--duration must be a finite number"),
+    (["--scenario", "highway", "--duration", "1e308"], "--duration must be a finite number"),
+    (["--scenario", "highway", "--workers", "99999999999"], "--workers must be a finite number between 1 and 256"),
+    (["--scenario", "highway", "--seeds", "0-99999999999"], "--seeds go from 0 to 2147483647"),
+    (["--scenario", "all", "--scenario", "highway"], "--scenario all already means every scenario"),
+    (["--scenario", "all", "--scenario", "nowhere"], "--scenario all already means every scenario"),
 ])
 def test_eval_bad_input_is_one_line_exit_2(tmp_path, args, message):
     r = runner.invoke(app, ["eval", "--out", str(tmp_path / "o"), *args])
@@ -168,6 +186,15 @@ def test_damaged_run_files_are_listed_and_redone(tmp_path):
     assert len(lines) == 4 and "Traceback" not in r.output
     assert "not JSON" in lines[0] and "empty" in lines[1] and "not a percept run" in lines[2]
     assert all(json.loads(p.read_text())["frames"] == 15 for p in runs.iterdir())
+    # a hand-edited run without its counts (once a KeyError in the summary) is damaged too
+    edited = json.loads((runs / "lead-brake-clear-1.json").read_text())
+    del edited["collisions"]
+    edited["pedestrians"] = None
+    (runs / "lead-brake-clear-1.json").write_text(json.dumps(edited))
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0 and "Traceback" not in r.output, r.output
+    assert "redoing" in r.output and "no valid collisions, pedestrians" in r.output
+    assert "collisions" in json.loads((runs / "lead-brake-clear-1.json").read_text())
     (runs / "lead-brake-clear-0.json").unlink()
     (runs / "lead-brake-clear-0.json").mkdir()
     r = runner.invoke(app, args)

@@ -173,6 +173,32 @@ def test_a_recording_that_raises_is_closed_as_partial(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["Y.partial.rrd"]
 
 
+def test_ctrl_c_while_flushing_never_replaces_a_finished_recording(tmp_path):
+    """Ctrl-C during the last flush once moved the unfinished file over RUN.rrd; now it becomes RUN.partial.rrd."""
+    final = tmp_path / "Z.rrd"
+    final.write_bytes(b"a finished recording")
+    rec = RunRecorder(final, StereoRig(), [], TASKS)
+    real_flush = rec.rec.flush
+
+    def interrupted():
+        real_flush()
+        raise KeyboardInterrupt
+
+    rec.rec.flush = interrupted
+    with pytest.raises(KeyboardInterrupt):
+        rec.close()
+    assert final.read_bytes() == b"a finished recording"
+    assert sorted(os.listdir(tmp_path)) == ["Z.partial.rrd", "Z.rrd"] and rec.closed_as == tmp_path / "Z.partial.rrd"
+
+
+def test_a_folder_in_the_way_leaves_no_temporary(tmp_path):
+    (tmp_path / "V.partial.rrd").mkdir()
+    rec = RunRecorder(tmp_path / "V.rrd", StereoRig(), [], TASKS)
+    with pytest.raises(OSError):
+        rec.close(complete=False)
+    assert sorted(os.listdir(tmp_path)) == ["V.partial.rrd"]
+
+
 def test_parts_are_resolved_from_the_table(tmp_path):
     def part(rec, ctx, estimate, debug, truth):
         pass

@@ -142,103 +142,115 @@ def _scaled(color, k: float) -> tuple:
     return tuple(min(255.0, c * k) for c in color)
 
 
-def pedestrian_patches(b: PatchBuilder, obj: ObjectState, view_world: np.ndarray) -> None:
-    """Add one pedestrian seen from ``view_world`` (3,) [m, world frame]. The pose's yaw is the walking (facing)
-    direction; ``obj.height_m`` its stature; ``obj.style`` seeds clothing, skin, hair and build; ``obj.gait_phase``
-    [rad] the walking cycle (0 = left heel strike), used when ``obj.speed_mps`` > 0.05. The lowest shoe point
-    touches the ground (z = 0) at the pose position; every patch carries ``obj.obj_id``."""
-    h = obj.height_m
-    rng = np.random.default_rng(int(obj.style) & 0xFFFFFFFF)
-    shirt = SHIRTS[int(rng.integers(len(SHIRTS)))]
-    pants = PANTS[int(rng.integers(len(PANTS)))]
-    skin = SKINS[int(rng.integers(len(SKINS)))]
-    hair = HAIR[int(rng.integers(len(HAIR)))]
-    shoes = SHOES[int(rng.integers(len(SHOES)))]
-    build = float(rng.uniform(0.92, 1.12))
-    long_sleeves = bool(rng.random() < 0.5)
-    shorts = bool(rng.random() < 0.12)
-    long_hair = bool(rng.random() < 0.3)
-    bulk = float(rng.uniform(1.0, 1.3))  # clothing on the upper body, from a shirt to a padded jacket
-    sleeve = _scaled(shirt, 0.93)
+class _Body:
+    """One pedestrian's frame, style and how it is seen: stature ``h`` [m]; ``fwd``, ``left`` (3,) unit vectors
+    of the walking direction at ``base`` (the pose on the ground) [world]; ``vdir`` the horizontal direction to
+    the viewer; ``cf`` = 1 seen from the front or back, 0 from the side (``cs`` the other way); the gait cycle
+    fraction ``c`` of the left leg (0 = heel strike). ``obj.style`` seeds the colours (BGR), build (a width
+    factor), sleeves, shorts, long hair and bulk (upper-body clothing, from a shirt to a padded jacket; the
+    hips get half of it), drawn in a fixed order so that a seed always dresses the same figure."""
 
-    p = obj.pose
-    fwd = np.array([math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0])
-    left = np.array([-fwd[1], fwd[0], 0.0])
-    base = np.array([p.x_m, p.y_m, 0.0])
-    view = np.asarray(view_world, dtype=np.float64)
-    fig = _Figure(view, obj.obj_id)
-    walking = obj.speed_mps > 0.05
-    c = (obj.gait_phase / (2 * math.pi)) % 1.0  # gait cycle fraction of the left leg, 0 = heel strike
+    def __init__(self, obj: ObjectState, view: np.ndarray):
+        rng = np.random.default_rng(int(obj.style) & 0xFFFFFFFF)
+        self.shirt, self.pants, self.skin, self.hair, self.shoes = (
+            palette[int(rng.integers(len(palette)))] for palette in (SHIRTS, PANTS, SKINS, HAIR, SHOES))
+        self.build = float(rng.uniform(0.92, 1.12))
+        self.long_sleeves, self.shorts, self.long_hair = (bool(rng.random() < q) for q in (0.5, 0.12, 0.3))
+        self.bulk = float(rng.uniform(1.0, 1.3))
+        self.hips = 1.0 + 0.5 * (self.bulk - 1.0)
+        p = obj.pose
+        self.h = obj.height_m
+        self.fwd = np.array([math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0])
+        self.left = np.array([-self.fwd[1], self.fwd[0], 0.0])
+        self.base = np.array([p.x_m, p.y_m, 0.0])
+        self.walking = obj.speed_mps > 0.05
+        self.c = (obj.gait_phase / (2 * math.pi)) % 1.0
+        vdir = view - self.base
+        vdir[2] = 0.0
+        vdir /= np.linalg.norm(vdir) + 1e-12
+        self.vdir = vdir
+        self.cf = abs(float(vdir @ self.fwd))
+        self.cs = math.sqrt(max(0.0, 1.0 - self.cf * self.cf))
+        self.lean = 0.06 if self.walking else 0.0  # trunk leans forwards a little when walking [rad]
 
-    def pt(x, y, z):
-        return base + x * fwd + y * left + z * UP
+    @property
+    def sides(self) -> tuple:
+        """(side, gait cycle fraction) of the left (+1) and right (-1) limbs: half a cycle apart."""
+        return (+1, self.c), (-1, (self.c + 0.5) % 1.0)
 
-    def seg(ang):
+    def pt(self, x, y, z) -> np.ndarray:
+        """The world point x forwards, y left, z up [m] of the figure's base."""
+        return self.base + x * self.fwd + y * self.left + z * UP
+
+    def seg(self, ang) -> np.ndarray:
         """Unit vector at angle ``ang`` from straight down, rotated forwards (sagittal plane)."""
-        return math.sin(ang) * fwd - math.cos(ang) * UP
+        return math.sin(ang) * self.fwd - math.cos(ang) * UP
 
-    # how wide a trunk part looks: an elliptic cross-section of width w (across) and depth d (front to back),
-    # fractions of h; the clothing adds to the depth, more on the upper body than on the hips
-    vdir = view - base
-    vdir[2] = 0.0
-    vdir /= np.linalg.norm(vdir) + 1e-12
-    cf = abs(float(vdir @ fwd))  # 1 = seen from the front or back, 0 = from the side
-    cs = math.sqrt(max(0.0, 1.0 - cf * cf))
+    def across(self, w, d, bk=None) -> float:
+        """How wide a trunk part looks [m]: an elliptic cross-section of width w (across) and depth d (front to
+        back), fractions of h; the clothing adds ``bk`` (default the upper body's bulk) to the depth."""
+        bk = self.bulk if bk is None else bk
+        return math.hypot(w * self.cf, d * self.cs * bk) * self.h * self.build
 
-    hips = 1.0 + 0.5 * (bulk - 1.0)
-
-    def across(w, d, bk=bulk):
-        return math.hypot(w * cf, d * cs * bk) * h * build
-
-    lean = 0.06 if walking else 0.0  # trunk leans forwards a little when walking [rad]
-
-    def trunk(z, x=0.0):
+    def trunk(self, z, x=0.0) -> np.ndarray:
         """A point on the trunk's mid-line at height z [fraction of h], leaning forwards about the hips."""
-        return pt(x * h + (z - 0.53) * h * math.sin(lean), 0.0, z * h)
+        h = self.h
+        return self.pt(x * h + (z - 0.53) * h * math.sin(self.lean), 0.0, z * h)
 
-    # ---- legs: thigh, shank, shoe
+
+def _legs(fig: _Figure, body: _Body) -> None:
+    """Thigh, shank (trousers, or shorts and skin) and a shoe pitched by the gait, per leg."""
+    h, fwd, left, seg, build = body.h, body.fwd, body.left, body.seg, body.build
     hip_z, thigh, shank = 0.53 * h, 0.245 * h, 0.246 * h
     foot_l, ankle_h = 0.155 * h, 0.039 * h
-    for sgn, cl in ((+1, c), (-1, (c + 0.5) % 1.0)):
-        if walking:
+    for sgn, cl in body.sides:
+        if body.walking:
             a, knee_flex, toe_down = (math.radians(float(np.interp(cl, GAIT_C, t))) for t in (HIP, KNEE, FOOT))
             stance_y = 0.05 * h
         else:
             a, knee_flex, toe_down, stance_y = 0.02 * sgn, 0.03, 0.0, 0.055 * h
         b_ang = a - knee_flex
-        hip = pt(0.0, sgn * stance_y, hip_z)
+        hip = body.pt(0.0, sgn * stance_y, hip_z)
         knee = hip + thigh * seg(a)
         ankle = knee + shank * seg(b_ang)
-        if shorts:
+        if body.shorts:
             mid = hip + 0.55 * thigh * seg(a)
-            fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, pants, bias=0.005)
-            fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, skin, bias=0.004, caps=(False, True))
-            fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, skin, bias=0.005)
+            fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, bias=0.005)
+            fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, body.skin, bias=0.004, caps=(False, True))
+            fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, bias=0.005)
         else:
-            fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, pants, bias=0.005)
-            fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, pants, bias=0.005)
+            fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, bias=0.005)
+            fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, bias=0.005)
         # the shoe, pitched toe-down at heel-off and toe-up at heel strike
         f_dir = math.cos(toe_down) * fwd - math.sin(toe_down) * UP
         f_up = math.sin(toe_down) * fwd + math.cos(toe_down) * UP
         shoe_h = 0.06 * h
         centre = ankle + 0.28 * foot_l * f_dir + (shoe_h / 2 - ankle_h) * f_up
-        fig.box(centre, np.stack([f_dir, left, f_up]), [foot_l, 0.058 * h * build, shoe_h], shoes)
+        fig.box(centre, np.stack([f_dir, left, f_up]), [foot_l, 0.058 * h * build, shoe_h], body.shoes)
 
-    # ---- trunk: pelvis (trousers), torso (shirt) with a lighter chest, shoulders sloping to the neck
-    fig.limb(trunk(0.465, -0.004), trunk(0.6), across(0.098, 0.086, hips), across(0.086, 0.079, hips), pants,
-             caps=(False, False))
+
+def _trunk(fig: _Figure, body: _Body) -> None:
+    """Pelvis (trousers), torso (shirt) with a lighter chest, shoulders sloping to the neck."""
+    trunk, across, hips, shirt = body.trunk, body.across, body.hips, body.shirt
+    fig.limb(trunk(0.465, -0.004), trunk(0.6), across(0.098, 0.086, hips), across(0.086, 0.079, hips),
+             body.pants, caps=(False, False))
     fig.limb(trunk(0.54), trunk(0.67, 0.006), across(0.09, 0.082, hips), across(0.086, 0.082, hips),
              _scaled(shirt, 0.95), bias=0.01, caps=(False, False))
     fig.limb(trunk(0.665, 0.006), trunk(0.785, 0.004), across(0.087, 0.084), across(0.104, 0.09),
              shirt, bias=0.01, caps=(False, False))
     fig.limb(trunk(0.78, 0.004), trunk(0.845), across(0.125, 0.086), across(0.055, 0.058),
              shirt, bias=0.011, caps=(False, False))
-    # ---- neck and head (face, hair cap, hair at the back)
-    fig.limb(trunk(0.82, 0.005), trunk(0.885, 0.01), 0.028 * h, 0.028 * h, _scaled(skin, 0.9),
+
+
+def _head(fig: _Figure, body: _Body) -> None:
+    """Neck and head: face, hair cap, hair at the back, eyes when seen from the front, long hair."""
+    h, fwd, left, cf, cs = body.h, body.fwd, body.left, body.cf, body.cs
+    skin, hair = body.skin, body.hair
+    fig.limb(body.trunk(0.82, 0.005), body.trunk(0.885, 0.01), 0.028 * h, 0.028 * h, _scaled(skin, 0.9),
              bias=0.0, caps=(False, False))
-    head_c = trunk(0.935, 0.012)
+    head_c = body.trunk(0.935, 0.012)
     head_w = (0.048 * cf + 0.055 * cs) * h
-    front = float(vdir @ fwd)
+    front = float(body.vdir @ fwd)
     face_bias, hair_bias = (0.02, 0.015) if front > -0.3 else (0.012, 0.02)
     fig.disc(head_c, 0.065 * h, head_w, skin, bias=face_bias)
     fig.disc(head_c + 0.022 * h * UP - 0.012 * h * fwd, 0.046 * h, head_w * 1.08, hair, bias=hair_bias)
@@ -247,24 +259,42 @@ def pedestrian_patches(b: PatchBuilder, obj: ObjectState, view_world: np.ndarray
         for s in (+1, -1):
             fig.disc(head_c + 0.046 * h * fwd + 0.018 * h * s * left + 0.004 * h * UP, 0.0055 * h, 0.008 * h,
                      (40, 35, 35), bias=0.01)
-    if long_hair:
+    if body.long_hair:
         fig.limb(head_c - 0.025 * h * fwd, head_c - 0.03 * h * fwd - 0.13 * h * UP, 0.05 * h, 0.045 * h, hair,
                  bias=0.012 * cs, caps=(True, False))
 
-    # ---- arms swing against the legs: upper arm, forearm, hand
-    for sgn, cl in ((+1, c), (-1, (c + 0.5) % 1.0)):
-        if walking:
+
+def _arms(fig: _Figure, body: _Body) -> None:
+    """Arms swinging against the legs: upper arm (sleeve), forearm (sleeve or skin), hand."""
+    h, left, seg = body.h, body.left, body.seg
+    build, hips, skin = body.build, body.hips, body.skin
+    sleeve = _scaled(body.shirt, 0.93)
+    for sgn, cl in body.sides:
+        if body.walking:
             hip_a = math.radians(float(np.interp(cl, GAIT_C, HIP)))
             a = -0.8 * (hip_a - math.radians(9.0))
             a2 = a + 0.3 + 0.8 * max(0.0, a)
         else:
             a, a2 = 0.0, 0.12
-        sh = trunk(0.795) + sgn * 0.113 * h * build * left
+        sh = body.trunk(0.795) + sgn * 0.113 * h * build * left
         out = 0.07 * sgn * left  # slight abduction so that the arm hangs clear of the waist
         elbow = sh + 0.186 * h * (seg(a) + out)
         wrist = elbow + 0.146 * h * (seg(a2) + 0.5 * out)
-        fore = sleeve if long_sleeves else skin
+        fore = sleeve if body.long_sleeves else skin
         fig.limb(sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, bias=0.025)
         fig.limb(elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, bias=0.025, caps=(False, True))
         fig.disc(wrist + 0.045 * h * seg(a2), 0.042 * h, 0.024 * h, skin, bias=0.03)
+
+
+def pedestrian_patches(b: PatchBuilder, obj: ObjectState, view_world: np.ndarray) -> None:
+    """Add one pedestrian seen from ``view_world`` (3,) [m, world frame]. The pose's yaw is the walking (facing)
+    direction; ``obj.height_m`` its stature; ``obj.style`` seeds clothing, skin, hair and build; ``obj.gait_phase``
+    [rad] the walking cycle (0 = left heel strike), used when ``obj.speed_mps`` > 0.05. The lowest shoe point
+    touches the ground (z = 0) at the pose position; every patch carries ``obj.obj_id``."""
+    view = np.asarray(view_world, dtype=np.float64)
+    body = _Body(obj, view)
+    fig = _Figure(view, obj.obj_id)
+    # the patches in the order they have always been added (legs, trunk, head, arms): it is part of the output
+    for part in (_legs, _trunk, _head, _arms):
+        part(fig, body)
     fig.emit(b)

@@ -1,0 +1,55 @@
+"""The command line as typed, through the console script (``python -m percept``): a line typer cannot parse is one
+`error:` line naming the help, with exit code 2; --help lists on/off flags without a value type."""
+
+import subprocess
+import sys
+
+import pytest
+from typer.testing import CliRunner
+
+from percept.cli import app
+
+runner = CliRunner()
+
+
+def percept(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "percept", *args], capture_output=True, text=True, timeout=60,
+                          cwd=cwd)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["drive", "--record", "."], "Invalid value for '--record'"),
+    (["drive", "--lateral", "magic"], "Invalid value for '--lateral'"),
+    (["render", "--frames", "x", "--out", "o"], "Invalid value for '--frames'"),
+    (["eval", "--scenario", "highway"], "Missing option '--out'"),
+    (["lanes"], "Missing argument"),
+    (["drive", "--bogus"], "No such option: --bogus"),
+])
+def test_usage_errors_are_one_line(tmp_path, args, message):
+    """typer printed these as a usage line, a hint and a framed box (five lines or more)."""
+    p = percept(*args, cwd=tmp_path)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.splitlines() == [p.stderr.strip()] and p.stderr.startswith("error: "), p.stderr
+    assert message in p.stderr and f"(see `python -m percept {args[0]} --help`)" in p.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_still_works_through_the_console_script():
+    p = percept("drive", "--help")
+    assert p.returncode == 0 and "--no-record" in p.stdout and p.stderr == ""
+    p = percept()  # no command: the help, as typer prints it
+    assert p.returncode == 2 and "drive" in p.stdout + p.stderr and "error:" not in p.stderr
+
+
+@pytest.mark.parametrize("command, flags", [
+    ("drive", ["--no-record"]), ("render", ["--scenery", "--force"]), ("eval", ["--redo"]),
+    ("calibrate", ["--stereo"]), ("view", ["--web"]), ("lanes", []),
+])
+def test_flags_show_no_value_type_in_help(command, flags):
+    r = runner.invoke(app, [command, "--help"], env={"COLUMNS": "200"})
+    assert r.exit_code == 0
+    lines = {ln.split()[1]: ln for ln in r.output.splitlines() if ln.strip().startswith(("│ --", "│    --"))}
+    for flag in flags:
+        assert "<bool>" not in lines[flag], lines[flag]
+    if command in ("calibrate", "view", "lanes"):  # registered with percept's Command class
+        assert "<bool>" not in lines["--help"], lines["--help"]
