@@ -150,3 +150,24 @@ def atomic_path(path: Path | str) -> Iterator[Path]:
             tmp.unlink(missing_ok=True)
         raise
     _sync_dir(path.parent)
+
+
+def png_bytes(image) -> bytes:
+    """An image (H, W[, C]) uint8 encoded as PNG in memory, for the atomic writers; OSError when OpenCV cannot."""
+    import cv2
+
+    ok, buf = cv2.imencode(".png", image)
+    if not ok:
+        raise OSError(f"cannot encode a {getattr(image, 'shape', '?')} image as PNG")
+    return buf.tobytes()
+
+
+def npy_bytes(array) -> bytes:
+    """An array in NumPy's .npy format, in memory, for the atomic writers."""
+    import io
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.save(buf, array)
+    return buf.getvalue()

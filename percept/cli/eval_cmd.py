@@ -118,7 +118,7 @@ def summary_table(summary: dict, tasks) -> Table:
     cols = [(t, h) for t in tasks for h in t.headline
             if any((g[t.group].get(h.key) or None) is not None for g in summary["groups"])]
     t = Table(title=f"{sum(len(g['seeds']) for g in summary['groups'])} runs; slots: "
-                    + ", ".join(f"{k} {v}" for k, v in summary["slots"].items()),
+                    + ", ".join(f"{k} {v}" for k, v in summary["settings"]["slots"].items()),
               box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True, caption="means over seeds")
     for col in ("scenario", "cond", "runs", "coll", "ped", "dep"):
         t.add_column(col, justify="left" if col in ("scenario", "cond") else "right", no_wrap=True)

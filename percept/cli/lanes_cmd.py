@@ -103,14 +103,9 @@ def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
 
 def _write_overlay(target: Path, image) -> None:
     """One overlay PNG, complete or absent (encoded in memory, then written atomically)."""
-    import cv2
+    from percept.outputs import png_bytes, write_bytes_atomic
 
-    from percept.outputs import write_bytes_atomic
-
-    ok, buf = cv2.imencode(".png", image)
-    if not ok:
-        raise OSError(f"cannot encode the overlay {target.name} as PNG")
-    write_bytes_atomic(target, buf.tobytes())
+    write_bytes_atomic(target, png_bytes(image))
 
 
 def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,

@@ -52,12 +52,10 @@ def stereo(
     from percept.sensors.stereo_io import RectifiedStereo
 
     opt.check_number("--scale", scale, 0.05, 1.0)
-    opt.check_number("--block-size", block_size, 1, 11)
-    opt.check_number("--num-disparities", num_disparities, 16, 1024)
-    if block_size % 2 == 0:
-        fail(f"--block-size must be odd, got {block_size}")
-    if num_disparities is not None and num_disparities % 16:
-        fail(f"--num-disparities must be a multiple of 16, got {num_disparities}")
+    try:  # the matcher's own checks, before any work (the default search range needs the image width)
+        DenseConfig(num_disparities=num_disparities or 16, block_size=block_size)
+    except ValueError as e:
+        fail(f"--{str(e).replace('_', '-')}")
     if out is not None and out.exists() and not out.is_dir():
         fail(f"--out {out} is a file; give a folder")
     outputs = [] if out is None else [out / name for name in OUT_FILES]
@@ -193,24 +191,19 @@ def colour_disparity(d: np.ndarray, d_max: float) -> np.ndarray:
 def _write(out: Optional[Path], json_path: Optional[Path], results: dict, data: dict) -> None:
     """disparity.png, depth.npy, disparity_sgbm.png (with ``out``; one colour scale for both PNGs) and the JSON,
     written as one unit: all complete, or none replaced."""
-    import io
     import json
 
-    import cv2
-
     from percept.cli.common import console, fail, write_error
-    from percept.outputs import write_files_atomic
+    from percept.outputs import npy_bytes, png_bytes, write_files_atomic
 
     files = {}
     if out is not None:
         ours, peer = results["percept"]["disparity"], results["sgbm"]["disparity"]
         finite = ours[np.isfinite(ours)]
         d_max = float(np.percentile(finite, 99.5)) if finite.size else 1.0
-        buf = io.BytesIO()
-        np.save(buf, results["percept"]["depth"])
-        files[out / "depth.npy"] = buf.getvalue()
+        files[out / "depth.npy"] = npy_bytes(results["percept"]["depth"])
         for name, d in (("disparity.png", ours), ("disparity_sgbm.png", peer)):
-            files[out / name] = cv2.imencode(".png", colour_disparity(d, d_max))[1].tobytes()
+            files[out / name] = png_bytes(colour_disparity(d, d_max))
     if json_path is not None:
         files[Path(json_path)] = json.dumps(data, indent=2).encode()
     try:

@@ -7,7 +7,9 @@ from .config import DriveConfig
 from .loop import run_drive
 from .privileged import TruthFeed, in_path_obstacle
 from .scoring import StepTruth
-from .tasks import TASKS, Headline, SlotContext, Source, Task, task_order
+from percept.sensors import Source
+
+from .tasks import TASKS, Headline, SlotContext, Task, task_order
 
 __all__ = ["TASKS", "Agent", "AgentStep", "DriveConfig", "Engine", "EvalPlan", "Headline", "Job", "SlotContext",
            "Source", "StageCost", "StepTruth", "Task", "TruthFeed", "bench_render", "bench_task", "evaluate",

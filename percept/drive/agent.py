@@ -6,9 +6,9 @@ import time
 from dataclasses import dataclass
 
 from percept.control import EmergencyBraking, Following, LaneKeeping, nearest_target
-from percept.sensors import Frame
+from percept.sensors import Frame, Source
 
-from .tasks import SlotContext, Source, Task, task_order
+from .tasks import SlotContext, Task, task_order
 
 
 @dataclass(frozen=True)

@@ -130,7 +130,9 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
 def sgbm_full_frame(frames: list) -> tuple[str, Callable]:
     """The stock way to range what is ahead: OpenCV's StereoSGBM over the whole grey frame (96 disparities, 5x5
     blocks, the usual P1 = 8 c b^2, P2 = 32 c b^2 smoothness penalties)."""
-    sgbm = cv2.StereoSGBM_create(0, 96, 5, P1=8 * 5 * 5, P2=32 * 5 * 5)
+    from percept.longitudinal.dense import sample_sgbm
+
+    sgbm = sample_sgbm(96, 5)
 
     def run(frame) -> None:
         sgbm.compute(cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY), cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY))

@@ -5,9 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from percept.sensors import Source
 from percept.sims import WorldConfig
 
-from .tasks import TASKS, Source, Task
+from .tasks import TASKS, Task
 
 MAX_DURATION_S = 24 * 3600.0
 """Longest run a configuration accepts [s] (a day of simulated driving)."""

@@ -5,13 +5,14 @@ from __future__ import annotations
 import time
 from typing import Callable
 
+from percept.sensors import Source
 from percept.sims import SimWorld
 
 from .agent import Agent
 from .config import DriveConfig
 from .privileged import TruthFeed, in_path_obstacle
 from .scoring import SafetyScorer, ScoreContext, StepTruth
-from .tasks import SlotContext, Source
+from .tasks import SlotContext
 
 
 def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, int], None] | None = None,
@@ -28,8 +29,9 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     lm = world.landmark_map()
     agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed),
                   world.cruise_speed_mps)
-    scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians, world.crossing_pedestrians,
-                                             agent.following.time_gap, world.dt)) for t in cfg.tasks}
+    scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
+                                             world.crossing_pedestrians, agent.following.time_gap))
+               for t in cfg.tasks}
     safety = SafetyScorer()
     recorder = recorder_factory(world) if recorder_factory else None
     duration = cfg.duration_s if cfg.duration_s is not None else world.scenario.duration_s
@@ -42,7 +44,8 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         render_ms += (time.perf_counter() - t0) * 1e3
         feed.truth = gt
         step = agent.step(frame)
-        truth = StepTruth(gt, in_path_obstacle(gt), step.accel_mps2, step.steering_rad)
+        ahead = feed.ahead()
+        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad)
         safety.update(truth)
         for name, scorer in scorers.items():
             scorer.update(step.estimates[name], step.debug[name], truth)

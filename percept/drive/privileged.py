@@ -17,15 +17,31 @@ from percept.sensors.vehicle import EGO_WIDTH_M, bumper_gap_m
 
 
 class TruthFeed:
-    """The current frame's ground truth, for privileged slots and scorers only (set by the loop)."""
+    """The current frame's ground truth, for privileged slots and scorers only (the loop sets ``truth``), and what
+    stands in the true ego corridor (``ahead()``, computed once per frame for every reader)."""
 
     def __init__(self) -> None:
-        self.truth = None
+        self._truth = None
+        self._ahead: list | None = None
+
+    @property
+    def truth(self):
+        return self._truth
+
+    @truth.setter
+    def truth(self, gt) -> None:
+        self._truth, self._ahead = gt, None
 
     def get(self):
-        if self.truth is None:
+        if self._truth is None:
             raise RuntimeError("no ground truth yet: the loop sets it before the slots step")
-        return self.truth
+        return self._truth
+
+    def ahead(self) -> list["InPath"]:
+        """``path_objects`` of the current truth."""
+        if self._ahead is None:
+            self._ahead = path_objects(self.get())
+        return self._ahead
 
 
 @dataclass(frozen=True)
@@ -87,9 +103,10 @@ class Obstacle:
     kind: ObjectKind
 
 
-def in_path_obstacle(gt) -> Obstacle | None:
-    """Nearest vehicle in the ego lane's corridor, or pedestrian in it or entering it: what the ego must respect."""
-    p = _nearest([p for p in path_objects(gt) if p.now or p.obj.kind is ObjectKind.PEDESTRIAN])
+def in_path_obstacle(ahead: list[InPath]) -> Obstacle | None:
+    """Of ``path_objects``: the nearest vehicle in the ego lane's corridor, or pedestrian in it or entering it (what
+    the ego must respect)."""
+    p = _nearest([p for p in ahead if p.now or p.obj.kind is ObjectKind.PEDESTRIAN])
     return None if p is None else Obstacle(p.gap_m, p.vx_mps, p.obj.kind)
 
 
@@ -118,7 +135,7 @@ class PrivilegedLongitudinal(TruthSlot):
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, None]:
         gt = self.truth.get()
-        p = _nearest([p for p in path_objects(gt) if p.now])
+        p = _nearest([p for p in self.truth.ahead() if p.now])
         if p is None:
             return None, None
         rate = p.vx_mps - gt.speed_mps
@@ -131,7 +148,7 @@ class PrivilegedPedestrians(TruthSlot):
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, None]:
         gt = self.truth.get()
-        p = _nearest([p for p in path_objects(gt) if p.obj.kind is ObjectKind.PEDESTRIAN])
+        p = _nearest([p for p in self.truth.ahead() if p.obj.kind is ObjectKind.PEDESTRIAN])
         if p is None:
             return None, None
         why = "pedestrian in the path" if p.now else "pedestrian stepping into the path"

@@ -17,7 +17,7 @@ from percept.odometry.metrics import ate_rmse_m, kitti_drift
 from percept.sensors import ObjectKind
 from percept.sensors.vehicle import EGO_WIDTH_M
 
-from .privileged import Obstacle, path_objects
+from .privileged import InPath, Obstacle
 
 STOP_SPEED_MPS = 0.5
 PHANTOM_DECEL_MPS2 = -3.0
@@ -27,21 +27,22 @@ PHANTOM_DECEL_MPS2 = -3.0
 @dataclass(frozen=True)
 class ScoreContext:
     """vision: the task's slot is a vision one (its estimates are scored); pedestrians, crossing_pedestrians: how
-    many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting; dt_s: frame period [s]."""
+    many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting."""
 
     vision: bool
     pedestrians: int
     crossing_pedestrians: int
     time_gap_setting_s: float
-    dt_s: float
 
 
 @dataclass(frozen=True)
 class StepTruth:
-    """One frame for the scorers: truth (GroundTruth), in_path (the true obstacle the ego must respect, or None),
-    the commands sent (accel_mps2, steering_rad)."""
+    """One frame for the scorers: truth (GroundTruth), ahead (``path_objects`` of it: what stands in the true ego
+    corridor), in_path (the true obstacle the ego must respect, or None), the commands sent (accel_mps2,
+    steering_rad)."""
 
     truth: object
+    ahead: list[InPath]
     in_path: Obstacle | None
     accel_mps2: float
     steering_rad: float
@@ -114,7 +115,7 @@ class LongitudinalScorer:
             self.phantom_brakes += 1
         self._braking_for_nothing = phantom
         if self.ctx.vision and lead is not None:
-            truth = [p for p in path_objects(gt) if p.now]
+            truth = [p for p in step.ahead if p.now]
             if truth:
                 t = min(truth, key=lambda p: p.gap_m)
                 closing = gt.speed_mps - t.vx_mps

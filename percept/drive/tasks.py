@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable, Protocol
 
-from percept.sensors import Frame, LandmarkMap, Source, StereoRig
+from percept.sensors import Frame, LandmarkMap, StereoRig
 
 from . import privileged as priv
 from .privileged import TruthFeed

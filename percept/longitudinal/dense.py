@@ -38,6 +38,12 @@ MIN_MATCHES = 20
 """Fewer RANSAC-consistent feature matches than this: the rectification cannot be measured."""
 
 
+def check_num_disparities(n: int) -> None:
+    """OpenCV's matchers search a multiple of 16 disparities; ValueError naming the bad value otherwise."""
+    if not (16 <= n <= MAX_DISPARITIES and n % 16 == 0):
+        raise ValueError(f"num_disparities must be a multiple of 16 from 16 to {MAX_DISPARITIES}, got {n}")
+
+
 @dataclass(frozen=True)
 class DenseConfig:
     """num_disparities: search range [px], a multiple of 16 from 16 to 1024 (disparities 0 .. n-1);
@@ -53,9 +59,7 @@ class DenseConfig:
     refine_iterations: int = 2
 
     def __post_init__(self) -> None:
-        n = self.num_disparities
-        if not (16 <= n <= MAX_DISPARITIES and n % 16 == 0):
-            raise ValueError(f"num_disparities must be a multiple of 16 from 16 to {MAX_DISPARITIES}, got {n}")
+        check_num_disparities(self.num_disparities)
         if not (1 <= self.block_size <= 11 and self.block_size % 2 == 1):
             raise ValueError(f"block_size must be odd, 1 to 11, got {self.block_size}")
         if not 0 <= self.uniqueness_pct <= 100:
@@ -103,10 +107,15 @@ def sgbm_sample_disparity(left: np.ndarray, right: np.ndarray, num_disparities: 
     """A second peer: StereoSGBM with the settings of OpenCV's stereo_match sample (P1 = 8 cn b^2, P2 = 32 cn b^2,
     disp12MaxDiff 1, uniqueness 10 %, speckle window 100 px, speckle range 32), on the pair as it is."""
     check_pair(left, right)
-    cn, b = (1 if left.ndim == 2 else left.shape[2]), block_size
-    matcher = cv2.StereoSGBM_create(0, num_disparities, b, P1=8 * cn * b * b, P2=32 * cn * b * b, disp12MaxDiff=1,
-                                    uniquenessRatio=10, speckleWindowSize=100, speckleRange=32)
+    matcher = sample_sgbm(num_disparities, block_size, 1 if left.ndim == 2 else left.shape[2], disp12MaxDiff=1,
+                          uniquenessRatio=10, speckleWindowSize=100, speckleRange=32)
     return _to_float(matcher.compute(left, right))
+
+
+def sample_sgbm(num_disparities: int, block_size: int, channels: int = 1, **options) -> cv2.StereoSGBM:
+    """StereoSGBM with OpenCV's sample smoothness penalties P1 = 8 cn b^2, P2 = 32 cn b^2 (and ``options``)."""
+    b = block_size
+    return cv2.StereoSGBM_create(0, num_disparities, b, P1=8 * channels * b * b, P2=32 * channels * b * b, **options)
 
 
 def compare_methods(left: np.ndarray, right: np.ndarray, cfg: DenseConfig) -> dict[str, tuple[np.ndarray, float]]:
@@ -126,11 +135,9 @@ def compare_methods(left: np.ndarray, right: np.ndarray, cfg: DenseConfig) -> di
 
 def _sgbm_wls(left: np.ndarray, right: np.ndarray, cfg: DenseConfig) -> np.ndarray:
     """Steps 1 and 2: padded left/right SGBM and the WLS filter with left-right confidence."""
-    n, b = cfg.num_disparities, cfg.block_size
-    cn = 1 if left.ndim == 2 else left.shape[2]
-    matcher = cv2.StereoSGBM_create(0, n, b, P1=8 * cn * b * b, P2=32 * cn * b * b, disp12MaxDiff=-1,
-                                    uniquenessRatio=cfg.uniqueness_pct, speckleWindowSize=0,
-                                    mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY)
+    n = cfg.num_disparities
+    matcher = sample_sgbm(n, cfg.block_size, 1 if left.ndim == 2 else left.shape[2], disp12MaxDiff=-1,
+                          uniquenessRatio=cfg.uniqueness_pct, speckleWindowSize=0, mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY)
     pad = [cv2.copyMakeBorder(im, 0, 0, n, 0, cv2.BORDER_REPLICATE) for im in (left, right)]
     d_left = matcher.compute(pad[0], pad[1])
     d_right = cv2.ximgproc.createRightMatcher(matcher).compute(pad[1], pad[0])
@@ -146,15 +153,25 @@ def _high_pass(image: np.ndarray) -> np.ndarray:
     return g - cv2.GaussianBlur(g, (0, 0), 3.0)
 
 
+class _Aligner:
+    """What the sub-pixel steps share for one pair, computed once: both views high-passed, the right view's row
+    gradient and the pixel grid."""
+
+    def __init__(self, left: np.ndarray, right: np.ndarray):
+        self.lh, self.rh = _high_pass(left), _high_pass(right)
+        # dR/dx by central differences (Sobel / 8: the smoothed derivative per pixel)
+        self.grad = cv2.Sobel(self.rh, cv2.CV_32F, 1, 0, ksize=3) / 8.0
+        h, w = self.lh.shape
+        self.xs, self.ys = np.meshgrid(np.arange(w, dtype=np.float32), np.arange(h, dtype=np.float32))
+
+
 def refine_subpixel(left: np.ndarray, right: np.ndarray, disparity: np.ndarray, window: int = 7,
-                    max_step_px: float = 0.25) -> np.ndarray:
+                    max_step_px: float = 0.25, aligner: _Aligner | None = None) -> np.ndarray:
     """One Lucas-Kanade step along the rows: the shift delta that best aligns a ``window`` x ``window`` block of the
-    right image, warped by the current disparity, with the left one; |delta| <= ``max_step_px``. NaN stays NaN."""
-    lh, rh = _high_pass(left), _high_pass(right)
-    # dR/dx by central differences (Sobel / 8: the smoothed derivative per pixel)
-    grad = cv2.Sobel(rh, cv2.CV_32F, 1, 0, ksize=3) / 8.0
-    h, w = disparity.shape
-    xs, ys = np.meshgrid(np.arange(w, dtype=np.float32), np.arange(h, dtype=np.float32))
+    right image, warped by the current disparity, with the left one; |delta| <= ``max_step_px``. NaN stays NaN.
+    ``aligner``: the pair's shared terms, when several steps run on one pair."""
+    a = aligner or _Aligner(left, right)
+    lh, rh, grad, xs, ys = a.lh, a.rh, a.grad, a.xs, a.ys
     d = np.nan_to_num(disparity).astype(np.float32)
     # the right image seen from the left: R_w(x, y) = R(x - d, y), and its gradient G there
     warped = [cv2.remap(im, xs - d, ys, cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE) for im in (rh, grad)]
@@ -200,8 +217,9 @@ def dense_disparity(left: np.ndarray, right: np.ndarray, cfg: DenseConfig = Dens
     there is no estimate. ValueError for images of different sizes."""
     check_pair(left, right)
     d = fill_from_background(_sgbm_wls(left, right, cfg))
+    aligner = _Aligner(left, right) if cfg.refine_iterations else None
     for _ in range(cfg.refine_iterations):
-        d = smooth_disparity(refine_subpixel(left, right, d))
+        d = smooth_disparity(refine_subpixel(left, right, d, aligner=aligner))
     return d
 
 

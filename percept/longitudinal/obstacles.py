@@ -17,6 +17,8 @@ import numpy as np
 
 from percept.sensors import EgoPath, Side, StereoRig
 
+from .dense import check_num_disparities
+
 
 @dataclass(frozen=True)
 class ObstacleConfig:
@@ -49,8 +51,7 @@ class ObstacleConfig:
             if not 0.1 <= s <= 1.0:
                 raise ValueError(f"band scales must be in [0.1, 1], got {s}")
         for n in self.num_disparities:
-            if n % 16 or n <= 0:
-                raise ValueError(f"num_disparities must be a positive multiple of 16, got {n}")
+            check_num_disparities(n)
         if not 0 < self.min_range_m < self.near_m < self.max_range_m:
             raise ValueError(f"need 0 < min_range_m < near_m < max_range_m, got {self.min_range_m}, {self.near_m}, "
                              f"{self.max_range_m}")
@@ -59,13 +60,11 @@ class ObstacleConfig:
 @dataclass(frozen=True)
 class Obstacle:
     """The nearest group of standing pixels in the path. range_m: its median depth [m] (coarse); box_px: (u0, v0,
-    u1, v1) full-resolution left-image box; support: its frontal area in full-resolution pixels; points_m: (N, 3)
-    its pixels in the vehicle frame."""
+    u1, v1) full-resolution left-image box; support: its frontal area in full-resolution pixels."""
 
     range_m: float
     box_px: tuple[int, int, int, int]
     support: float
-    points_m: np.ndarray
 
 
 class _Band:
@@ -162,4 +161,4 @@ class ObstacleFinder:
         u0, u1 = np.percentile(us, [2, 98])
         v0, v1 = np.percentile(vs, [2, 98])
         box = (int(max(u0 - 1, 0)), int(max(v0 - 1, 0)), int(min(u1 + 2, cam.width)), int(min(v1 + 2, cam.height)))
-        return Obstacle(float(np.median(z[near])), box, float(area[near].sum()), pv[near])
+        return Obstacle(float(np.median(z[near])), box, float(area[near].sum()))

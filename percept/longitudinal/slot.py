@@ -44,7 +44,7 @@ class LeadConfig:
 class LeadDebug:
     """obstacle: this frame's nearest standing group (None if none); refined: its subpixel disparity; measured_m:
     the stereo range [m] (None without one); state: (range, range rate) after the update; hits, misses: the
-    track's counts; disparity: the coarse disparity band (for review)."""
+    track's counts."""
 
     obstacle: Obstacle | None
     refined: Refined | None

@@ -108,7 +108,10 @@ class StereoRig:
                    float(d.get("mount_x_m", 0.8)))
 
     def save(self, path: Path) -> None:
-        Path(path).write_text(json.dumps(self.to_dict(), indent=2))
+        """camera.json, written atomically (temporary file, then rename)."""
+        from percept.outputs import write_json_atomic
+
+        write_json_atomic(Path(path), self.to_dict())
 
     @classmethod
     def load(cls, path: Path) -> "StereoRig":

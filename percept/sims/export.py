@@ -8,16 +8,14 @@ it, and then removes only files a render writes.
 
 from __future__ import annotations
 
-import io
 import json
 import re
 from pathlib import Path
 from typing import Callable
 
-import cv2
 import numpy as np
 
-from percept.outputs import write_files_atomic, write_json_atomic
+from percept.outputs import npy_bytes, png_bytes, write_files_atomic, write_json_atomic
 from percept.sensors import Frame
 
 from .ground_truth import GroundTruth
@@ -55,19 +53,6 @@ def prepare_out_dir(out: Path, force: bool = False) -> Path:
     return out
 
 
-def _png(image: np.ndarray) -> bytes:
-    ok, buf = cv2.imencode(".png", image)
-    if not ok:
-        raise ValueError(f"cannot encode a {image.shape} image as PNG")
-    return buf.tobytes()
-
-
-def _npy(array: np.ndarray) -> bytes:
-    buf = io.BytesIO()
-    np.save(buf, array)
-    return buf.getvalue()
-
-
 def write_frame(out: Path, i: int, frame: Frame, gt: GroundTruth) -> None:
     """``{i:06d}_left.png``, ``_right.png`` (absent for a dropped frame), ``_depth.npy`` (float32 m, inf sky),
     ``_gt.json``: all of them or none."""
@@ -77,22 +62,20 @@ def write_frame(out: Path, i: int, frame: Frame, gt: GroundTruth) -> None:
     d["dropped"] = frame.dropped
     d["sensors"] = {"imu": {"accel_mps2": frame.imu.accel_mps2.tolist(), "gyro_rps": frame.imu.gyro_rps.tolist()},
                     "wheel_speed_mps": frame.wheel_speed_mps}
-    files = {} if frame.dropped else {out / f"{stem}_left.png": _png(frame.left),
-                                      out / f"{stem}_right.png": _png(frame.right)}
-    files[out / f"{stem}_depth.npy"] = _npy(gt.depth_m.astype(np.float32))
+    files = {} if frame.dropped else {out / f"{stem}_left.png": png_bytes(frame.left),
+                                      out / f"{stem}_right.png": png_bytes(frame.right)}
+    files[out / f"{stem}_depth.npy"] = npy_bytes(gt.depth_m.astype(np.float32))
     # the ground truth last: a reader that finds it finds the whole frame
     files[out / f"{stem}_gt.json"] = json.dumps(d, indent=1).encode()
     write_files_atomic(files)
 
 
-def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], None] | None = None,
-               force: bool = False) -> int:
-    """Render ``frames`` consecutive frames of ``world`` into ``out`` with camera.json (and landmarks.json); the
-    number of frames written (also when stopped early: see ``written``)."""
+def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], None] | None = None) -> None:
+    """Render ``frames`` consecutive frames of ``world`` into ``out`` (made ready by ``prepare_out_dir``) with
+    camera.json (and landmarks.json); ``written`` counts the frames when stopped early."""
     if frames < 1:
         raise ValueError(f"--frames must be at least 1, got {frames}")
-    out = prepare_out_dir(out, force)
-    write_json_atomic(out / "camera.json", world.cfg.rig.to_dict())
+    world.cfg.rig.save(out / "camera.json")
     landmarks = world.landmark_map()
     if len(landmarks):
         write_json_atomic(out / "landmarks.json", landmarks.to_dict(), indent=1)
@@ -103,7 +86,6 @@ def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], N
             progress()
         if i + 1 < frames:
             world.step()
-    return frames
 
 
 def written(out: Path) -> int:

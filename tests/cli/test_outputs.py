@@ -32,28 +32,34 @@ def one_error_line(result, message: str, code: int = 2) -> None:
 
 @pytest.fixture
 def disk_full(monkeypatch):
-    """``disk_full(after=N, when=pred)``: the disk takes N more bytes (of files whose path satisfies ``pred``),
-    then every write fails with ENOSPC."""
+    """``disk_full(after=N, when=pred)``: the disk takes N more bytes (of files whose target path satisfies
+    ``pred``), then every write fails with ENOSPC. Which file a descriptor writes is learnt from the writer's own
+    temporaries (``outputs._temporary``)."""
 
     def arm(after: int = 0, when=lambda path: True):
         left = [after]
-        real = outputs._os_write
+        real_write, real_temporary = outputs._os_write, outputs._temporary
+        target: dict[int, str] = {}
+
+        def temporary(path):
+            fd, name = real_temporary(path)
+            target[fd] = str(name)
+            return fd, name
 
         def write(fd, data):
-            if not when(os.readlink(f"/proc/self/fd/{fd}")):
-                return real(fd, data)
+            if not when(target.get(fd, "")):
+                return real_write(fd, data)
             if len(data) > left[0]:
                 if left[0]:
-                    real(fd, bytes(data[:left[0]]))
+                    real_write(fd, bytes(data[:left[0]]))
                 left[0] = 0
                 raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
             left[0] -= len(data)
-            return real(fd, data)
+            return real_write(fd, data)
 
+        monkeypatch.setattr(outputs, "_temporary", temporary)
         monkeypatch.setattr(outputs, "_os_write", write)
 
-    if not Path("/proc/self/fd").is_dir():
-        pytest.skip("needs /proc/self/fd (Linux)")
     return arm
 
 

@@ -70,5 +70,5 @@ def test_the_finder_reports_a_wall_standing_in_the_path_at_its_range():
     assert ob is not None and ob.range_m == pytest.approx(z_wall, rel=0.05)
     # its lowest standing pixels are min_height_m above the road: f h_min / Z rows above the foot
     assert ob.box_px[3] == pytest.approx(foot - cam.fy * ObstacleConfig().min_height_m / z_wall, abs=3)
-    with pytest.raises(ValueError, match="num_disparities must be a positive multiple of 16"):
+    with pytest.raises(ValueError, match="num_disparities must be a multiple of 16"):
         ObstacleConfig(num_disparities=(40, 32))
