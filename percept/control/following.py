@@ -1,8 +1,14 @@
 """Following (ACC): cruise at the set speed, or keep a constant time gap to what is ahead.
 
-Gap error e = gap - gap*, gap* = max(d0, v h) behind a vehicle (h the time gap), d0 behind anything else; the
-law a = e / Td^2 - 2 closing / Td makes the gap error critically damped with time constant Td (constant
-time-gap policy: Rajamani, *Vehicle Dynamics and Control*, 2nd ed., ch. 6). Cruise: a = (v_set - v) / Tv.
+Gap error e = gap - gap*, gap* = max(d0, v_lead h) behind a vehicle (h the time gap), d0 behind anything else;
+the law a = e / Td^2 - 2 closing / Td makes the gap error critically damped with time constant Td (constant
+time-gap policy: Rajamani, *Vehicle Dynamics and Control*, 2nd ed., ch. 6). The gap aimed at is the lead's
+speed times h (the same as the ego's once they match): referred to the ego's own speed it would move with every
+correction (de/dt = -closing - h a), which turns the critically damped loop into an overdamped one about twice
+as slow. Cruise: a = (v_set - v) / Tv.
+Towards something standing still the law brakes no harder than stopping needs: at most ``gain`` times the
+constant deceleration a_req = closing^2 / (2 (gap - d0)) that stops the car d0 short of it (the damped law
+alone brakes hard early and then eases off).
 """
 
 from __future__ import annotations
@@ -24,13 +30,15 @@ class FollowingDebug:
     follow_mps2: float | None
     target_gap_m: float | None
     limited_by: str
+    stop_cap_mps2: float | None = None
 
 
 class Following(Controller):
     """Acceleration [m/s²] from the set speed and the in-path target; gains as time constants [s]."""
 
     def __init__(self, set_speed_mps: float, time_gap_s: float = 1.8, standstill_m: float = 4.0,
-                 gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5):
+                 gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5, stop_gain: float = 1.3,
+                 standing_mps: float = 1.0):
         for name, v in (("time_gap_s", time_gap_s), ("gap_time_constant_s", gap_time_constant_s),
                         ("speed_time_constant_s", speed_time_constant_s)):
             if not v > 0:
@@ -39,6 +47,7 @@ class Following(Controller):
             raise ValueError(f"set_speed_mps must be >= 0, got {set_speed_mps}")
         self.set_speed, self.time_gap, self.d0 = set_speed_mps, time_gap_s, standstill_m
         self.Td, self.Tv = gap_time_constant_s, speed_time_constant_s
+        self.stop_gain, self.standing_mps = stop_gain, standing_mps
 
     def update(self, target: Target | None, speed_mps: float) -> tuple[float, FollowingDebug]:
         v = speed_mps
@@ -46,8 +55,16 @@ class Following(Controller):
         cruise = (self.set_speed - v) / self.Tv
         if target is None:
             return cruise, FollowingDebug(cruise, None, None, "cruise")
-        gap_ref = max(self.d0, v * self.time_gap) if target.kind is ObjectKind.VEHICLE else self.d0
+        # gap* = max(d0, h v_lead), v_lead = v - closing
+        lead_speed = max(v - target.closing_mps, 0.0)
+        gap_ref = max(self.d0, lead_speed * self.time_gap) if target.kind is ObjectKind.VEHICLE else self.d0
         # gap dynamics critically damped: a = (gap - gap*) / Td^2 - 2 closing / Td
         follow = (target.gap_m - gap_ref) / self.Td ** 2 - 2 * target.closing_mps / self.Td
+        cap = None
+        closing, room = target.closing_mps, target.gap_m - self.d0
+        if closing > 0 and room > 0 and v - closing < self.standing_mps:
+            # standing target: no harder than gain * a_req, a_req = closing^2 / (2 (gap - d0))
+            cap = -self.stop_gain * closing * closing / (2 * room)
+            follow = max(follow, cap)
         a, name = limiting({"cruise": cruise, "follow": follow})
-        return a, FollowingDebug(cruise, follow, gap_ref, name)
+        return a, FollowingDebug(cruise, follow, gap_ref, name, cap)

@@ -22,6 +22,10 @@ from .privileged import InPath, Obstacle
 STOP_SPEED_MPS = 0.5
 PHANTOM_DECEL_MPS2 = -3.0
 """A commanded deceleration below this with nothing in the path to justify it is a phantom brake [m/s²]."""
+STEADY_REL_MPS = 0.5
+STEADY_S = 2.0
+"""Following is steady once the ego's and the lead's speeds have stayed within STEADY_REL_MPS [m/s] of each other
+for STEADY_S [s]; ``time_gap_steady_s`` averages the time gap over those frames."""
 
 
 @dataclass(frozen=True)
@@ -99,14 +103,25 @@ class LongitudinalScorer:
         self.ctx = ctx
         self.gaps_s: list[float] = []
         self.pairs: list[tuple[float, float, float, float]] = []  # est range, true range, est ttc, true ttc
+        self.steady_gaps_s: list[float] = []
+        self._calm_since_s: float | None = None
         self.phantom_brakes = 0
         self._braking_for_nothing = False
 
     def update(self, lead, debug, step: StepTruth) -> None:
         gt, obstacle = step.truth, step.in_path
         # time gap to an in-path vehicle lead within 100 m, while moving
-        if obstacle is not None and obstacle.kind is ObjectKind.VEHICLE and obstacle.gap_m < 100 and gt.speed_mps > 5:
+        following = (obstacle is not None and obstacle.kind is ObjectKind.VEHICLE and obstacle.gap_m < 100
+                     and gt.speed_mps > 5)
+        if following:
             self.gaps_s.append(obstacle.gap_m / gt.speed_mps)
+        # steady following: the speeds have matched within STEADY_REL_MPS for STEADY_S
+        if following and abs(obstacle.speed_mps - gt.speed_mps) < STEADY_REL_MPS:
+            self._calm_since_s = gt.time_s if self._calm_since_s is None else self._calm_since_s
+            if gt.time_s - self._calm_since_s >= STEADY_S:
+                self.steady_gaps_s.append(obstacle.gap_m / gt.speed_mps)
+        else:
+            self._calm_since_s = None
         # phantom brake: a hard deceleration with nothing in the path within the stopping distance at 3 m/s^2 + 10 m
         reach = gt.speed_mps ** 2 / (2 * -PHANTOM_DECEL_MPS2) + 10.0
         justified = obstacle is not None and obstacle.gap_m <= reach
@@ -133,8 +148,7 @@ class LongitudinalScorer:
             "ttc_abs_err_s": ttc_abs_err_s(p[:, 2], p[:, 3]) if scored else None,
             "time_gap_mean_s": float(np.mean(g)) if g else None,
             "time_gap_min_s": float(np.min(g)) if g else None,
-            # steady state: the last quarter of the frames that had a lead
-            "time_gap_steady_s": float(np.mean(g[-max(len(g) // 4, 1):])) if g else None,
+            "time_gap_steady_s": float(np.mean(self.steady_gaps_s)) if self.steady_gaps_s else None,
             "time_gap_setting_s": self.ctx.time_gap_setting_s,
             "phantom_brakes": self.phantom_brakes,
         }

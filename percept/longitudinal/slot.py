@@ -1,11 +1,13 @@
 """The vision longitudinal slot: the stereo pair and the ego path in, the lead out.
 
-Each frame: the nearest obstacle standing in the path (``obstacles``), its subpixel disparity over the lower
-part of it that faces the ego (``refine``), range Z = f b / d with the stereo noise sigma_Z = Z^2 sigma_d / (f b);
-then a Kalman filter (filterpy) over range and range rate (constant velocity, white acceleration noise) with a
-gate: a measurement far from the prediction twice in a row starts a new track (a cut-in, the lead changing
-lanes). A track is reported once confirmed, kept through short misses and dropped frames, with a confidence
-that falls while it is only predicted.
+Each frame: the nearest obstacle standing in the path (``obstacles``) and three measurements of it: its range
+from stereo (subpixel disparity over the lower part that faces the ego, ``refine``: Z = f b / d, noise
+sigma_Z = Z^2 sigma_d / (f b)); its range from where its tyres meet the road (``contact``); its range rate from
+the expansion of its image (``flow``: dZ/dt = -Z (s - 1) / dt). A Kalman filter (filterpy) over range and range
+rate (constant velocity, white acceleration noise) takes each with its own noise, each gated; a stereo range
+far from the prediction twice in a row starts a new track (a cut-in, the lead changing lanes). A track is
+reported once confirmed, kept through short misses and dropped frames, with a confidence that falls while it
+is only predicted.
 """
 
 from __future__ import annotations
@@ -18,37 +20,53 @@ from filterpy.kalman import KalmanFilter
 
 from percept.sensors import EgoPath, Frame, Lead, ObjectKind, StereoRig
 
+from .contact import Contact, ContactConfig, ContactRange
+from .flow import Expansion, ExpansionTracker, FlowConfig
 from .obstacles import Obstacle, ObstacleConfig, ObstacleFinder
 from .refine import Refined, refine_disparity, surface_mask
+
+
+_RANGE = np.array([[1.0, 0.0, 0.0]])
+_RATE = np.array([[0.0, 1.0, 0.0]])
+"""Measurement rows of the filter's state (range [m], range rate [m/s], range acceleration [m/s²])."""
 
 
 @dataclass(frozen=True)
 class LeadConfig:
     """face_m: heights above the road of the band whose disparity is refined (a vehicle's body faces the ego
-    there) [m]; sigma_d_px: floor on the disparity noise [px] (the simulator renders object edges without
-    anti-aliasing, so an edge's disparity is quantised to whole pixels: uniform error, sigma = 1/sqrt(12) px);
-    accel_sigma_mps2: white acceleration noise of the lead's range [m/s²]; gate_sigma: innovations beyond this
+    there) [m]; sigma_d_px: floor on the disparity noise [px] (the refinement's own standard error is often far
+    smaller; the floor covers what it does not model: slanted faces, pixels at the outline); jerk_sigma_mps3: white jerk noise of the range (the filter is constant-acceleration, so that a lead braking hard is
+    followed without lag) [m/s³]; gate_sigma: innovations beyond this
     many sigma are outliers; confirm: hits before a track is reported; hold_s: how long a track is predicted
     without measurements [s]."""
 
     face_m: tuple[float, float] = (0.4, 0.9)
-    sigma_d_px: float = 0.29
-    accel_sigma_mps2: float = 3.0
+    sigma_d_px: float = 0.05
+    column_fill: float = 0.3
+    huber: float = 6.0
+    edge_px: int = 0
+    jerk_sigma_mps3: float = 8.0
     gate_sigma: float = 5.0
     confirm: int = 3
     hold_s: float = 0.6
     obstacles: ObstacleConfig = ObstacleConfig()
+    contact: ContactConfig = ContactConfig()
+    flow: FlowConfig = FlowConfig()
 
 
 @dataclass(frozen=True)
 class LeadDebug:
     """obstacle: this frame's nearest standing group (None if none); refined: its subpixel disparity; measured_m:
-    the stereo range [m] (None without one); state: (range, range rate) after the update; hits, misses: the
-    track's counts."""
+    the stereo range [m] (None without one); contact: the ground-contact range; expansion: the image expansion
+    (flow); used: which of "stereo", "contact", "flow" updated the filter; state: (range, range rate) after the
+    update; hits, misses: the track's counts."""
 
     obstacle: Obstacle | None
     refined: Refined | None
     measured_m: float | None
+    contact: Contact | None
+    expansion: Expansion | None
+    used: tuple[str, ...]
     state: tuple[float, float] | None
     hits: int
     misses: int
@@ -61,6 +79,8 @@ class LongitudinalSlot:
     def __init__(self, rig: StereoRig, dt_s: float, cfg: LeadConfig = LeadConfig()):
         self.rig, self.dt, self.cfg = rig, dt_s, cfg
         self.finder = ObstacleFinder(rig, cfg.obstacles)
+        self.contact = ContactRange(rig, cfg.contact)
+        self.flow = ExpansionTracker(cfg.flow)
         self.fb = rig.camera.fx * rig.baseline_m
         self.reset()
 
@@ -68,11 +88,13 @@ class LongitudinalSlot:
         self.kf: KalmanFilter | None = None
         self.hits = self.misses = self.outliers = 0
         self.box: tuple | None = None
+        self.flow.reset()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
         path = upstream.get("lateral") or EgoPath.straight(frame.wheel_speed_mps)
         self._predict()
-        ob = ref = z = None
+        ob = ref = z = contact = expansion = None
+        used: tuple[str, ...] = ()
         if not frame.dropped:
             left = cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY)
             right = cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY)
@@ -80,9 +102,15 @@ class LongitudinalSlot:
             if ob is not None:
                 ref = self._refine(left, right, ob)
                 z = self.fb / ref.disparity_px if ref is not None and ref.disparity_px > 0.5 else ob.range_m
-        self._update(z, ref, ob)
+                contact = self.contact.measure(left, ob.box_px, z)
+                used = self._update(z, ref, ob, contact)
+                expansion = self.flow.measure(left, ob.box_px, frame.timestamp_s) if used else None
+                if expansion is not None and self._update_rate(expansion):
+                    used += ("flow",)
+        if not used:
+            self._miss()
         state = None if self.kf is None else (float(self.kf.x[0, 0]), float(self.kf.x[1, 0]))
-        return self._lead(), LeadDebug(ob, ref, z, state, self.hits, self.misses)
+        return self._lead(), LeadDebug(ob, ref, z, contact, expansion, used, state, self.hits, self.misses)
 
     def _refine(self, left: np.ndarray, right: np.ndarray, ob: Obstacle) -> Refined | None:
         """Subpixel disparity over the band of the obstacle that faces the ego (its lower body)."""
@@ -101,46 +129,81 @@ class LongitudinalSlot:
         m = surface_mask(L, R, box, d0)
         if m is None or m.sum() < 12:
             return None
-        return refine_disparity(L, R, box, m, d0)
+        # the obstacle's own columns: where most of the band matches (stray matches on the road beside it, e.g. a
+        # slanted lane line, would pull the estimate); ``edge_px`` more are dropped at each side, where the pixels
+        # mix the obstacle with a background that differs between the two images
+        cols = np.flatnonzero(m.mean(axis=0) >= self.cfg.column_fill)
+        k = self.cfg.edge_px
+        if len(cols) == 0 or cols[-1] - cols[0] - 2 * k < 2:
+            return None
+        m[:, :cols[0] + k] = False
+        m[:, cols[-1] + 1 - k:] = False
+        if m.sum() < 12:
+            return None
+        return refine_disparity(L, R, box, m, d0, huber=self.cfg.huber)
 
     def _predict(self) -> None:
         if self.kf is not None:
             self.kf.predict()
 
     def _new_track(self, z: float, sigma: float) -> None:
-        kf = KalmanFilter(dim_x=2, dim_z=1)
-        dt, q = self.dt, self.cfg.accel_sigma_mps2 ** 2
-        kf.F = np.array([[1.0, dt], [0.0, 1.0]])
-        kf.H = np.array([[1.0, 0.0]])
-        # white acceleration: Q = q [[dt^4/4, dt^3/2], [dt^3/2, dt^2]]
-        kf.Q = q * np.array([[dt ** 4 / 4, dt ** 3 / 2], [dt ** 3 / 2, dt ** 2]])
-        kf.x = np.array([[z], [0.0]])
-        kf.P = np.diag([sigma ** 2, 10.0 ** 2])
+        kf = KalmanFilter(dim_x=3, dim_z=1)
+        dt, q = self.dt, self.cfg.jerk_sigma_mps3 ** 2
+        kf.F = np.array([[1.0, dt, dt * dt / 2], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+        kf.H = _RANGE
+        # white jerk (Bar-Shalom, Estimation with Applications to Tracking, 6.2.3):
+        # Q = q [[dt^5/20, dt^4/8, dt^3/6], [dt^4/8, dt^3/3, dt^2/2], [dt^3/6, dt^2/2, dt]]
+        kf.Q = q * np.array([[dt ** 5 / 20, dt ** 4 / 8, dt ** 3 / 6], [dt ** 4 / 8, dt ** 3 / 3, dt ** 2 / 2],
+                             [dt ** 3 / 6, dt ** 2 / 2, dt]])
+        kf.x = np.array([[z], [0.0], [0.0]])
+        kf.P = np.diag([sigma ** 2, 10.0 ** 2, 5.0 ** 2])
         self.kf, self.hits, self.misses, self.outliers = kf, 1, 0, 0
+        self.flow.reset()
 
-    def _update(self, z: float | None, ref: Refined | None, ob: Obstacle | None) -> None:
-        if z is None:
-            self.misses += 1
-            if self.kf is not None and self.misses * self.dt > self.cfg.hold_s:
-                self.reset()
-            return
+    def _miss(self) -> None:
+        self.misses += 1
+        if self.kf is not None and self.misses * self.dt > self.cfg.hold_s:
+            self.reset()
+
+    def _gated_update(self, value: float, sigma: float, H: np.ndarray) -> bool:
+        """One measurement ``value`` = H x with noise ``sigma``, unless it is beyond the gate; True if used."""
+        R = np.array([[sigma ** 2]])
+        s = float((H @ self.kf.P @ H.T + R)[0, 0])
+        innovation = value - float((H @ self.kf.x)[0, 0])
+        if innovation * innovation > self.cfg.gate_sigma ** 2 * s:
+            return False
+        self.kf.update(np.array([[value]]), R=R, H=H)
+        return True
+
+    def _update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
+        """The range measurements: stereo (which also starts and replaces tracks), then ground contact."""
         sd = max(ref.sigma_px if ref is not None else 1.0, self.cfg.sigma_d_px)
         # stereo range noise: sigma_Z = Z^2 sigma_d / (f b)
         sigma = z * z * sd / self.fb
         self.box = ob.box_px
         if self.kf is None:
             self._new_track(z, sigma)
-            return
-        self.kf.R = np.array([[sigma ** 2]])
-        s = float((self.kf.H @ self.kf.P @ self.kf.H.T + self.kf.R)[0, 0])
-        innovation = z - float(self.kf.x[0, 0])
-        if innovation * innovation > self.cfg.gate_sigma ** 2 * s:
+            return ("stereo",)
+        used: tuple[str, ...] = ()
+        if self._gated_update(z, sigma, _RANGE):
+            used = ("stereo",)
+            self.outliers = 0
+        else:
             self.outliers += 1
             if self.outliers >= 2:  # the lead changed: follow the new one
                 self._new_track(z, sigma)
-            return
-        self.kf.update(np.array([[z]]))
-        self.hits, self.misses, self.outliers = self.hits + 1, 0, 0
+                return ("stereo",)
+        if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, _RANGE):
+            used += ("contact",)
+        if used:
+            self.hits, self.misses = self.hits + 1, 0
+        return used
+
+    def _update_rate(self, e: Expansion) -> bool:
+        """The range rate from the image's expansion at the current range: dZ/dt = -Z (s - 1) / dt."""
+        z = float(self.kf.x[0, 0])
+        sigma = z * e.sigma / e.dt_s
+        return self._gated_update(e.range_rate_mps(z), sigma, _RATE)
 
     def _lead(self) -> Lead | None:
         if self.kf is None or self.hits < self.cfg.confirm:

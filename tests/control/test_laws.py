@@ -44,9 +44,9 @@ def test_following_cruises_without_a_target_and_holds_the_time_gap_behind_a_vehi
     # at the target gap (v h) and not closing: the follow term is zero and limits the command
     a, dbg = law.update(Target(25.0 * 1.8, 0.0, ObjectKind.VEHICLE, "lead"), 25.0)
     assert a == pytest.approx(0.0) and dbg.limited_by == "follow" and dbg.target_gap_m == pytest.approx(45.0)
-    # closing at 5 m/s at that gap: a = -2 c / Td
-    a, _ = law.update(Target(45.0, 5.0, ObjectKind.VEHICLE, "lead"), 25.0)
-    assert a == pytest.approx(-2 * 5.0 / 2.5)
+    # closing at 5 m/s at 45 m: the lead does 20 m/s, so the gap aimed at is 36 m: a = (45 - 36) / Td^2 - 2 c / Td
+    a, dbg = law.update(Target(45.0, 5.0, ObjectKind.VEHICLE, "lead"), 25.0)
+    assert dbg.target_gap_m == pytest.approx(36.0) and a == pytest.approx(9.0 / 2.5 ** 2 - 2 * 5.0 / 2.5)
     # behind anything that is not a vehicle the gap aimed at is the standstill distance
     _, dbg = law.update(Target(10.0, 0.0, ObjectKind.PEDESTRIAN, "request"), 10.0)
     assert dbg.target_gap_m == 4.0
@@ -54,11 +54,24 @@ def test_following_cruises_without_a_target_and_holds_the_time_gap_behind_a_vehi
         Following(30.0, time_gap_s=0.0)
 
 
+def test_following_brakes_no_harder_than_stopping_needs_behind_a_standing_target():
+    law = Following(set_speed_mps=30.0, time_gap_s=1.8, gap_time_constant_s=2.5, stop_gain=1.3)
+    # 8 m/s towards a stopped car 20 m ahead: stopping 4 m short needs a_req = 8^2 / (2 * 16) = 2 m/s^2
+    a, dbg = law.update(Target(20.0, 8.0, ObjectKind.VEHICLE, "lead"), 8.0)
+    assert dbg.stop_cap_mps2 == pytest.approx(-1.3 * 2.0) and a == pytest.approx(-2.6)
+    # the undamped law alone would have braked at (20 - 4) / Td^2 - 2 * 8 / Td = -3.84 m/s^2
+    assert dbg.follow_mps2 > (20.0 - 4.0) / 2.5 ** 2 - 2 * 8.0 / 2.5
+    # a moving lead is no standing target: no cap
+    _, dbg = law.update(Target(20.0, 8.0, ObjectKind.VEHICLE, "lead"), 20.0)
+    assert dbg.stop_cap_mps2 is None
+
+
 def test_following_settles_at_the_time_gap_in_closed_loop():
-    # a point-mass ego behind a lead at a constant 20 m/s: the gap error is critically damped to v h
+    # a point-mass ego behind a lead at a constant 20 m/s: the gap error is critically damped to v h with Td = 2.5 s
+    # (gap* referred to the lead's speed); after 8 Td it is settled
     law, dt = Following(30.0, time_gap_s=1.8), 1 / 15
     v, gap = 28.0, 80.0
-    for _ in range(int(60 / dt)):
+    for _ in range(int(20 / dt)):
         a, _ = law.update(Target(gap, v - 20.0, ObjectKind.VEHICLE, "lead"), v)
         v += a * dt
         gap += (20.0 - v) * dt

@@ -1,11 +1,12 @@
-"""Longitudinal part: the lead. Range, range rate and time to contact beside the true in-path obstacle's; a line
-across the path at the lead's range; its box on the left image labelled with range and TTC."""
+"""Longitudinal part: the lead. Range, range rate and time to contact beside the true in-path obstacle's, with the
+vision slot's separate cues (stereo and ground-contact range, the range rate from image expansion); a line across
+the path at the lead's range; its box on the left image labelled with range and TTC."""
 
 from __future__ import annotations
 
 import rerun as rr
 
-from ..context import Part, PartContext, Plot, cross_line
+from ..context import TRUTH_VS_ESTIMATE, Part, PartContext, Plot, cross_line
 
 LEAD_RGB = (255, 80, 200)
 TTC_SHOWN_S = 20.0
@@ -36,6 +37,11 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, lead, debug, truth) -> None:
     t_range, t_rate, t_ttc = true_lead(ctx, truth)
     ctx.scalars(rec, "range_m", truth=t_range, estimate=lead.range_m if lead else None)
     ctx.scalars(rec, "range_rate_mps", truth=t_rate, estimate=lead.range_rate_mps if lead else None)
+    if hasattr(debug, "expansion"):  # the vision slot's cues, each before fusion
+        contact, expansion = debug.contact, debug.expansion
+        ctx.scalars(rec, "range_m", stereo=debug.measured_m, contact=contact.range_m if contact else None)
+        ctx.scalars(rec, "range_rate_mps",
+                    flow=expansion.range_rate_mps(lead.range_m) if expansion is not None and lead else None)
     ctx.scalars(rec, "ttc_s", truth=t_ttc, estimate=_shown(lead.ttc_s) if lead else None)
     if lead is None:
         rec.log(ctx.around_ego("lead"), rr.Clear(recursive=False))
@@ -52,5 +58,7 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, lead, debug, truth) -> None:
                                              colors=[LEAD_RGB], radii=1.5, labels=[label(lead)]))
 
 
-PART = Part(draw, plots=(Plot("range_m", "range [m]"), Plot("range_rate_mps", "range rate [m/s]"),
+STEREO_RGB, CONTACT_RGB, FLOW_RGB = (90, 170, 255), (250, 190, 60), (120, 220, 120)
+PART = Part(draw, plots=(Plot("range_m", "range [m]", TRUTH_VS_ESTIMATE + (("stereo", STEREO_RGB), ("contact", CONTACT_RGB))),
+                         Plot("range_rate_mps", "range rate [m/s]", TRUTH_VS_ESTIMATE + (("flow", FLOW_RGB),)),
                          Plot("ttc_s", f"TTC [s] (to {TTC_SHOWN_S:.0f})")))

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .spans import pixel_spans, smooth_edges, span_bounds
 from .textures import TextureAtlas
 
 BIG_PX = 1500
@@ -56,8 +57,10 @@ class PreparedPatches:
     texsize: np.ndarray
 
 
-def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouettes: bool) -> None:
-    """Draw prepared patches into ``target`` (z-tested against ``target.inv_depth``)."""
+def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouettes: bool,
+                       antialias: bool = True) -> None:
+    """Draw prepared patches into ``target`` (z-tested against ``target.inv_depth``); ``antialias``: blend the
+    pixels vertical edges cross by their coverage (``spans.smooth_edges``)."""
     with np.errstate(invalid="ignore"):
         big = p.crossing | ~(p.area <= BIG_PX)
     sil: dict[int, list[np.ndarray]] | None = target.silhouettes if silhouettes else None
@@ -67,62 +70,19 @@ def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouet
     small = np.flatnonzero(~big)
     # row spans of every patch in front of the near plane: the large ones first, in drawing order
     front = order[~p.crossing[order]]
-    sp = spans(p, np.concatenate([front, small]))
+    rp, v, lo, hi = span_bounds(p, np.concatenate([front, small]))
+    first, last = pixel_spans(p, rp, lo, hi)
     nbig = int((p.y1[front] - p.y0[front]).sum())
-    _big_patches(target, p, atlas, order, front, sp[2][:nbig], sp[3][:nbig], sil)
+    _big_patches(target, p, atlas, order, front, first[:nbig], last[:nbig], sil)
     if len(small):
-        frags = _small_patches(target.inv_depth, p, *(a[nbig:] for a in sp), sil)
+        frags = _small_patches(target.inv_depth, p, rp[nbig:], v[nbig:], first[nbig:], last[nbig:], sil)
         if frags is not None:
             _shade(target, p, atlas, *frags)
+    if antialias:
+        smooth_edges(target, p, rp, v, lo, hi)
     # Z = 1 / c wherever a patch won the z-test
     if target.depth is not None:
         np.divide(np.float32(1.0), target.inv_depth, out=target.depth, where=target.inv_depth != target.base_inv_depth)
-
-
-def spans(p: PreparedPatches, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Every box row of the patches ``idx`` (not crossing the near plane), in order: patch, row v, and the
-    first and last inside column lo, hi (lo > hi when the row has none), clipped to the box."""
-    h = p.y1[idx] - p.y0[idx]
-    rp = np.repeat(idx, h)
-    v = (np.arange(len(rp)) - np.repeat(np.cumsum(h) - h, h) + np.repeat(p.y0[idx], h)).astype(np.float64)
-    lo = np.empty(len(rp))
-    hi = np.empty(len(rp))
-    ell = p.ellipse[rp]
-    q, e = np.flatnonzero(~ell), np.flatnonzero(ell)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        if len(q):
-            # quad: the half-planes c ± a' >= 0, c ± b' >= 0 are alpha u + delta >= 0 on row v; each bounds u
-            half = np.concatenate([p.mc + p.ma, p.mc - p.ma, p.mc + p.mb, p.mc - p.mb], axis=1)  # (P, 12)
-            m = np.take(half, rp[q], axis=0)
-            vq = v[q]
-            lq = np.full(len(q), -np.inf)
-            hq = np.full(len(q), np.inf)
-            for k in range(0, 12, 3):
-                alpha, delta = m[:, k], m[:, k + 1] * vq + m[:, k + 2]
-                x = -delta / alpha
-                lq = np.maximum(lq, np.where(alpha > 0, x, -np.inf))
-                # alpha = 0: the whole row is inside (delta >= 0) or outside
-                hq = np.minimum(hq, np.where(alpha < 0, x, np.where((alpha == 0) & (delta < 0), -np.inf, np.inf)))
-            lo[q], hi[q] = lq, hq
-        if len(e):
-            # ellipse: (A1 u + A0)^2 + (B1 u + B0)^2 - (C1 u + C0)^2 <= 0, i.e. q2 u^2 + q1 u + q0 <= 0
-            m = np.take(np.stack([p.ma, p.mb, p.mc], axis=1), rp[e], axis=0)  # (n, 3, 3)
-            g = m[:, :, 0]
-            f = m[:, :, 1] * v[e, None] + m[:, :, 2]
-            sign = np.array([1.0, 1.0, -1.0])
-            q2 = (g * g) @ sign
-            q1 = 2 * (g * f) @ sign
-            q0 = (f * f) @ sign
-            disc = q1 * q1 - 4 * q2 * q0
-            root = np.sqrt(np.maximum(disc, 0))
-            none = (disc < 0) | ~(q2 > 0)
-            lo[e] = np.where(none, np.inf, (-q1 - root) / (2 * q2))
-            hi[e] = np.where(none, -np.inf, (-q1 + root) / (2 * q2))
-    # pixel centres k with lo <= k <= hi, inside the box
-    x0, x1 = p.x0[rp], p.x1[rp]
-    lo = np.clip(np.ceil(lo), x0, x1).astype(np.int64)
-    hi = np.clip(np.floor(hi), x0 - 1, x1 - 1).astype(np.int64)
-    return rp, v.astype(np.int64), lo, hi
 
 
 _GIDX: dict[tuple, np.ndarray] = {}

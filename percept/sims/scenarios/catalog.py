@@ -110,8 +110,9 @@ def build_lead_brake(env, rng) -> Road:
     road = _new_road(env, straight_road(3, 2000.0))
     env.road = road
     env.make_ego(("0", "1", 1), 60.0, 25.0)
-    _idm(road, ("0", "1", 1), 60.0 + float(rng.uniform(40.0, 50.0)), 25.0, cls=ScriptedVehicle,
-         brake_at_s=float(rng.uniform(4.0, 6.0)), brake_mps2=-6.0)
+    # the ego (set to 25 m/s) follows a lead at 24 m/s, from bumper gaps of 40-50 m, until the lead brakes
+    _idm(road, ("0", "1", 1), 60.0 + float(rng.uniform(45.0, 55.0)), 24.0, cls=ScriptedVehicle,
+         brake_at_s=float(rng.uniform(8.0, 10.0)), brake_mps2=-6.0)
     _traffic(road, rng, [0, 2], 0.0, 500.0, 8, (24.0, 28.0), [])
     return road
 
@@ -196,8 +197,9 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
              build_highway, 25.0),
     Scenario("curves", "3-lane winding road: arcs of radii 150-600 m both ways, joined by clothoids, traffic", 60.0,
              build_curves, 20.0),
-    Scenario("lead-brake", "the lead brakes at -6 m/s^2 from 25 m/s to a stop", 20.0, build_lead_brake, 25.0),
-    Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead", 20.0, build_cut_in, 25.0),
+    Scenario("lead-brake", "following a lead at 24 m/s that brakes at -6 m/s^2 to a stop", 25.0, build_lead_brake, 25.0),
+    Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead; the ego falls back to its time gap", 40.0,
+             build_cut_in, 25.0),
     Scenario("crossing", "pedestrians cross the ego lane at 5 km/h from both sides, others stay on the verge; "
              "ego at 20-60 km/h", 70.0, build_crossing, 12.0),
     Scenario("loop", "a 3.7 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,

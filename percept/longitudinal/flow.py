@@ -1,0 +1,112 @@
+"""Time to contact from the expansion of the obstacle's image: KLT features on it, tracked over a few frames.
+
+An object at range Z images at a size proportional to 1/Z, so between two frames the distances between its
+features scale by s = Z0 / Z1; the time to contact is tau = dt / (s - 1) and the range rate is
+dZ/dt = -Z1 (s - 1) / dt (Lee 1976; Camus 1995; Hartley & Zisserman for the pinhole model). The scale is the
+median of the ratios of pairwise feature distances, which ignores features that slide across the object's
+outline; tracks are checked forwards and backwards (Kalal et al. 2010).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+
+@dataclass(frozen=True)
+class FlowConfig:
+    """frames_back: the scale is measured against the frame this many frames earlier (a longer baseline in time
+    resolves slower expansion) ; max_features, quality, min_distance_px: goodFeaturesToTrack's; win_px, levels:
+    the pyramidal KLT window and pyramid levels; fb_max_px: largest forward-backward error kept [px]; min_pairs:
+    fewest feature pairs for a measurement; min_pair_px: shortest pair distance used [px]."""
+
+    frames_back: int = 4
+    max_features: int = 80
+    quality: float = 0.002
+    min_distance_px: int = 2
+    win_px: int = 11
+    levels: int = 2
+    fb_max_px: float = 0.3
+    min_pairs: int = 6
+    min_pair_px: float = 6.0
+
+
+@dataclass(frozen=True)
+class Expansion:
+    """scale: s = Z0 / Z1, the image scale change over dt_s [s]; sigma: its standard error; features: tracks kept.
+    ``range_rate_mps(Z)`` and ``ttc_s`` follow from it."""
+
+    scale: float
+    sigma: float
+    dt_s: float
+    features: int
+
+    def range_rate_mps(self, range_m: float) -> float:
+        # dZ/dt = -Z1 (s - 1) / dt
+        return -range_m * (self.scale - 1.0) / self.dt_s
+
+    @property
+    def ttc_s(self) -> float | None:
+        # tau = dt / (s - 1), only while the object expands
+        return self.dt_s / (self.scale - 1.0) if self.scale > 1.0 else None
+
+
+class ExpansionTracker:
+    """Keeps the last few left images (grey) with the obstacle's box; ``measure`` compares the newest with the
+    oldest kept."""
+
+    def __init__(self, cfg: FlowConfig = FlowConfig()):
+        self.cfg = cfg
+        self.history: deque = deque(maxlen=cfg.frames_back + 1)
+
+    def reset(self) -> None:
+        self.history.clear()
+
+    def measure(self, gray: np.ndarray, box: tuple[int, int, int, int], t_s: float) -> Expansion | None:
+        """Add this frame (grey image, the obstacle's box (u0, v0, u1, v1), its time [s]) and return the expansion
+        since the oldest kept frame, or None (first frame, too few features, a box that moved off the image)."""
+        self.history.append((gray, box, t_s))
+        if len(self.history) < 2:
+            return None
+        g0, b0, t0 = self.history[0]
+        return _expansion(g0, gray, b0, t_s - t0, self.cfg)
+
+
+def _expansion(g0: np.ndarray, g1: np.ndarray, box: tuple[int, int, int, int], dt: float,
+               cfg: FlowConfig) -> Expansion | None:
+    u0, v0, u1, v1 = box
+    if dt <= 0 or u1 - u0 < 8 or v1 - v0 < 8:
+        return None
+    # features and tracks on a crop about the box (room for the motion), not the whole frame
+    m = max(cfg.win_px * 2 ** cfg.levels, (u1 - u0) // 2)
+    h, w = g0.shape
+    c0, r0, c1, r1 = max(u0 - m, 0), max(v0 - m, 0), min(u1 + m, w), min(v1 + m, h)
+    g0, g1 = g0[r0:r1, c0:c1], g1[r0:r1, c0:c1]
+    mask = np.zeros(g0.shape, np.uint8)
+    mask[v0 - r0:v1 - r0, u0 - c0:u1 - c0] = 255
+    p0 = cv2.goodFeaturesToTrack(g0, cfg.max_features, cfg.quality, cfg.min_distance_px, mask=mask)
+    if p0 is None or len(p0) < 5:
+        return None
+    lk = dict(winSize=(cfg.win_px, cfg.win_px), maxLevel=cfg.levels,
+              criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.01))
+    p1, st1, _ = cv2.calcOpticalFlowPyrLK(g0, g1, p0, None, **lk)
+    pb, st2, _ = cv2.calcOpticalFlowPyrLK(g1, g0, p1, None, **lk)
+    # forward-backward consistency: the track back from frame 1 must land where it started
+    ok = (st1[:, 0] == 1) & (st2[:, 0] == 1) & (np.linalg.norm((pb - p0)[:, 0], axis=1) < cfg.fb_max_px)
+    a, b = p0[ok, 0].astype(np.float64), p1[ok, 0].astype(np.float64)
+    if len(a) < 5:
+        return None
+    i, j = np.triu_indices(len(a), 1)
+    d0 = np.linalg.norm(a[i] - a[j], axis=1)
+    far = d0 >= cfg.min_pair_px
+    if far.sum() < cfg.min_pairs:
+        return None
+    ratio = np.linalg.norm(b[i] - b[j], axis=1)[far] / d0[far]
+    s = float(np.median(ratio))
+    # robust spread (MAD) over about as many independent pairs as features
+    mad = 1.4826 * float(np.median(np.abs(ratio - s)))
+    sigma = max(mad, 1e-4) * np.sqrt(np.pi / 2) / np.sqrt(len(a))
+    return Expansion(s, sigma, dt, int(len(a)))
