@@ -18,6 +18,7 @@ import numpy as np
 from percept.sensors import EgoPath, Side, StereoRig
 
 from .dense import check_num_disparities
+from .ground import GroundConfig, GroundPlane
 
 
 @dataclass(frozen=True)
@@ -29,7 +30,8 @@ class ObstacleConfig:
     min_height_m, max_height_m: a pixel between these heights above the road stands up [m]; min_area_m2: smallest
     frontal area that counts as an obstacle [m²]; bin_rel: relative width of a range bin; grounded_m: a group's
     lowest pixels must be below this height (obstacles stand on the road; a patch of sky or glare matched by
-    chance floats) [m]; texture_threshold: StereoBM's (flat regions are not matched)."""
+    chance floats) [m]; texture_threshold: StereoBM's (flat regions are not matched); ground: the online road-plane
+    fit (heights are measured from it)."""
 
     near_m: float = 15.0
     far_scale: float = 0.5
@@ -45,6 +47,7 @@ class ObstacleConfig:
     bin_rel: float = 0.04
     grounded_m: float = 1.0
     texture_threshold: int = 12
+    ground: GroundConfig = GroundConfig()
 
     def __post_init__(self) -> None:
         for s in (self.far_scale, self.near_scale):
@@ -102,7 +105,8 @@ class _Band:
 
 
 class ObstacleFinder:
-    """Coarse disparity in two bands below the horizon, lifted to the vehicle frame, filtered by the ego path."""
+    """Coarse disparity in two bands below the horizon, lifted to the vehicle frame, heights measured from the road
+    plane refined online (``ground``), filtered by the ego path. ``reset()`` forgets the plane."""
 
     def __init__(self, rig: StereoRig, cfg: ObstacleConfig = ObstacleConfig()):
         self.rig, self.cfg = rig, cfg
@@ -116,6 +120,10 @@ class ObstacleFinder:
         self.near = _Band(rig, cfg.near_scale, split - bn / cfg.near_scale, cam.height, nn, bn, t)
         self.c = rig.camera_position(Side.LEFT)
         self.x_far = np.linspace(cfg.near_m, cfg.max_range_m, 24) + rig.mount_x_m
+        self.ground = GroundPlane(cfg.ground)
+
+    def reset(self) -> None:
+        self.ground.reset()
 
     def _far_columns(self, path: EgoPath) -> tuple[float, float]:
         """Image columns the corridor spans beyond near_m (full resolution)."""
@@ -138,6 +146,8 @@ class ObstacleFinder:
         keep = (z > cfg.min_range_m) & (z < cfg.max_range_m)
         u, v, z, area = u[keep], v[keep], z[keep], area[keep]
         pv = rays[keep] * z[:, None] + self.c
+        self.ground.update(pv, u)
+        pv[:, 2] = self.ground.height(pv)
         lateral = np.abs(pv[:, 1] - path.centre_y(pv[:, 0]))
         stand = (pv[:, 2] > cfg.min_height_m) & (pv[:, 2] < cfg.max_height_m) & (lateral < cfg.half_width_m)
         debug = {"matched": int(len(z)), "standing": int(stand.sum())}

@@ -35,16 +35,17 @@ _RATE = np.array([[0.0, 1.0, 0.0]])
 class LeadConfig:
     """face_m: heights above the road of the band whose disparity is refined (a vehicle's body faces the ego
     there) [m]; sigma_d_px: floor on the disparity noise [px] (the refinement's own standard error is often far
-    smaller; the floor covers what it does not model: slanted faces, pixels at the outline); jerk_sigma_mps3: white jerk noise of the range (the filter is constant-acceleration, so that a lead braking hard is
-    followed without lag) [m/s³]; gate_sigma: innovations beyond this
-    many sigma are outliers; confirm: hits before a track is reported; hold_s: how long a track is predicted
-    without measurements [s]."""
+    smaller; the floor covers what it does not model: slanted faces, pixels at the outline); column_fill: a column
+    of the band belongs to the obstacle when this fraction of it matches the obstacle's disparity; huber: the
+    refinement's Huber threshold [grey levels]; jerk_sigma_mps3: white jerk noise of the range (the filter is
+    constant-acceleration, so that a lead braking hard is followed without lag) [m/s³]; gate_sigma: innovations
+    beyond this many sigma are outliers; confirm: hits before a track is reported; hold_s: how long a track is
+    predicted without measurements [s]; obstacles, contact, flow: the cues' own settings."""
 
     face_m: tuple[float, float] = (0.4, 0.9)
     sigma_d_px: float = 0.05
     column_fill: float = 0.3
     huber: float = 6.0
-    edge_px: int = 0
     jerk_sigma_mps3: float = 8.0
     gate_sigma: float = 5.0
     confirm: int = 3
@@ -85,6 +86,11 @@ class LongitudinalSlot:
         self.reset()
 
     def reset(self) -> None:
+        """A new run: no track, and the road plane back to the rig's."""
+        self.finder.reset()
+        self._drop_track()
+
+    def _drop_track(self) -> None:
         self.kf: KalmanFilter | None = None
         self.hits = self.misses = self.outliers = 0
         self.box: tuple | None = None
@@ -129,15 +135,13 @@ class LongitudinalSlot:
         m = surface_mask(L, R, box, d0)
         if m is None or m.sum() < 12:
             return None
-        # the obstacle's own columns: where most of the band matches (stray matches on the road beside it, e.g. a
-        # slanted lane line, would pull the estimate); ``edge_px`` more are dropped at each side, where the pixels
-        # mix the obstacle with a background that differs between the two images
+        # the obstacle's own columns: where much of the band matches (stray matches on the road beside it, e.g. on
+        # a slanted lane line, would pull the estimate)
         cols = np.flatnonzero(m.mean(axis=0) >= self.cfg.column_fill)
-        k = self.cfg.edge_px
-        if len(cols) == 0 or cols[-1] - cols[0] - 2 * k < 2:
+        if len(cols) == 0 or cols[-1] - cols[0] < 2:
             return None
-        m[:, :cols[0] + k] = False
-        m[:, cols[-1] + 1 - k:] = False
+        m[:, :cols[0]] = False
+        m[:, cols[-1] + 1:] = False
         if m.sum() < 12:
             return None
         return refine_disparity(L, R, box, m, d0, huber=self.cfg.huber)
@@ -163,7 +167,7 @@ class LongitudinalSlot:
     def _miss(self) -> None:
         self.misses += 1
         if self.kf is not None and self.misses * self.dt > self.cfg.hold_s:
-            self.reset()
+            self._drop_track()
 
     def _gated_update(self, value: float, sigma: float, H: np.ndarray) -> bool:
         """One measurement ``value`` = H x with noise ``sigma``, unless it is beyond the gate; True if used."""

@@ -86,15 +86,16 @@ class RenderTarget:
 
 def rasterize(target: RenderTarget, batch: PatchBatch, cam: PinholeCamera, cam_from_world: Transform,
               textures: TextureAtlas | list[np.ndarray], sun_dir_world: np.ndarray, ambient: float = 0.55,
-              silhouettes: bool = True, lod_px: float = LOD_PX) -> None:
+              silhouettes: bool = True, lod_px: float = LOD_PX, antialias: bool = True) -> None:
     """Draw ``batch`` into ``target`` with a z-test; camera pose ``cam_from_world``.
 
     silhouettes: record each object's unoccluded pixels in ``target.silhouettes``; lod_px: scenery
-    (obj_id 0) narrower than this on screen is skipped."""
+    (obj_id 0) narrower than this on screen is skipped; antialias: blend the pixels vertical edges cross by
+    their coverage (``spans.smooth_edges``)."""
     atlas = textures if isinstance(textures, TextureAtlas) else TextureAtlas(list(textures))
     prep = prepare(batch, cam, [cam_from_world], atlas, sun_dir_world, ambient, lod_px)[0]
     if prep is not None:
-        rasterize_prepared(target, prep, atlas, silhouettes)
+        rasterize_prepared(target, prep, atlas, silhouettes, antialias)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
