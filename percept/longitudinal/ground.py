@@ -26,7 +26,8 @@ class GroundConfig:
     bins [m]; min_points: fewest points
     for a bin's median; smoothing: weight of each new fit (exponential smoothing); ref_range_m, deadband_m: the
     correction is applied while it moves a height at ref_range_m by more than deadband_m [m] (0.2 m at 30 m: a
-    0.4 degree pitch; on the simulator's exact rig the fit stayed within 0.11 m over 20 s runs by day, night and rain)."""
+    0.4 degree pitch; on the simulator's exact rig the fit stayed within 0.11 m over 20 s runs by day, night and
+    rain)."""
 
     band_m: float = 0.5
     cell_px: int = 16
@@ -61,7 +62,8 @@ class GroundPlane:
         cfg = self.cfg
         x, y, z = points[:, 0], points[:, 1], points[:, 2]
         h = z - self._plane(x)
-        near = (x > cfg.min_range_m) & (x < cfg.max_range_m) & (np.abs(y) < cfg.half_width_m) & (np.abs(h) < cfg.band_m)
+        near = ((x > cfg.min_range_m) & (x < cfg.max_range_m) & (np.abs(y) < cfg.half_width_m)
+                & (np.abs(h) < cfg.band_m))
         # not the low parts of what stands on the road (bumpers, tyres): no point in a cell (image columns x range)
         # that also holds a point standing above the band
         cell_u, cell_x = (u_px // cfg.cell_px).astype(int), np.floor(x / cfg.cell_m).astype(int)

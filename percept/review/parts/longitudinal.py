@@ -59,6 +59,7 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, lead, debug, truth) -> None:
 
 
 STEREO_RGB, CONTACT_RGB, FLOW_RGB = (90, 170, 255), (250, 190, 60), (120, 220, 120)
-PART = Part(draw, plots=(Plot("range_m", "range [m]", TRUTH_VS_ESTIMATE + (("stereo", STEREO_RGB), ("contact", CONTACT_RGB))),
+CUES = (("stereo", STEREO_RGB), ("contact", CONTACT_RGB))
+PART = Part(draw, plots=(Plot("range_m", "range [m]", TRUTH_VS_ESTIMATE + CUES),
                          Plot("range_rate_mps", "range rate [m/s]", TRUTH_VS_ESTIMATE + (("flow", FLOW_RGB),)),
                          Plot("ttc_s", f"TTC [s] (to {TTC_SHOWN_S:.0f})")))
