@@ -16,43 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def _boxes(boxes: np.ndarray, what: str) -> np.ndarray:
-    """Validated (K, 4) float boxes; an empty input is (0, 4)."""
-    b = np.asarray(boxes, dtype=np.float64)
-    if b.size == 0:
-        return b.reshape(0, 4)
-    if b.ndim != 2 or b.shape[1] != 4:
-        raise ValueError(f"{what}: expected boxes of shape (K, 4) as (u0, v0, u1, v1), got {b.shape}")
-    if not np.all(np.isfinite(b)):
-        raise ValueError(f"{what}: box coordinates must be finite")
-    if np.any(b[:, 2] < b[:, 0]) or np.any(b[:, 3] < b[:, 1]):
-        raise ValueError(f"{what}: a box has u1 < u0 or v1 < v0; boxes are (u0, v0, u1, v1)")
-    return b
-
-
-def iou_matrix(a_boxes: np.ndarray, b_boxes: np.ndarray) -> np.ndarray:
-    """Intersection over union of every box of A (N, 4) with every box of B (M, 4) -> (N, M).
-
-    Two boxes of zero area have IoU 0.
-    """
-    a = _boxes(a_boxes, "iou_matrix A")[:, None, :]
-    b = _boxes(b_boxes, "iou_matrix B")[None, :, :]
-    # |A ∩ B| = max(0, min(u1) - max(u0)) * max(0, min(v1) - max(v0))
-    inter_w = np.clip(np.minimum(a[..., 2], b[..., 2]) - np.maximum(a[..., 0], b[..., 0]), 0.0, None)
-    inter_h = np.clip(np.minimum(a[..., 3], b[..., 3]) - np.maximum(a[..., 1], b[..., 1]), 0.0, None)
-    inter = inter_w * inter_h
-    area_a = (a[..., 2] - a[..., 0]) * (a[..., 3] - a[..., 1])
-    area_b = (b[..., 2] - b[..., 0]) * (b[..., 3] - b[..., 1])
-    # |A ∪ B| = |A| + |B| - |A ∩ B|
-    union = area_a + area_b - inter
-    # IoU = |A ∩ B| / |A ∪ B|
-    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0.0)
-
-
-def iou(a: np.ndarray, b: np.ndarray) -> float:
-    """Intersection over union of two boxes (u0, v0, u1, v1) [px]."""
-    return float(iou_matrix(np.reshape(a, (1, -1)), np.reshape(b, (1, -1)))[0, 0])
+from percept.sensors.boxes import check_boxes as _boxes
+from percept.sensors.boxes import iou, iou_matrix
 
 
 def eligible(box_px: np.ndarray, visible: float, min_height_px: float = 24.0, min_visible: float = 0.5) -> bool:

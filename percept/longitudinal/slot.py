@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from percept.sensors import EgoPath, Frame, Lead, ObjectKind, StereoRig
+from percept.sensors import EgoPath, Frame, Lead, ObjectKind, StereoRig, iou
 
 from .contact import Contact, ContactConfig, ContactRange
 from .flow import Expansion, ExpansionTracker, FlowConfig
@@ -39,7 +39,9 @@ class LeadConfig:
     of the band belongs to the obstacle when this fraction of it matches the obstacle's disparity; huber: the
     refinement's Huber threshold [grey levels]; jerk_sigma_mps3: white jerk noise of the range (the filter is
     constant-acceleration, so that a lead braking hard is followed without lag) [m/s³]; gate_sigma: innovations
-    beyond this many sigma are outliers; confirm: hits before a track is reported; hold_s: how long a track is
+    beyond this many sigma are outliers; two in a row are a new lead when its box overlaps the last one by less than
+    same_object_iou (IoU), else the same one manoeuvring: the filter's rate and acceleration variances grow by
+    manoeuvre_rate_mps² and manoeuvre_accel_mps2² and it takes the measurement; confirm: hits before a track is reported; hold_s: how long a track is
     predicted without measurements [s]; obstacles, contact, flow: the cues' own settings."""
 
     face_m: tuple[float, float] = (0.4, 0.9)
@@ -48,6 +50,9 @@ class LeadConfig:
     huber: float = 6.0
     jerk_sigma_mps3: float = 8.0
     gate_sigma: float = 5.0
+    same_object_iou: float = 0.3
+    manoeuvre_rate_mps: float = 5.0
+    manoeuvre_accel_mps2: float = 6.0
     confirm: int = 3
     hold_s: float = 0.6
     obstacles: ObstacleConfig = ObstacleConfig()
@@ -184,7 +189,7 @@ class LongitudinalSlot:
         sd = max(ref.sigma_px if ref is not None else 1.0, self.cfg.sigma_d_px)
         # stereo range noise: sigma_Z = Z^2 sigma_d / (f b)
         sigma = z * z * sd / self.fb
-        self.box = ob.box_px
+        previous, self.box = self.box, ob.box_px
         if self.kf is None:
             self._new_track(z, sigma)
             return ("stereo",)
@@ -194,9 +199,14 @@ class LongitudinalSlot:
             self.outliers = 0
         else:
             self.outliers += 1
-            if self.outliers >= 2:  # the lead changed: follow the new one
-                self._new_track(z, sigma)
+            if self.outliers >= 2 and iou(previous, ob.box_px) < self.cfg.same_object_iou:
+                self._new_track(z, sigma)  # the lead changed (a cut-in, the lead leaving): follow the new one
                 return ("stereo",)
+            if self.outliers >= 2:
+                # the same object, manoeuvring (braking hard): open the filter up and take the measurement
+                self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
+                self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
+                used, self.outliers = ("stereo",), 0
         if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, _RANGE):
             used += ("contact",)
         if used:

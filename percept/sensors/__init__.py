@@ -1,5 +1,6 @@
 """Shared vocabulary: cameras, the stereo rig, poses and sensor frames. Pure numpy/OpenCV."""
 
+from .boxes import check_boxes, iou, iou_matrix
 from .camera import PinholeCamera
 from .chessboard import CameraCalibration, calibrate_chessboards, chessboard_images, parse_pattern
 from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, VideoReader, list_footage,
@@ -13,4 +14,5 @@ __all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "
            "IMAGE_SUFFIXES", "VIDEO_SUFFIXES", "FootageKind", "Undistorter", "VideoReader", "list_footage",
            "list_images", "open_video", "read_image",
            "CameraCalibration", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform",
-           "calibrate_chessboards", "chessboard_images", "parse_pattern", "rot_z", "wrap_angle"]
+           "calibrate_chessboards", "check_boxes", "chessboard_images", "iou", "iou_matrix", "parse_pattern", "rot_z",
+           "wrap_angle"]

@@ -52,39 +52,62 @@ class ConditionEffects:
         H, W = cam.height, cam.width
         hz = rig.horizon_row
         v, u = np.mgrid[0:H, 0:W].astype(np.float32)
-        # headlight beam: ground points ahead within +-15 deg, brightest near, fading with distance
-        with np.errstate(divide="ignore"):
-            dist = np.where(v > hz + 0.5, rig.mount_height_m * cam.fy / np.maximum(v - hz, 1e-3), np.inf)
-        dist = np.minimum(dist, 1e4)
-        lateral = np.abs(u - cam.cx) / cam.fx * dist
-        beam = np.exp(-(np.maximum(lateral - 1.5, 0) / (0.3 * dist + 1.0)) ** 2) / (1.0 + (dist / 35.0) ** 2)
-        beam = np.where(dist < 1e4, beam, 0.0)
-        # objects standing in the beam are lit too: a blurred copy spreads the beam up from the ground rows
-        lit = cv2.GaussianBlur(beam.astype(np.float32), (0, 0), 25)
-        self.night_gain = (0.08 + 1.1 * np.maximum(beam, 0.7 * lit)).astype(np.float32)[..., None]
+        # per camera: column slope (u - cx) / fx and the camera's lateral offset (left +b/2, right -b/2) [m]
+        self.slope = ((np.arange(W, dtype=np.float32) - cam.cx) / cam.fx)[None, :]
+        self.cam_y = (rig.baseline_m / 2, -rig.baseline_m / 2)
+        # the road's inverse depth per pixel, for images given without a depth map: 1/Z = (v - hz) / (f h)
+        self.ground_inv = np.maximum(v - hz, 0.0) / np.float32(rig.mount_height_m * cam.fy)
         # glare: the sun low ahead, a little left of centre, above the horizon
         self.sun_uv = (cam.cx - 0.25 * cam.cx, max(hz - 0.18 * H, 10))
         r = np.hypot(u - self.sun_uv[0], v - self.sun_uv[1])
         self.glare = (255 * (np.exp(-r / 40.0) + 0.35 * np.exp(-r / 220.0))).astype(np.float32)[..., None]
         self.H, self.W = H, W
 
-    def apply(self, img: np.ndarray, seed: int, frame: int, camera: int) -> np.ndarray:
+    def night_gain(self, inv_depth: np.ndarray | None, camera: int) -> np.ndarray:
+        """(H, W, 1) light reaching each pixel's surface at night: ambient plus the headlight beam, which lights
+        points ahead within about 1.5 m of the ego's centreline, widening and fading with distance. Computed from
+        the camera's own inverse depth map (the road plane's without one), so that the beam lies on the world and
+        both cameras see it at the surface's disparity."""
+        inv = self.ground_inv if inv_depth is None else inv_depth
+        with np.errstate(divide="ignore"):
+            z = np.where(inv > 0, 1.0 / np.maximum(inv, 1e-6), np.inf).astype(np.float32)
+        z = np.minimum(z, 1e4)
+        # lateral distance from the centreline: y = y_cam - (u - cx) Z / fx
+        lateral = np.abs(self.cam_y[camera] - self.slope * z)
+        spread = np.maximum(lateral - 1.5, 0) / (0.3 * z + 1.0)
+        beam = np.exp(-spread * spread) / (1.0 + (z / 35.0) ** 2)
+        beam[z >= 1e4] = 0.0
+        return (0.08 + 1.1 * beam)[..., None]
+
+    def _night(self, f: np.ndarray, gain: np.ndarray, emission: np.ndarray) -> np.ndarray:
+        """Lamps keep their light and glow; everything else is lit by ``gain``. Linear in each pixel's lamp
+        fraction, so that a lamp's anti-aliased edge moves smoothly (a threshold would snap it to whole pixels)."""
+        e = emission[..., None]
+        lamps = f * e
+        out = f * gain * (1.0 - e) + lamps
+        rows, cols = np.flatnonzero(emission.any(axis=1)), np.flatnonzero(emission.any(axis=0))
+        if len(rows):
+            # the glow is local: blur only the lamps' bounding box, padded by the kernel radius (4 sigma)
+            y0, y1 = max(rows[0] - 13, 0), min(rows[-1] + 14, self.H)
+            x0, x1 = max(cols[0] - 13, 0), min(cols[-1] + 14, self.W)
+            out[y0:y1, x0:x1] += cv2.GaussianBlur(lamps[y0:y1, x0:x1], (0, 0), 3) * 1.5
+        return out
+
+    def apply(self, img: np.ndarray, seed: int, frame: int, camera: int, inv_depth: np.ndarray | None = None,
+              emission: np.ndarray | None = None) -> np.ndarray:
+        """The condition applied to one camera's image (camera 0 left, 1 right). At night, ``inv_depth`` (that
+        camera's (H, W) 1/Z map [1/m], 0 for sky) places the headlight beam on the world, and ``emission`` (the
+        fraction of each pixel that is a lamp) says what glows; without them the beam lies on the road plane and
+        red-and-bright pixels glow."""
         c = self.condition
         if c in (Condition.CLEAR, Condition.DROPOUT):
             return img
         rng = frame_rng(seed, frame, camera)
         f = img.astype(np.float32)
         if c is Condition.NIGHT:
-            lights = (img[..., 2] > 180) & (img[..., 1] < 90)  # tail lights glow; the rest is lit by the beam
-            out = f * self.night_gain
-            if lights.any():
-                # the glow is local: blur only the lights' bounding box, padded by the kernel radius (4 sigma)
-                rows, cols = np.flatnonzero(lights.any(axis=1)), np.flatnonzero(lights.any(axis=0))
-                y0, y1 = max(rows[0] - 13, 0), min(rows[-1] + 14, self.H)
-                x0, x1 = max(cols[0] - 13, 0), min(cols[-1] + 14, self.W)
-                lit, src = lights[y0:y1, x0:x1, None], f[y0:y1, x0:x1]
-                glow = cv2.GaussianBlur(np.where(lit, src, 0), (0, 0), 3) * 1.5
-                out[y0:y1, x0:x1] = np.where(lit, src, out[y0:y1, x0:x1]) + glow
+            if emission is None:
+                emission = ((img[..., 2] > 180) & (img[..., 1] < 90)).astype(np.float32)
+            out = self._night(f, self.night_gain(inv_depth, camera), emission)
             out += 3.0 * rng.standard_normal(out.shape[:2], dtype=np.float32)[..., None]
         elif c is Condition.RAIN:
             haze = np.array([150, 150, 145], np.float32)

@@ -118,8 +118,9 @@ class SimWorld:
         dropped = is_dropped(self.cfg.condition, self.cfg.seed, self.frame_index)
         if render:
             img = self.renderer.render(scene)
-            left = self.effects.apply(img.left, self.cfg.seed, self.frame_index, 0)
-            right = self.effects.apply(img.right, self.cfg.seed, self.frame_index, 1)
+            left = self.effects.apply(img.left, self.cfg.seed, self.frame_index, 0, img.inv_depth[0], img.emission[0])
+            right = self.effects.apply(img.right, self.cfg.seed, self.frame_index, 1, img.inv_depth[1],
+                                       img.emission[1])
             depth, boxes, visible = img.depth_m, img.boxes_px, img.visible
         else:
             left = right = None

@@ -6,6 +6,7 @@ import pytest
 
 from percept.sims import Condition, SimWorld, WorldConfig
 from percept.sims.conditions import DROPOUT_RATE, ConditionEffects, is_dropped
+from percept.sims.world import scene_from_road
 
 
 @pytest.fixture(scope="module")
@@ -107,9 +108,42 @@ def test_dropout_drops_about_10_percent_of_frames_deterministically():
 
 def test_world_applies_the_condition_to_both_cameras(clear):
     rig, frame = clear
-    night, _ = SimWorld(WorldConfig("highway", 0, condition="night", autopilot=True)).observe()
-    assert np.array_equal(night.left, apply(rig, frame.left, Condition.NIGHT, camera=0))
-    assert np.array_equal(night.right, apply(rig, frame.right, Condition.NIGHT, camera=1))
+    w = SimWorld(WorldConfig("highway", 0, condition="night", autopilot=True))
+    night, _ = w.observe()
+    # the night effect reads each camera's inverse depth and lamp map from the renderer
+    img = w.renderer.render(scene_from_road(w.env.road, w.ego, w.ids))
+    effects = ConditionEffects(rig, Condition.NIGHT)
+    assert np.array_equal(night.left, effects.apply(frame.left, 0, 0, 0, img.inv_depth[0], img.emission[0]))
+    assert np.array_equal(night.right, effects.apply(frame.right, 0, 0, 1, img.inv_depth[1], img.emission[1]))
+
+
+def test_the_headlight_beam_lies_on_the_world_so_both_cameras_see_it_at_the_surface_s_disparity(clear):
+    rig, _ = clear
+    effects = ConditionEffects(rig, Condition.NIGHT)
+    cam = rig.camera
+    for z in (8.0, 30.0):
+        wall = np.full((cam.height, cam.width), 1.0 / z, np.float32)
+        left, right = effects.night_gain(wall, 0)[..., 0], effects.night_gain(wall, 1)[..., 0]
+        # a point of the wall at left column u is at u - f b / Z in the right image: the same light there
+        d = cam.fx * rig.baseline_m / z
+        u = np.arange(100, 540)
+        np.testing.assert_allclose(np.interp(u - d, np.arange(cam.width), right[240]), left[240, u], atol=2e-3)
+    # the sky gets the ambient light only
+    assert np.allclose(effects.night_gain(np.zeros((cam.height, cam.width), np.float32), 0), 0.08)
+
+
+def test_a_lamp_keeps_its_light_in_proportion_to_the_pixel_it_covers(clear):
+    rig, _ = clear
+    effects = ConditionEffects(rig, Condition.NIGHT)
+    img = np.full((rig.camera.height, rig.camera.width, 3), 200, np.uint8)
+    sky = np.zeros(img.shape[:2], np.float32)
+    lamp = np.zeros(img.shape[:2], np.float32)
+    lamp[100, 100:103] = (1.0, 0.5, 0.25)
+    out = effects._night(img.astype(np.float32), effects.night_gain(sky, 0), lamp)
+    # lamp fraction e: 200 e + 200 * 0.08 (1 - e), plus the glow around it
+    base = 200 * 0.08
+    lit = out[100, 100:103, 0] - base
+    np.testing.assert_allclose(lit / lit[0], [1.0, 0.5, 0.25], atol=0.06)
 
 
 def test_world_dropout_frame_has_no_images_but_keeps_imu_and_wheel_speed():

@@ -38,7 +38,8 @@ class PreparedPatches:
     ma, mb, mc: (P, 3) affine rows (see module doc); ellipse, crossing (of the near plane): (P,) bool;
     zmin: (P,) nearest depth [m]; area: (P,) projected area [px] (NaN when crossing); obj_id: (P,);
     color: (P, 3) float32 shaded BGR; entry: (P,) atlas entry or -1; texsize: (P, 2) texels across the
-    patch along e1, e2 at that entry."""
+    patch along e1, e2 at that entry; emissive: (P,) bool, a lamp (its pixels are marked in the target's
+    emission map, for the night's glow)."""
 
     x0: np.ndarray
     x1: np.ndarray
@@ -55,6 +56,7 @@ class PreparedPatches:
     color: np.ndarray
     entry: np.ndarray
     texsize: np.ndarray
+    emissive: np.ndarray
 
 
 def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouettes: bool,
@@ -166,6 +168,8 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
         np.copyto(wr, c, where=vis)
         if ids is not None:
             np.copyto(ids[y0:y1, x0:x1], oid, where=vis)
+        if target.emission is not None:
+            np.copyto(target.emission[y0:y1, x0:x1], np.float32(p.emissive[i]), where=vis)
         if tmap is None:
             col = np.asarray(color, np.float32).astype(np.uint8).view(np.dtype("V3"))[0]
         else:
@@ -234,6 +238,8 @@ def _shade(target, p: PreparedPatches, atlas: TextureAtlas, pix, pi, t, ap, bp, 
     are ``ap``, ``bp``."""
     if target.ids is not None:
         target.ids.reshape(-1)[pix] = p.obj_id[pi]
+    if target.emission is not None:
+        target.emission.reshape(-1)[pix] = p.emissive[pi]
     albedo = np.ones(len(pix), np.float32)
     if len(t):
         # per textured patch: half the texels across (e1, e2), the atlas entry's interior x0, y0, w, h

@@ -43,13 +43,15 @@ class RenderTarget:
     (inf where nothing is) or None to skip; ids: (H, W) int32 object id per pixel (0 = road or scenery,
     -1 = sky) or None to skip; inv_depth: (H, W) float32 1/z, the z-buffer (None: derived from depth);
     base_inv_depth: what inv_depth held before any patch (None: a copy is taken), to find the pixels
-    patches were drawn on."""
+    patches were drawn on; emission: (H, W) float32, the fraction of each pixel a lamp covers (untextured,
+    unshaded patches: vehicles' lights), or None to skip."""
 
     image: np.ndarray
     depth: np.ndarray | None
     ids: np.ndarray | None
     inv_depth: np.ndarray | None = None
     base_inv_depth: np.ndarray | None = None
+    emission: np.ndarray | None = None
     silhouettes: dict[int, list[np.ndarray]] = field(default_factory=dict)
     """Per object id, flat pixel indices (row * W + col) its patches cover before the z-test: the
     silhouette without occluders (may repeat pixels)."""
@@ -238,4 +240,4 @@ def _finish(batch: PatchBatch, cam: PinholeCamera, v: dict, tiny: np.ndarray, le
         ma=2 * m0 - m2, mb=2 * m1 - m2, mc=m2,
         ellipse=batch.outline[pi] == 1, crossing=crossing, zmin=np.maximum(v["zmin"][sel], NEAR_M),
         area=v["area"][sel], obj_id=batch.obj_id[pi].astype(np.int32), color=colors[pi], entry=entry,
-        texsize=texsize)
+        texsize=texsize, emissive=~batch.shade[pi] & ~has)

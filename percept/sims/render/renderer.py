@@ -41,7 +41,9 @@ class StereoImages:
     """left, right: (H, W, 3) uint8 BGR; depth_m: (H, W) float32 left-camera z [m], inf for sky;
     ids: (H, W) int32 object id per left pixel (0 road/scenery, -1 sky);
     boxes_px: obj id -> (u0, v0, u1, v1) tight box of the object's unoccluded silhouette in the left image [px],
-    u1 and v1 exclusive; visible: obj id -> fraction 0..1 of that silhouette not hidden by nearer things."""
+    u1 and v1 exclusive; visible: obj id -> fraction 0..1 of that silhouette not hidden by nearer things;
+    inv_depth, emission: (left, right) (H, W) float32 maps of each camera: 1/z [1/m] (0 for sky) and the
+    fraction of each pixel that is a lamp."""
 
     left: np.ndarray
     right: np.ndarray
@@ -49,6 +51,8 @@ class StereoImages:
     ids: np.ndarray
     boxes_px: dict
     visible: dict
+    inv_depth: tuple[np.ndarray, np.ndarray] | None = None
+    emission: tuple[np.ndarray, np.ndarray] | None = None
 
 
 class StereoRenderer:
@@ -179,7 +183,7 @@ class StereoRenderer:
         layer = self.layers[side]
         img, depth = layer.paint(scene.ego, self.road, prepared_ground, depth=depth)
         target = RenderTarget(img, depth, layer.ground_ids() if ids else None, layer.ground_inv_depth.copy(),
-                              layer.ground_inv_depth)
+                              layer.ground_inv_depth, np.zeros(img.shape[:2], np.float32))
         if prepared is None:
             patches = self.scene_patches(scene) if patches is None else patches
             prepared = prepare(patches, self.rig.camera, [self._cam_from_world(scene, side)], self.atlas, SUN_DIR)[0]
@@ -201,4 +205,5 @@ class StereoRenderer:
                 continue
             boxes[oid] = sil[0]
             visible[oid] = min(1.0, sil[2] / sil[1])
-        return StereoImages(left.image, right.image, left.depth, left.ids, boxes, visible)
+        return StereoImages(left.image, right.image, left.depth, left.ids, boxes, visible,
+                            (left.inv_depth, right.inv_depth), (left.emission, right.emission))

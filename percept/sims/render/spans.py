@@ -69,7 +69,8 @@ def pixel_spans(p, rp: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.n
 
 
 def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> None:
-    """Blend the pixel each span's left and right edge crosses, by its coverage, in ``target.image``.
+    """Blend the pixel each span's left and right edge crosses, by its coverage, in ``target.image`` (and its
+    emission map).
 
     Left edge at lo, first inside centre j = ceil(lo), f = j - lo in [0, 1): pixel j covers [j - 1/2, j + 1/2].
     When f >= 1/2 pixel j is wholly inside and the outside neighbour n = j - 1 is covered by f - 1/2; when
@@ -106,4 +107,8 @@ def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: n
     tv, tu, sv, su = t // W, t % W, s // W, s % W
     # colour = (1 - a) * own + a * other, from the unblended image
     mixed = (1.0 - a) * img[tv, tu] + a * img[sv, su]
+    if target.emission is not None:
+        e = target.emission
+        blend = (1.0 - a[:, 0]) * e[tv, tu] + a[:, 0] * e[sv, su]
+        e[tv, tu] = blend
     img[tv, tu] = np.rint(mixed).astype(np.uint8)
