@@ -80,7 +80,7 @@ def privileged(tmp_path_factory):
 @pytest.fixture(scope="module")
 def vision(tmp_path_factory):
     path = tmp_path_factory.mktemp("vision") / "run.rrd"
-    return path, record(path, {"lateral": "vision"})
+    return path, record(path, {"lateral": "vision", "longitudinal": "vision"}, duration_s=2.0)
 
 
 def images(cols: dict) -> int:
@@ -110,6 +110,15 @@ def test_the_vision_lateral_slot_draws_its_evidence(vision):
         assert entity in cols, entity
     # drawings on the image are stored with the image, not every frame
     assert cols["/world/ego/camera/left/lateral/boundaries"]["LineStrips2D:strips"] <= images(cols)
+
+
+def test_the_vision_longitudinal_slot_records_each_cue_beside_the_fused_estimate(vision):
+    cols = columns_by_entity(vision[0])
+    for entity in TASK_ENTITIES["longitudinal"] + ["/longitudinal/range_m/stereo", "/longitudinal/range_m/contact",
+                                                    "/longitudinal/range_rate_mps/flow",
+                                                    "/world/ego/camera/left/longitudinal/lead"]:
+        assert entity in cols, entity
+    assert cols["/longitudinal/range_m/stereo"]["Scalars:scalars"] >= 20
 
 
 def test_the_camera_rate_sets_how_many_images_are_stored(privileged, tmp_path):
