@@ -60,6 +60,11 @@ class GroundPlane:
     def update(self, points: np.ndarray, u_px: np.ndarray) -> None:
         """Refine from vehicle-frame points (N, 3) and their image columns (N,) [px]."""
         cfg = self.cfg
+        # only the range cells the fit can use (the cells of the cell test below)
+        lo = np.floor(cfg.min_range_m / cfg.cell_m) * cfg.cell_m
+        hi = (np.floor(cfg.max_range_m / cfg.cell_m) + 1) * cfg.cell_m
+        sel = (points[:, 0] >= lo) & (points[:, 0] < hi)
+        points, u_px = points[sel], u_px[sel]
         x, y, z = points[:, 0], points[:, 1], points[:, 2]
         h = z - self._plane(x)
         near = ((x > cfg.min_range_m) & (x < cfg.max_range_m) & (np.abs(y) < cfg.half_width_m)
