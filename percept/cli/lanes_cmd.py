@@ -75,7 +75,9 @@ def register(app: typer.Typer) -> None:
 
 
 def _overlay_path(out: Path, source: Path, video: bool) -> Path:
-    return out / f"{source.stem}.lanes{'.mp4' if video else '.png'}"
+    from .footage_out import overlay_path
+
+    return overlay_path(out, source, "lanes", video)
 
 
 def _record(result, **keys) -> dict:
@@ -101,16 +103,10 @@ def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
         console.print(f"overlays in {out}")
 
 
-def _write_overlay(target: Path, image) -> None:
-    """One overlay PNG, complete or absent (encoded in memory, then written atomically)."""
-    from percept.outputs import png_bytes, write_bytes_atomic
-
-    write_bytes_atomic(target, png_bytes(image))
-
-
 def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,
                 single: bool) -> None:
     from percept.cli.common import err, fail, on_interrupt, progress_bar, write_error, write_json
+    from percept.cli.footage_out import write_overlay
     from percept.lanes.overlay import draw_overlay
     from percept.sensors import read_image
 
@@ -135,7 +131,7 @@ def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optio
             if out is not None:
                 target = _overlay_path(out, path, video=False)
                 try:
-                    _write_overlay(target, draw_overlay(runner.prepare(image), result, path.name))
+                    write_overlay(target, draw_overlay(runner.prepare(image), result, path.name))
                 except OSError as e:
                     kept = f"; {len(done)} overlay(s) before it are kept" if done else ""
                     fail(f"{write_error(target, e)}{kept}; no JSON was written")
@@ -176,6 +172,7 @@ def _lanes_on_video(runner, video, path: Path, writer) -> tuple[list[dict], list
 
 def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict) -> None:
     from percept.cli.common import console, err, fail, on_interrupt, write_error, write_json
+    from percept.cli.footage_out import open_writer
     from percept.outputs import atomic_path
     from percept.sensors import open_video
 
@@ -188,7 +185,7 @@ def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path
     try:
         with contextlib.ExitStack() as stack:
             tmp = None if target is None else stack.enter_context(atomic_path(target))
-            writer = None if tmp is None else _open_writer(tmp, video.fps, video.size)
+            writer = None if tmp is None else open_writer(tmp, video.fps, video.size)
             try:
                 records, ms = _lanes_on_video(runner, video, path, writer)
             finally:
@@ -210,13 +207,3 @@ def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path
     _print_summary(f"{len(records)} frame(s) of {path.name}", summary, None)
     if target is not None:
         console.print(f"overlay video: {target}")
-
-
-def _open_writer(tmp: Path, fps: float, size: tuple[int, int]):
-    """An mp4v writer on the temporary ``tmp`` (.mp4); OSError when this OpenCV build cannot write mp4v."""
-    import cv2
-
-    w = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), fps, size)
-    if not w.isOpened():
-        raise OSError(f"this OpenCV build cannot write mp4v video into {tmp.parent}")
-    return w

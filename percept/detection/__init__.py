@@ -1,5 +1,14 @@
-"""Detection: pedestrians (HOG, constrained search, tracking) and their scoring."""
+"""Detection: pedestrians (HOG features shared across windows, the image-pyramid search, scoring).
 
+``hog``: Dalal & Triggs HOG blocks computed once per image and scale (OpenCV's ``HOGDescriptor``) and a linear model
+scored over every window from them; ``pyramid``: the unconstrained search over every scale (``percept detect``);
+``metrics``: the scoring formulas; ``overlay``: drawings.
+"""
+
+from .hog import DESCRIPTOR_LEN, WINDOW_PX, LinearModel, block_grid, hog_descriptor
 from .metrics import DetectionScore, FrameMatch, eligible, iou, iou_matrix, match_detections, score_frames
+from .pyramid import Detection, detect_multiscale, group, pyramid_scales, windows_at_scale
 
-__all__ = ["DetectionScore", "FrameMatch", "eligible", "iou", "iou_matrix", "match_detections", "score_frames"]
+__all__ = ["DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",
+           "detect_multiscale", "eligible", "group", "hog_descriptor", "iou", "iou_matrix", "match_detections",
+           "pyramid_scales", "score_frames", "windows_at_scale"]

@@ -23,6 +23,7 @@ def percept(*args: str, cwd=None) -> subprocess.CompletedProcess:
     (["render", "--frames", "x", "--out", "o"], "Invalid value for '--frames'"),
     (["eval", "--scenario", "highway"], "Missing option '--out'"),
     (["lanes"], "Missing argument"),
+    (["detect"], "Missing argument"),
     (["drive", "--bogus"], "No such option: --bogus"),
 ])
 def test_usage_errors_are_one_line(tmp_path, args, message):
@@ -43,7 +44,7 @@ def test_help_still_works_through_the_console_script():
 
 @pytest.mark.parametrize("command, flags", [
     ("drive", ["--no-record"]), ("render", ["--scenery", "--force"]), ("eval", ["--redo"]),
-    ("calibrate", ["--stereo"]), ("view", ["--web"]), ("lanes", []),
+    ("calibrate", ["--stereo"]), ("view", ["--web"]), ("lanes", []), ("detect", []),
 ])
 def test_flags_show_no_value_type_in_help(command, flags):
     r = runner.invoke(app, [command, "--help"], env={"COLUMNS": "200"})
@@ -51,5 +52,5 @@ def test_flags_show_no_value_type_in_help(command, flags):
     lines = {ln.split()[1]: ln for ln in r.output.splitlines() if ln.strip().startswith(("│ --", "│    --"))}
     for flag in flags:
         assert "<bool>" not in lines[flag], lines[flag]
-    if command in ("calibrate", "view", "lanes"):  # registered with percept's Command class
+    if command in ("calibrate", "view", "lanes", "detect"):  # registered with percept's Command class
         assert "<bool>" not in lines["--help"], lines["--help"]

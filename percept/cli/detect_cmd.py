@@ -1,0 +1,198 @@
+"""`percept detect`: people in recorded footage, HOG over the full image pyramid (no calibration needed).
+
+Registered on the main typer app by ``percept.cli.app``; parses options, calls ``percept.detection``, prints.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.markup import escape
+
+from .common import Command
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``detect`` command to ``app``."""
+
+    @app.command("detect", cls=Command)
+    def detect(
+        source: Path = typer.Argument(..., help="An image, a video or a folder of images."),
+        json_path: Optional[Path] = typer.Option(None, "--json", help="Write per-image / per-frame detections to "
+                                                                      "this JSON file."),
+        out: Optional[Path] = typer.Option(None, "--out", help="Folder for overlays: NAME.detect.png per image, "
+                                                               "NAME.detect.mp4 for a video."),
+        model: str = typer.Option("inria", "--model", help="'inria' (OpenCV's people detector, trained on the "
+                                                           "INRIA photographs) or a model file (.npz) saved by "
+                                                           "percept."),
+        scale_step: float = typer.Option(1.05, "--scale-step", help="Pyramid scale step, 1.01 to 2."),
+        threshold: float = typer.Option(0.0, "--threshold", help="Smallest window score kept (the linear "
+                                                                 "model's margin), -10 to 10."),
+        max_frames: Optional[int] = typer.Option(None, "--max-frames", help="Process at most this many video "
+                                                                          "frames (at least 1)."),
+    ):
+        """Find people with a HOG sliding window over every scale of the image (64x128 windows, 8-pixel stride),
+        features computed once per scale and shared by all its windows.
+
+        The JSON has, per image or frame, `file`, `frame` and `detections` [{`box_px` [u0, v0, u1, v1], `score`}].
+        The JSON and every overlay are written complete or not at all.
+        """
+        from percept.cli.common import check_outputs, fail
+        from percept.cli.footage_out import overlay_path
+        from percept.cli.options import check_number
+        from percept.detection import LinearModel
+        from percept.sensors import FootageKind, list_footage
+
+        check_number("--scale-step", scale_step, 1.01, 2.0)
+        check_number("--threshold", threshold, -10.0, 10.0)
+        check_number("--max-frames", max_frames, 1, 10**7)
+        try:
+            linear = LinearModel.inria() if model == "inria" else LinearModel.load(Path(model))
+            kind, files = list_footage(source)
+        except ValueError as e:
+            fail(str(e))
+        video = kind is FootageKind.VIDEO
+        if out is not None and out.exists() and not out.is_dir():
+            fail(f"--out {out} is a file; give a folder for the overlays")
+        check_outputs([json_path, *([] if out is None else [overlay_path(out, p, "detect", video) for p in files])],
+                      [*files, None if model == "inria" else Path(model)])
+        header = {"source": str(source), "kind": kind.value, "model": linear.name, "scale_step": scale_step,
+                  "threshold": threshold}
+        params = dict(model=linear, step=scale_step, threshold=threshold)
+        if video:
+            _run_video(files[0], out, json_path, max_frames, header, params)
+        else:
+            _run_images(files, out, json_path, header, params, single=source.is_file())
+
+
+def _detect(image, params: dict) -> tuple[list, float]:
+    from percept.detection import detect_multiscale
+
+    t0 = time.perf_counter()
+    found = detect_multiscale(image, **params)
+    return found, 1000 * (time.perf_counter() - t0)
+
+
+def _summary(records: list[dict], ms: list[float]) -> dict:
+    ok = [r for r in records if "error" not in r]
+    return {"count": len(ok), "errors": len(records) - len(ok),
+            "detections": sum(len(r["detections"]) for r in ok),
+            "ms_per_frame_median": float(sorted(ms)[len(ms) // 2]) if ms else None}
+
+
+def _print_summary(title: str, summary: dict) -> None:
+    from percept.cli.common import console, fmt
+
+    ms = summary["ms_per_frame_median"]
+    console.print(f"{title}: {summary['detections']} detection(s) in {summary['count']}"
+                  + (f", {summary['errors']} unreadable" if summary["errors"] else "")
+                  + (f"; {fmt(ms, '{:.0f}')} ms each (median)" if ms else ""))
+
+
+def _run_images(files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict, params: dict,
+                single: bool) -> None:
+    from percept.cli.common import err, fail, on_interrupt, progress_bar, write_error, write_json
+    from percept.cli.footage_out import overlay_path, write_overlay
+    from percept.detection.overlay import draw_detections
+    from percept.sensors import read_image
+
+    records, ms, done = [], [], []
+    on_interrupt(lambda: f"{len(done)} overlay(s) kept in {out}; no JSON was written" if done else None)
+    with progress_bar() as bar:
+        task = bar.add_task("people in images", total=len(files))
+        for path in files:
+            try:
+                image = read_image(path)
+                found, t = _detect(image, params)
+            except ValueError as e:
+                if single:
+                    fail(f"{path}: {e}" if str(path) not in str(e) else str(e))
+                err.print(f"[yellow]skipped:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
+                records.append({"file": str(path), "error": str(e)})
+                bar.advance(task)
+                continue
+            ms.append(t)
+            records.append({"file": str(path), "frame": None, "detections": [d.to_dict() for d in found]})
+            if out is not None:
+                target = overlay_path(out, path, "detect", video=False)
+                try:
+                    write_overlay(target, draw_detections(image, found, path.name))
+                except OSError as e:
+                    kept = f"; {len(done)} overlay(s) before it are kept" if done else ""
+                    fail(f"{write_error(target, e)}{kept}; no JSON was written")
+                done.append(target)
+            bar.advance(task)
+    summary = _summary(records, ms)
+    if summary["count"] == 0:
+        fail(f"none of the {len(files)} images could be used; no JSON was written")
+    write_json(json_path, {**header, "results": records, "summary": summary})
+    _print_summary(f"{len(files)} image(s)", summary)
+    if out is not None:
+        from percept.cli.common import console
+
+        console.print(f"overlays in {out}")
+
+
+def _frames(video, path: Path, params: dict, writer) -> tuple[list[dict], list[float]]:
+    from percept.cli.common import progress_bar
+    from percept.detection.overlay import draw_detections
+
+    records, ms = [], []
+    with progress_bar() as bar:
+        task = bar.add_task(f"people in {path.name}", total=video.expected_frames)
+        for i, image in enumerate(video):
+            try:
+                found, t = _detect(image, params)
+            except ValueError as e:
+                raise ValueError(f"{path} frame {i}: {e}") from None
+            ms.append(t)
+            records.append({"file": str(path), "frame": i, "time_s": round(i / video.fps, 4),
+                            "detections": [d.to_dict() for d in found]})
+            if writer is not None:
+                writer.write(draw_detections(image, found, f"{path.name} #{i}"))
+            bar.advance(task)
+    return records, ms
+
+
+def _run_video(path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict,
+               params: dict) -> None:
+    from percept.cli.common import console, err, fail, on_interrupt, write_error, write_json
+    from percept.cli.footage_out import open_writer, overlay_path
+    from percept.outputs import atomic_path
+    from percept.sensors import open_video
+
+    try:
+        video = open_video(path, max_frames)
+    except ValueError as e:
+        fail(str(e))
+    target = None if out is None else overlay_path(out, path, "detect", video=True)
+    on_interrupt("nothing was written (the overlay video and the JSON are written only when complete)")
+    try:
+        with contextlib.ExitStack() as stack:
+            tmp = None if target is None else stack.enter_context(atomic_path(target))
+            writer = None if tmp is None else open_writer(tmp, video.fps, video.size)
+            try:
+                records, ms = _frames(video, path, params, writer)
+            finally:
+                video.close()
+                if writer is not None:
+                    writer.release()
+    except ValueError as e:
+        fail(f"{e}; nothing was written")
+    except OSError as e:
+        fail(write_error(target, e))
+    if video.ended_early:
+        err.print(f"[yellow]warning:[/] {escape(str(path))} ended after {video.frames_read} of the "
+                  f"{video.declared_frames} frames its header declares (truncated or damaged?)", highlight=False,
+                  soft_wrap=True)
+    summary = _summary(records, ms)
+    write_json(json_path, {**header, "fps": video.fps, "frames": len(records), "ended_early": video.ended_early,
+                           "overlay": None if target is None else str(target), "results": records,
+                           "summary": summary})
+    _print_summary(f"{len(records)} frame(s) of {path.name}", summary)
+    if target is not None:
+        console.print(f"overlay video: {target}")

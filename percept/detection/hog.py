@@ -1,0 +1,120 @@
+"""HOG features computed once per image (or strip) and scale, and a linear model scored over every window at once.
+
+Dalal & Triggs (CVPR 2005): gradient orientations in 8x8-pixel cells, 9 unsigned bins weighted by magnitude,
+16x16 blocks of 2x2 cells stepped by 8 pixels, each block normalised (L2-Hys); a 64x128 window's descriptor is
+its 7x15 blocks in a row. OpenCV's ``HOGDescriptor`` computes the blocks: one call with a window as large as the
+image returns every block of the image (block (bx, by) covers pixels (8 bx, 8 by) to (8 bx + 15, 8 by + 15)), so
+the blocks are computed once and shared by all the windows that contain them (OpenCV's own ``detectMultiScale``
+shares them too, within a scale). A linear model w on a window at block (x, y) scores
+
+    s(x, y) = b + sum_{i < 7, j < 15} w_ij . B(x + i, y + j)
+
+which is computed as one product of every block with all 105 weight vectors, then 105 shifted sums.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+WINDOW_PX = (64, 128)
+"""Detection window (width, height) [px]."""
+CELL_PX = 8
+BLOCK_PX = 16
+BINS = 9
+BLOCKS = ((WINDOW_PX[0] - BLOCK_PX) // CELL_PX + 1, (WINDOW_PX[1] - BLOCK_PX) // CELL_PX + 1)
+"""Blocks across and down one window: (7, 15)."""
+BLOCK_LEN = 4 * BINS
+DESCRIPTOR_LEN = BLOCKS[0] * BLOCKS[1] * BLOCK_LEN
+
+
+def hog_descriptor(win_px: tuple[int, int] = WINDOW_PX) -> cv2.HOGDescriptor:
+    """OpenCV's HOG with Dalal & Triggs' parameters (those of its default people detector) for windows of
+    ``win_px`` (width, height) [px]: 8x8 cells, 16x16 blocks at an 8-pixel stride, 9 bins, L2-Hys at 0.2, gamma
+    correction, the block's Gaussian weighting."""
+    return cv2.HOGDescriptor(win_px, (BLOCK_PX, BLOCK_PX), (CELL_PX, CELL_PX), (CELL_PX, CELL_PX), BINS, 1, -1.0,
+                             cv2.HOGDescriptor_L2Hys, 0.2, True, 64, False)
+
+
+_DESCRIPTORS: dict[tuple[int, int], cv2.HOGDescriptor] = {}
+
+
+def block_grid(image: np.ndarray) -> np.ndarray:
+    """Every HOG block of ``image`` (grey or BGR uint8, at least one window): (nbx, nby, 36) float32, block (bx, by)
+    at pixel (8 bx, 8 by). Columns and rows past the last whole block are not covered."""
+    h, w = image.shape[:2]
+    if w < WINDOW_PX[0] or h < WINDOW_PX[1]:
+        raise ValueError(f"image of {w}x{h} px is smaller than the {WINDOW_PX[0]}x{WINDOW_PX[1]} detection window")
+    nbx, nby = (w - BLOCK_PX) // CELL_PX + 1, (h - BLOCK_PX) // CELL_PX + 1
+    size = (BLOCK_PX + CELL_PX * (nbx - 1), BLOCK_PX + CELL_PX * (nby - 1))
+    hog = _DESCRIPTORS.get(size)
+    if hog is None:
+        hog = _DESCRIPTORS.setdefault(size, hog_descriptor(size))
+    # one window over the whole image: its descriptor is every block, x-major (bx, by, 36)
+    d = hog.compute(image, (CELL_PX, CELL_PX), (0, 0), [(0, 0)])
+    return d.reshape(nbx, nby, BLOCK_LEN)
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """A linear window classifier on HOG: weights (3780,) float32 in OpenCV's descriptor order, bias; name: where
+    it came from. ``score_map`` scores every window of a block grid."""
+
+    weights: np.ndarray
+    bias: float
+    name: str
+
+    def __post_init__(self) -> None:
+        if self.weights.shape != (DESCRIPTOR_LEN,) or not np.all(np.isfinite(self.weights)):
+            raise ValueError(f"model {self.name}: expected {DESCRIPTOR_LEN} finite weights, got shape "
+                             f"{self.weights.shape}")
+
+    @classmethod
+    def inria(cls) -> "LinearModel":
+        """OpenCV's people detector, trained on the INRIA person photographs (Dalal & Triggs)."""
+        d = np.asarray(cv2.HOGDescriptor_getDefaultPeopleDetector(), np.float32).ravel()
+        return cls(d[:DESCRIPTOR_LEN].copy(), float(d[DESCRIPTOR_LEN]), "inria")
+
+    @classmethod
+    def load(cls, path: Path) -> "LinearModel":
+        """A model saved by ``save`` (an .npz with ``weights`` and ``bias``); ValueError when missing or corrupt."""
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                return cls(np.asarray(z["weights"], np.float32), float(z["bias"]), str(path))
+        except FileNotFoundError:
+            raise ValueError(f"model file {path} does not exist") from None
+        except (OSError, KeyError, ValueError, EOFError) as e:
+            raise ValueError(f"model file {path} is not a percept HOG model ({type(e).__name__}: {e})") from None
+
+    def save(self, path: Path, **meta: str) -> None:
+        """Write the model (weights, bias and string metadata, e.g. its training data) to an .npz, atomically."""
+        import io
+
+        from percept.outputs import write_bytes_atomic
+
+        buf = io.BytesIO()
+        np.savez(buf, weights=self.weights.astype(np.float32), bias=np.float32(self.bias),
+                 **{k: np.asarray(v) for k, v in meta.items()})
+        write_bytes_atomic(path, buf.getvalue())
+
+    def opencv_detector(self) -> np.ndarray:
+        """The model as OpenCV's ``setSVMDetector`` takes it: weights then bias, (3781,) float32."""
+        return np.append(self.weights, np.float32(self.bias)).astype(np.float32)
+
+    def score_map(self, blocks: np.ndarray) -> np.ndarray:
+        """Score of the window at every block position of ``blocks`` (nbx, nby, 36): (nbx - 6, nby - 14)."""
+        nbx, nby, _ = blocks.shape
+        nx, ny = nbx - BLOCKS[0] + 1, nby - BLOCKS[1] + 1
+        w = self.weights.reshape(BLOCKS[0] * BLOCKS[1], BLOCK_LEN)
+        # every block against every weight vector at once: P[k, bx, by] = w_k . B(bx, by), k = 15 i + j
+        p = (w @ blocks.reshape(-1, BLOCK_LEN).T).reshape(-1, nbx, nby)
+        s = np.full((nx, ny), self.bias, np.float32)
+        for i in range(BLOCKS[0]):
+            for j in range(BLOCKS[1]):
+                # s(x, y) += w_ij . B(x + i, y + j)
+                s += p[i * BLOCKS[1] + j, i:i + nx, j:j + ny]
+        return s

@@ -1,0 +1,84 @@
+"""The unconstrained search: every window of an image pyramid, for footage without calibration.
+
+Scales 1, 1.05, 1.05^2, ... while the shrunken image still holds a window (as OpenCV's ``detectMultiScale``
+builds them); at each scale the image's HOG blocks are computed once (``hog.block_grid``) and every window at an
+8-pixel stride is scored from them (``LinearModel.score_map``). Windows scoring at least the threshold are
+grouped as ``detectMultiScale`` groups them (``cv2.groupRectangles``: rectangles within 20 % of each other's size
+and position form a cluster, clusters of fewer than ``group_threshold + 1`` are dropped, the cluster's mean is
+the detection); a detection's score is the best of the windows it was made from.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .hog import CELL_PX, WINDOW_PX, LinearModel, block_grid
+
+
+@dataclass(frozen=True)
+class Detection:
+    """box_px: (u0, v0, u1, v1) in the image [px]; score: the linear model's margin (0 is the decision boundary)."""
+
+    box_px: tuple[float, float, float, float]
+    score: float
+
+    def to_dict(self) -> dict:
+        return {"box_px": [round(float(c), 1) for c in self.box_px], "score": round(float(self.score), 4)}
+
+
+def pyramid_scales(width: int, height: int, step: float = 1.05, max_levels: int = 64) -> list[float]:
+    """Shrink factors of the pyramid: step^k while the image shrunk by it still holds a window."""
+    if not step > 1.0:
+        raise ValueError(f"the pyramid's scale step must be > 1, got {step}")
+    scales, s = [], 1.0
+    while len(scales) < max_levels and round(width / s) >= WINDOW_PX[0] and round(height / s) >= WINDOW_PX[1]:
+        scales.append(s)
+        s *= step
+    return scales
+
+
+def windows_at_scale(image: np.ndarray, model: LinearModel, scale: float,
+                     threshold: float) -> tuple[np.ndarray, np.ndarray]:
+    """Windows of ``image`` shrunk by ``scale`` that score >= ``threshold``: boxes (N, 4) as (x, y, w, h) in the
+    original image [px] and their scores (N,)."""
+    h, w = image.shape[:2]
+    size = (round(w / scale), round(h / scale))
+    small = image if size == (w, h) else cv2.resize(image, size, interpolation=cv2.INTER_LINEAR_EXACT)
+    s = model.score_map(block_grid(small))
+    x, y = np.nonzero(s >= threshold)
+    boxes = np.column_stack([np.round(x * CELL_PX * scale), np.round(y * CELL_PX * scale),
+                             np.full(len(x), round(WINDOW_PX[0] * scale)), np.full(len(x), round(WINDOW_PX[1] * scale))])
+    return boxes.astype(np.int32), s[x, y]
+
+
+def group(boxes: np.ndarray, scores: np.ndarray, group_threshold: int = 2, eps: float = 0.2) -> list[Detection]:
+    """Clusters of windows (x, y, w, h) -> detections, as ``detectMultiScale`` groups them; each detection's score is
+    the best of the windows overlapping it by IoU >= 0.5."""
+    if not len(boxes):
+        return []
+    grouped, _ = cv2.groupRectangles(boxes.tolist(), group_threshold, eps)
+    out = []
+    for gx, gy, gw, gh in np.asarray(grouped).reshape(-1, 4):
+        # IoU of the group's box with each window
+        ix = np.clip(np.minimum(gx + gw, boxes[:, 0] + boxes[:, 2]) - np.maximum(gx, boxes[:, 0]), 0, None)
+        iy = np.clip(np.minimum(gy + gh, boxes[:, 1] + boxes[:, 3]) - np.maximum(gy, boxes[:, 1]), 0, None)
+        inter = ix * iy
+        iou = inter / (gw * gh + boxes[:, 2] * boxes[:, 3] - inter)
+        best = float(scores[iou >= 0.5].max()) if (iou >= 0.5).any() else float(scores.max())
+        out.append(Detection((float(gx), float(gy), float(gx + gw), float(gy + gh)), best))
+    return sorted(out, key=lambda d: -d.score)
+
+
+def detect_multiscale(image: np.ndarray, model: LinearModel, step: float = 1.05, threshold: float = 0.0,
+                      group_threshold: int = 2) -> list[Detection]:
+    """People in ``image`` (grey or BGR uint8) at every scale of the pyramid, best first."""
+    h, w = image.shape[:2]
+    if w < WINDOW_PX[0] or h < WINDOW_PX[1]:
+        raise ValueError(f"image of {w}x{h} px is smaller than the {WINDOW_PX[0]}x{WINDOW_PX[1]} detection window")
+    found = [windows_at_scale(image, model, s, threshold) for s in pyramid_scales(w, h, step)]
+    boxes = np.concatenate([f[0] for f in found])
+    scores = np.concatenate([f[1] for f in found])
+    return group(boxes, scores, group_threshold)

@@ -1,0 +1,79 @@
+"""HOG blocks computed once per image and scored for every window equal OpenCV's per-window descriptors; the
+pyramid search finds what OpenCV's detectMultiScale finds (real video); models load, save and fail clearly."""
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from percept.detection import DESCRIPTOR_LEN, LinearModel, block_grid, detect_multiscale, hog_descriptor
+from percept.detection.pyramid import pyramid_scales
+from percept.sensors import iou
+
+VTEST = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "opencv-samples" / "pedestrians" / "vtest.avi"
+
+
+def textured(h=200, w=160, seed=0):
+    rng = np.random.default_rng(seed)
+    return cv2.GaussianBlur(rng.uniform(0, 255, (h, w, 3)).astype(np.uint8), (0, 0), 1.5)
+
+
+def test_every_window_scores_as_its_own_descriptor_would():
+    img = textured()
+    model = LinearModel.inria()
+    scores = model.score_map(block_grid(img))
+    # windows at 8-pixel steps: (160 - 64) / 8 + 1 across, (200 - 128) / 8 + 1 down
+    assert scores.shape == (13, 10)
+    locs = [(0, 0), (8, 16), (96, 72), (48, 40)]
+    desc = hog_descriptor().compute(img, (8, 8), (0, 0), locs).reshape(len(locs), DESCRIPTOR_LEN)
+    for (u, v), d in zip(locs, desc):
+        assert scores[u // 8, v // 8] == pytest.approx(float(d @ model.weights) + model.bias, abs=1e-4)
+
+
+def test_pyramid_scales_stop_where_a_window_no_longer_fits():
+    s = pyramid_scales(640, 480, 1.05)
+    assert s[0] == 1.0 and s[1] == pytest.approx(1.05)
+    assert round(480 / s[-1]) >= 128 and round(480 / (s[-1] * 1.05)) < 128
+    with pytest.raises(ValueError, match="scale step must be > 1"):
+        pyramid_scales(640, 480, 1.0)
+
+
+def test_an_image_smaller_than_the_window_is_refused():
+    with pytest.raises(ValueError, match="smaller than the 64x128 detection window"):
+        detect_multiscale(np.zeros((100, 200, 3), np.uint8), LinearModel.inria())
+
+
+def test_a_model_saves_and_loads_and_bad_files_say_so(tmp_path):
+    m = LinearModel(np.linspace(-1, 1, DESCRIPTOR_LEN).astype(np.float32), -0.5, "test")
+    m.save(tmp_path / "m.npz", trained_on="nothing")
+    back = LinearModel.load(tmp_path / "m.npz")
+    assert np.array_equal(back.weights, m.weights) and back.bias == -0.5
+    with pytest.raises(ValueError, match="does not exist"):
+        LinearModel.load(tmp_path / "missing.npz")
+    (tmp_path / "bad.npz").write_bytes(b"not a zip")
+    with pytest.raises(ValueError, match="is not a percept HOG model"):
+        LinearModel.load(tmp_path / "bad.npz")
+    np.savez(tmp_path / "short.npz", weights=np.zeros(10), bias=0.0)
+    with pytest.raises(ValueError, match="expected 3780 finite weights"):
+        LinearModel.load(tmp_path / "short.npz")
+
+
+@pytest.mark.skipif(not VTEST.is_file(), reason=f"{VTEST} is absent (real data in ../shared/data)")
+def test_the_pyramid_finds_what_opencv_detect_multiscale_finds_on_real_video():
+    cap = cv2.VideoCapture(str(VTEST))
+    hog = cv2.HOGDescriptor()
+    hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
+    model, theirs_n, ours_n, theirs_hit, ours_hit = LinearModel.inria(), 0, 0, 0, 0
+    for k in range(31):
+        ok, frame = cap.read()
+        if k % 10:
+            continue
+        ours = [d.box_px for d in detect_multiscale(frame, model)]
+        rects, _ = hog.detectMultiScale(frame)
+        theirs = [(x, y, x + w, y + h) for x, y, w, h in np.asarray(rects).reshape(-1, 4)]
+        theirs_n, ours_n = theirs_n + len(theirs), ours_n + len(ours)
+        theirs_hit += sum(any(iou(t, o) >= 0.5 for o in ours) for t in theirs)
+        ours_hit += sum(any(iou(o, t) >= 0.5 for t in theirs) for o in ours)
+    assert theirs_n >= 8
+    assert theirs_hit >= 0.9 * theirs_n and ours_hit >= 0.9 * ours_n
