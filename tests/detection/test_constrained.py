@@ -1,0 +1,50 @@
+"""The ground-constrained search on a rendered crossing: it scores only windows where a person standing on the road
+can be, finds a person 30 m ahead (33 px tall, below what a full pyramid from scale 1 can see) and skips most of the
+full pyramid's windows over the same scales."""
+
+import numpy as np
+import pytest
+
+from percept.detection import LinearModel
+from percept.detection.constrained import PERSON_PX, ConstrainedSearch, SearchConfig
+from percept.sensors import EgoPath, ObjectKind, StereoRig, iou
+from percept.sims import SimWorld, WorldConfig
+
+
+@pytest.fixture(scope="module")
+def crossing_frame():
+    w = SimWorld(WorldConfig("crossing", 100))
+    for _ in range(140):
+        w.step(0.0, 0.0)
+    frame, gt = w.observe()
+    return w.cfg.rig, frame, gt
+
+
+def window_of(box):
+    """The 64x128 detection window around a person's tight box (the person is 96/128 of its height)."""
+    u0, v0, u1, v1 = box
+    h = (v1 - v0) * 128 / PERSON_PX
+    cu = (u0 + u1) / 2
+    return (cu - h / 4, v0 - h * 16 / 128, cu + h / 4, v1 + h * 16 / 128)
+
+
+def test_the_constrained_search_finds_a_far_person_and_skips_most_windows(crossing_frame):
+    rig, frame, gt = crossing_frame
+    people = [o for o in gt.objects if o.kind is ObjectKind.PEDESTRIAN and o.visible >= 0.5 and o.box_px
+              and 24 <= o.box_px[3] - o.box_px[1] <= 40]
+    assert people, "the frame should hold a far pedestrian"
+    search = ConstrainedSearch(rig, LinearModel.inria())
+    dets, stats = search.search(frame.left, EgoPath.straight(frame.wheel_speed_mps))
+    for p in people:
+        assert max(iou(window_of(p.box_px), d.box_px) for d in dets) >= 0.5
+    assert stats.removed >= 0.9 and stats.windows < stats.full_windows
+    # scales from the smallest person searched (24 px) to the tallest near one
+    assert search.scales[0] == pytest.approx(24 / PERSON_PX)
+
+
+def test_no_scale_admits_a_person_outside_the_searched_depths():
+    search = ConstrainedSearch(StereoRig(), LinearModel.inria(), SearchConfig(min_range_m=10.0, max_range_m=20.0))
+    path = EgoPath.straight(10.0)
+    # a 2.1 m person at 5 m would be 233 px tall: no window that large is ever scored
+    big = [s for s in search.scales if search._region(float(s), path) is not None and s * PERSON_PX > 150]
+    assert not big and np.all(np.diff(search.scales) > 0)
