@@ -30,7 +30,8 @@ class ObstacleConfig:
     min_height_m, max_height_m: a pixel between these heights above the road stands up [m]; min_area_m2: smallest
     frontal area that counts as an obstacle [m²]; bin_rel: relative width of a range bin; grounded_m: a group's
     lowest pixels must be below this height (obstacles stand on the road; a patch of sky or glare matched by
-    chance floats) [m]; texture_threshold: StereoBM's (flat regions are not matched); ground: the online road-plane
+    chance floats) [m]; texture_threshold: StereoBM's (flat regions are not matched); blob_cell_px: cells of the image grid in which a
+    range group must form one connected blob [px]; ground: the online road-plane
     fit (heights are measured from it)."""
 
     near_m: float = 15.0
@@ -47,6 +48,7 @@ class ObstacleConfig:
     bin_rel: float = 0.04
     grounded_m: float = 1.0
     texture_threshold: int = 12
+    blob_cell_px: int = 8
     ground: GroundConfig = GroundConfig()
 
     def __post_init__(self) -> None:
@@ -160,15 +162,30 @@ class ObstacleFinder:
         # range bins of relative width bin_rel: log(Z) in steps of log(1 + bin_rel)
         k = np.floor(np.log(z) / np.log1p(cfg.bin_rel)).astype(int)
         for b in np.unique(k):
-            near = np.abs(k - b) <= 1
+            near = np.flatnonzero(np.abs(k - b) <= 1)
             # a full-resolution pixel covers (Z / f)^2 m^2 at range Z: the pixels an area needs there
-            need = cfg.min_area_m2 * (cam.fx / np.exp(b * np.log1p(cfg.bin_rel))) ** 2
-            if area[near].sum() >= max(need, 24) and np.percentile(pv[near, 2], 5) < cfg.grounded_m:
+            need = max(cfg.min_area_m2 * (cam.fx / np.exp(b * np.log1p(cfg.bin_rel))) ** 2, 24)
+            if area[near].sum() < need:
+                continue
+            blob = near[self._largest_blob(u[near], v[near], area[near])]
+            if area[blob].sum() >= need and np.percentile(pv[blob, 2], 5) < cfg.grounded_m:
                 break
         else:
             return None
-        us, vs = u[near], v[near]
+        us, vs = u[blob], v[blob]
         u0, u1 = np.percentile(us, [2, 98])
         v0, v1 = np.percentile(vs, [2, 98])
         box = (int(max(u0 - 1, 0)), int(max(v0 - 1, 0)), int(min(u1 + 2, cam.width)), int(min(v1 + 2, cam.height)))
-        return Obstacle(float(np.median(z[near])), box, float(area[near].sum()))
+        return Obstacle(float(np.median(z[blob])), box, float(area[blob].sum()))
+
+    def _largest_blob(self, u: np.ndarray, v: np.ndarray, area: np.ndarray) -> np.ndarray:
+        """Indices of the pixels of the largest connected blob (by area) among pixels (u, v) [px]: one object is
+        one solid region of the image; matches scattered over it (rain streaks, noise matched by chance) are not."""
+        cell = self.cfg.blob_cell_px
+        cu, cv_ = (u / cell).astype(int), (v / cell).astype(int)
+        grid = np.zeros((int(cv_.max()) + 2, int(cu.max()) + 2), np.uint8)
+        grid[cv_, cu] = 1
+        n, labels = cv2.connectedComponents(grid, connectivity=8)
+        lab = labels[cv_, cu]
+        best = int(np.argmax(np.bincount(lab, weights=area, minlength=n)[1:])) + 1
+        return np.flatnonzero(lab == best)

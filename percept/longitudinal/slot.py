@@ -190,7 +190,9 @@ class LongitudinalSlot:
         # stereo range noise: sigma_Z = Z^2 sigma_d / (f b)
         sigma = z * z * sd / self.fb
         previous, self.box = self.box, ob.box_px
-        if self.kf is None:
+        if self.kf is None or (self.hits < self.cfg.confirm and iou(previous, ob.box_px) < self.cfg.same_object_iou):
+            # a track is confirmed only by an obstacle that stays where it was in the image (rain streaks and
+            # matches made by chance jump about)
             self._new_track(z, sigma)
             return ("stereo",)
         used: tuple[str, ...] = ()
