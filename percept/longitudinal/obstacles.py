@@ -159,12 +159,19 @@ class ObstacleFinder:
 
     def _nearest_group(self, u, v, z, pv, area) -> Obstacle | None:
         cfg, cam = self.cfg, self.rig.camera
-        # range bins of relative width bin_rel: log(Z) in steps of log(1 + bin_rel)
+        # range bins of relative width bin_rel: log(Z) in steps of log(1 + bin_rel); points sorted by bin, so that
+        # bins b-1..b+1 are one slice and their area a difference of running sums
         k = np.floor(np.log(z) / np.log1p(cfg.bin_rel)).astype(int)
-        for b in np.unique(k):
-            near = np.flatnonzero(np.abs(k - b) <= 1)
+        order = np.argsort(k, kind="stable")
+        ks = k[order]
+        run = np.concatenate([[0.0], np.cumsum(area[order], dtype=np.float64)])
+        for b in np.unique(ks):
+            lo, hi = np.searchsorted(ks, b - 1, "left"), np.searchsorted(ks, b + 1, "right")
             # a full-resolution pixel covers (Z / f)^2 m^2 at range Z: the pixels an area needs there
             need = max(cfg.min_area_m2 * (cam.fx / np.exp(b * np.log1p(cfg.bin_rel))) ** 2, 24)
+            if run[hi] - run[lo] < need * (1 - 1e-4):
+                continue
+            near = np.sort(order[lo:hi])
             if area[near].sum() < need:
                 continue
             blob = near[self._largest_blob(u[near], v[near], area[near])]
