@@ -5,7 +5,6 @@ Registered on the main typer app by ``percept.cli.app``; parses options, calls `
 
 from __future__ import annotations
 
-import contextlib
 import time
 from pathlib import Path
 from typing import Optional
@@ -160,39 +159,13 @@ def _frames(video, path: Path, params: dict, writer) -> tuple[list[dict], list[f
 
 def _run_video(path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict,
                params: dict) -> None:
-    from percept.cli.common import console, err, fail, on_interrupt, write_error, write_json
-    from percept.cli.footage_out import open_writer, overlay_path
-    from percept.outputs import atomic_path
-    from percept.sensors import open_video
+    from percept.cli.common import console, write_json
+    from percept.cli.footage_out import process_video, video_header
 
-    try:
-        video = open_video(path, max_frames)
-    except ValueError as e:
-        fail(str(e))
-    target = None if out is None else overlay_path(out, path, "detect", video=True)
-    on_interrupt("nothing was written (the overlay video and the JSON are written only when complete)")
-    try:
-        with contextlib.ExitStack() as stack:
-            tmp = None if target is None else stack.enter_context(atomic_path(target))
-            writer = None if tmp is None else open_writer(tmp, video.fps, video.size)
-            try:
-                records, ms = _frames(video, path, params, writer)
-            finally:
-                video.close()
-                if writer is not None:
-                    writer.release()
-    except ValueError as e:
-        fail(f"{e}; nothing was written")
-    except OSError as e:
-        fail(write_error(target, e))
-    if video.ended_early:
-        err.print(f"[yellow]warning:[/] {escape(str(path))} ended after {video.frames_read} of the "
-                  f"{video.declared_frames} frames its header declares (truncated or damaged?)", highlight=False,
-                  soft_wrap=True)
+    video, target, records, ms = process_video(path, out, "detect", max_frames,
+                                               lambda video, writer: _frames(video, path, params, writer))
     summary = _summary(records, ms)
-    write_json(json_path, {**header, "fps": video.fps, "frames": len(records), "ended_early": video.ended_early,
-                           "overlay": None if target is None else str(target), "results": records,
-                           "summary": summary})
+    write_json(json_path, {**header, **video_header(video, target, records), "results": records, "summary": summary})
     _print_summary(f"{len(records)} frame(s) of {path.name}", summary)
     if target is not None:
         console.print(f"overlay video: {target}")

@@ -6,7 +6,9 @@ scored over every window from them; ``pyramid``: the unconstrained search over e
 """
 
 from .hog import DESCRIPTOR_LEN, WINDOW_PX, LinearModel, block_grid, hog_descriptor
-from .metrics import DetectionScore, FrameMatch, eligible, iou, iou_matrix, match_detections, score_frames
+from percept.sensors.boxes import iou, iou_matrix
+
+from .metrics import DetectionScore, FrameMatch, eligible, match_detections, score_frames
 from .pyramid import Detection, detect_multiscale, group, pyramid_scales, windows_at_scale
 
 __all__ = ["DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from percept.sensors.boxes import check_boxes as _boxes
-from percept.sensors.boxes import iou, iou_matrix
+from percept.sensors.boxes import iou_matrix
 
 
 def eligible(box_px: np.ndarray, visible: float, min_height_px: float = 24.0, min_visible: float = 0.5) -> bool:

@@ -85,7 +85,7 @@ class GroundPlane:
         bins = np.flatnonzero(counts >= cfg.min_points)
         if len(bins) < 4:
             return
-        zs, xs = z[near], x[near]
+        zs = z[near]
         med = np.array([np.median(zs[k == b]) for b in bins])
         xc = cfg.min_range_m + (bins + 0.5) * cfg.bin_m
         # least squares z = a + b x through the bins' medians
