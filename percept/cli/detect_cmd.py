@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.markup import escape
 
 from .common import Command
 
@@ -94,45 +93,23 @@ def _print_summary(title: str, summary: dict) -> None:
 
 def _run_images(files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict, params: dict,
                 single: bool) -> None:
-    from percept.cli.common import err, fail, on_interrupt, progress_bar, write_error, write_json
-    from percept.cli.footage_out import overlay_path, write_overlay
+    from percept.cli.common import console, fail, write_json
+    from percept.cli.footage_out import process_images
+    from percept.detection import detect_multiscale
     from percept.detection.overlay import draw_detections
-    from percept.sensors import read_image
 
-    records, ms, done = [], [], []
-    on_interrupt(lambda: f"{len(done)} overlay(s) kept in {out}; no JSON was written" if done else None)
-    with progress_bar() as bar:
-        task = bar.add_task("people in images", total=len(files))
-        for path in files:
-            try:
-                image = read_image(path)
-                found, t = _detect(image, params)
-            except ValueError as e:
-                if single:
-                    fail(f"{path}: {e}" if str(path) not in str(e) else str(e))
-                err.print(f"[yellow]skipped:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
-                records.append({"file": str(path), "error": str(e)})
-                bar.advance(task)
-                continue
-            ms.append(t)
-            records.append({"file": str(path), "frame": None, "detections": [d.to_dict() for d in found]})
-            if out is not None:
-                target = overlay_path(out, path, "detect", video=False)
-                try:
-                    write_overlay(target, draw_detections(image, found, path.name))
-                except OSError as e:
-                    kept = f"; {len(done)} overlay(s) before it are kept" if done else ""
-                    fail(f"{write_error(target, e)}{kept}; no JSON was written")
-                done.append(target)
-            bar.advance(task)
+    def work(image, path):
+        found = detect_multiscale(image, **params)
+        record = {"file": str(path), "frame": None, "detections": [d.to_dict() for d in found]}
+        return record, lambda: draw_detections(image, found, path.name)
+
+    records, ms = process_images(files, out, "detect", "people in images", single, work)
     summary = _summary(records, ms)
     if summary["count"] == 0:
         fail(f"none of the {len(files)} images could be used; no JSON was written")
     write_json(json_path, {**header, "results": records, "summary": summary})
     _print_summary(f"{len(files)} image(s)", summary)
     if out is not None:
-        from percept.cli.common import console
-
         console.print(f"overlays in {out}")
 
 

@@ -72,3 +72,45 @@ def video_header(video, target: Path | None, records: list) -> dict:
     """The JSON keys every footage command writes about a video it went through."""
     return {"fps": video.fps, "frames": len(records), "frames_declared": video.declared_frames,
             "ended_early": video.ended_early, "overlay": None if target is None else str(target)}
+
+
+def process_images(files: list[Path], out: Path | None, tag: str, title: str, single: bool, work) -> tuple:
+    """The image job of a footage command: for each file, ``work(image, path) -> (record, draw)`` (``draw()`` makes
+    its overlay), timed; an unreadable or unusable image is skipped with a warning (a one-line error when it is the
+    only one); each overlay is written as it is made (``OUT/NAME.TAG.png``, atomically). Returns (records, ms);
+    a record of a skipped image is {file, error}."""
+    import time
+
+    from rich.markup import escape
+
+    from percept.cli.common import err, fail, on_interrupt, progress_bar, write_error
+    from percept.sensors import read_image
+
+    records, ms, done = [], [], []
+    on_interrupt(lambda: f"{len(done)} overlay(s) kept in {out}; no JSON was written" if done else None)
+    with progress_bar() as bar:
+        task = bar.add_task(title, total=len(files))
+        for path in files:
+            try:
+                image = read_image(path)
+                t0 = time.perf_counter()
+                record, draw = work(image, path)
+                ms.append(1000 * (time.perf_counter() - t0))
+            except ValueError as e:
+                if single:
+                    fail(str(e) if str(path) in str(e) else f"{path}: {e}")
+                err.print(f"[yellow]skipped:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
+                records.append({"file": str(path), "error": str(e)})
+                bar.advance(task)
+                continue
+            records.append(record)
+            if out is not None:
+                target = overlay_path(out, path, tag, video=False)
+                try:
+                    write_overlay(target, draw())
+                except OSError as e:
+                    kept = f"; {len(done)} overlay(s) before it are kept" if done else ""
+                    fail(f"{write_error(target, e)}{kept}; no JSON was written")
+                done.append(target)
+            bar.advance(task)
+    return records, ms

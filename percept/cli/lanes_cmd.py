@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.markup import escape
 
 from .common import Command
 
@@ -44,6 +43,7 @@ def register(app: typer.Typer) -> None:
         files that were there untouched. Overlays of a folder are written one by one as each image is done.
         """
         from percept.cli.common import check_outputs, fail
+        from percept.cli.footage_out import overlay_path
         from percept.cli.options import check_number
         from percept.lanes.realworld import FootageLanes, RealLaneConfig
         from percept.sensors import CameraCalibration, FootageKind, list_footage
@@ -59,7 +59,7 @@ def register(app: typer.Typer) -> None:
         except ValueError as e:
             fail(str(e))
         video = kind is FootageKind.VIDEO
-        overlays = [] if out is None else [_overlay_path(out, p, video) for p in files]
+        overlays = [] if out is None else [overlay_path(out, p, "lanes", video) for p in files]
         if out is not None and out.exists() and not out.is_dir():
             fail(f"--out {out} is a file; give a folder for the overlays")
         check_outputs([json_path, *overlays], [*files, calib])
@@ -71,12 +71,6 @@ def register(app: typer.Typer) -> None:
             _run_video(runner, files[0], out, json_path, max_frames, header)
         else:
             _run_images(runner, files, out, json_path, header, single=source.is_file())
-
-
-def _overlay_path(out: Path, source: Path, video: bool) -> Path:
-    from .footage_out import overlay_path
-
-    return overlay_path(out, source, "lanes", video)
 
 
 def _record(result, **keys) -> dict:
@@ -104,38 +98,15 @@ def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
 
 def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,
                 single: bool) -> None:
-    from percept.cli.common import err, fail, on_interrupt, progress_bar, write_error, write_json
-    from percept.cli.footage_out import write_overlay
+    from percept.cli.common import fail, write_json
+    from percept.cli.footage_out import process_images
     from percept.lanes.overlay import draw_overlay
-    from percept.sensors import read_image
 
-    records, ms, done = [], [], []
-    on_interrupt(lambda: f"{len(done)} overlay(s) kept in {out}; no JSON was written" if done else None)
-    with progress_bar() as bar:
-        task = bar.add_task("lanes on images", total=len(files))
-        for path in files:
-            try:
-                image = read_image(path)
-                t0 = time.perf_counter()
-                result = runner.still(image)
-                ms.append(1000 * (time.perf_counter() - t0))
-            except ValueError as e:
-                if single:
-                    fail(str(e))
-                err.print(f"[yellow]skipped:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
-                records.append({"file": str(path), "error": str(e)})
-                bar.advance(task)
-                continue
-            records.append(_record(result, file=str(path)))
-            if out is not None:
-                target = _overlay_path(out, path, video=False)
-                try:
-                    write_overlay(target, draw_overlay(runner.prepare(image), result, path.name))
-                except OSError as e:
-                    kept = f"; {len(done)} overlay(s) before it are kept" if done else ""
-                    fail(f"{write_error(target, e)}{kept}; no JSON was written")
-                done.append(target)
-            bar.advance(task)
+    def work(image, path):
+        result = runner.still(image)
+        return _record(result, file=str(path)), lambda: draw_overlay(runner.prepare(image), result, path.name)
+
+    records, ms = process_images(files, out, "lanes", "lanes on images", single, work)
     summary = _summary(records, ms)
     if summary["count"] == 0:
         fail(f"none of the {len(files)} images could be read; no JSON was written")
