@@ -3,11 +3,12 @@
 Each frame: the nearest obstacle standing in the path (``obstacles``) and three measurements of it: its range
 from stereo (subpixel disparity over the lower part that faces the ego, ``refine``: Z = f b / d, noise
 sigma_Z = Z^2 sigma_d / (f b)); its range from where its tyres meet the road (``contact``); its range rate from
-the expansion of its image (``flow``: dZ/dt = -Z (s - 1) / dt). A Kalman filter (filterpy) over range and range
-rate (constant velocity, white acceleration noise) takes each with its own noise, each gated; a stereo range
-far from the prediction twice in a row starts a new track (a cut-in, the lead changing lanes). A track is
-reported once confirmed, kept through short misses and dropped frames, with a confidence that falls while it
-is only predicted.
+the expansion of its image (``flow``: dZ/dt = -Z (s - 1) / dt). A Kalman filter (filterpy) over range, range rate
+and range acceleration (constant acceleration, white jerk noise) takes each with its own noise, each gated. Two
+stereo ranges in a row beyond the gate are a new lead when the obstacle's box moved (a cut-in, the lead changing
+lanes), else the same lead manoeuvring (braking hard): the filter's uncertainty is opened up. A track is confirmed
+by hits on an obstacle that stays in place in the image, reported once confirmed, kept through short misses and
+dropped frames, with a confidence that falls while it is only predicted.
 """
 
 from __future__ import annotations
