@@ -73,6 +73,9 @@ class ConstrainedSearch:
         n = int(np.floor(np.log(s_max / s_min) / np.log(cfg.step))) + 1
         self.scales = s_min * cfg.step ** np.arange(n)
         self.cam_x = float(rig.camera_position()[0])
+        # what a full pyramid over the same scales scores: every window at an 8-pixel stride, for the count
+        self.full_windows = int(sum(max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0)
+                                    * max(int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0) for s in self.scales))
 
     def _region(self, scale: float, path: EgoPath) -> tuple[int, int, int, int] | None:
         """The image region (u0, v0, u1, v1) that holds every plausible window at ``scale``, or None."""
@@ -98,12 +101,9 @@ class ConstrainedSearch:
         return box
 
     def search(self, image: np.ndarray, path: EgoPath) -> tuple[list[Detection], SearchStats]:
-        cfg, cam = self.cfg, self.rig.camera
-        boxes, scores, windows, full = [], [], 0, 0
+        cfg = self.cfg
+        boxes, scores, windows = [], [], 0
         for s in self.scales:
-            # the full pyramid's windows at this scale, for the count
-            full += max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0) * max(
-                int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0)
             region = self._region(float(s), path)
             if region is None:
                 continue
@@ -117,7 +117,7 @@ class ConstrainedSearch:
             boxes.append(np.column_stack([u0 + x * CELL_PX * sx, v0 + y * CELL_PX * sy,
                                           np.full(len(x), WINDOW_PX[0] * sx), np.full(len(x), WINDOW_PX[1] * sy)]))
             scores.append(model_scores[x, y])
-        stats = SearchStats(windows, full, len(self.scales))
+        stats = SearchStats(windows, self.full_windows, len(self.scales))
         if not boxes:
             return [], stats
         b = np.round(np.concatenate(boxes)).astype(np.int32)

@@ -81,7 +81,7 @@ def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouet
         if frags is not None:
             _shade(target, p, atlas, *frags)
     if antialias:
-        smooth_edges(target, p, rp, v, lo, hi)
+        smooth_edges(target, p, rp, v, lo, hi, first, last)
     # Z = 1 / c wherever a patch won the z-test
     if target.depth is not None:
         np.divide(np.float32(1.0), target.inv_depth, out=target.depth, where=target.inv_depth != target.base_inv_depth)

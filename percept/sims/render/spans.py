@@ -68,7 +68,8 @@ def pixel_spans(p, rp: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.n
     return first, last
 
 
-def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> None:
+def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: np.ndarray, lo_px: np.ndarray,
+                 hi_px: np.ndarray) -> None:
     """Blend the pixel each span's left and right edge crosses, by its coverage, in ``target.image`` (and its
     emission map).
 
@@ -76,9 +77,9 @@ def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: n
     When f >= 1/2 pixel j is wholly inside and the outside neighbour n = j - 1 is covered by f - 1/2; when
     f < 1/2 pixel j is covered by 1/2 + f and shows the background for the rest. (The right edge mirrors it.)
     An edge is blended only where pixel j shows the patch (its 1/Z within EDGE_TOL of the patch's) and the
-    neighbour shows something behind the patch's plane; an occluded edge belongs to its occluder."""
+    neighbour shows something behind the patch's plane; an occluded edge belongs to its occluder. ``lo_px``,
+    ``hi_px``: the spans' first and last pixel centres (``pixel_spans``), as the rasteriser filled them."""
     H, W = target.inv_depth.shape
-    lo_px, hi_px = pixel_spans(p, rp, lo, hi)
     ok = (lo_px <= hi_px) & np.isfinite(lo) & np.isfinite(hi)
     img = target.image
     inv = target.inv_depth.reshape(-1)
