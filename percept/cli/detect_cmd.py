@@ -25,8 +25,9 @@ def register(app: typer.Typer) -> None:
         out: Optional[Path] = typer.Option(None, "--out", help="Folder for overlays: NAME.detect.png per image, "
                                                                "NAME.detect.mp4 for a video."),
         model: str = typer.Option("inria", "--model", help="'inria' (OpenCV's people detector, trained on the "
-                                                           "INRIA photographs) or a model file (.npz) saved by "
-                                                           "percept."),
+                                                           "INRIA photographs), 'sim' (percept's, trained on "
+                                                           "rendered people) or a model file (.npz) saved by "
+                                                           "percept train-detector."),
         scale_step: float = typer.Option(1.05, "--scale-step", help="Pyramid scale step, 1.01 to 2."),
         threshold: float = typer.Option(0.0, "--threshold", help="Smallest window score kept (the linear "
                                                                  "model's margin), -10 to 10."),
@@ -49,7 +50,7 @@ def register(app: typer.Typer) -> None:
         check_number("--threshold", threshold, -10.0, 10.0)
         check_number("--max-frames", max_frames, 1, 10**7)
         try:
-            linear = LinearModel.inria() if model == "inria" else LinearModel.load(Path(model))
+            linear = LinearModel.named(model)
             kind, files = list_footage(source)
         except ValueError as e:
             fail(str(e))
@@ -57,7 +58,7 @@ def register(app: typer.Typer) -> None:
         if out is not None and out.exists() and not out.is_dir():
             fail(f"--out {out} is a file; give a folder for the overlays")
         check_outputs([json_path, *([] if out is None else [overlay_path(out, p, "detect", video) for p in files])],
-                      [*files, None if model == "inria" else Path(model)])
+                      [*files, None if model in ("inria", "sim") else Path(model)])
         header = {"source": str(source), "kind": kind.value, "model": linear.name, "scale_step": scale_step,
                   "threshold": threshold}
         params = dict(model=linear, step=scale_step, threshold=threshold)

@@ -23,6 +23,7 @@ def drive(
     lateral: opt.Lateral = Source.PRIVILEGED,
     longitudinal: opt.Longitudinal = Source.PRIVILEGED,
     pedestrians: opt.Pedestrians = Source.PRIVILEGED,
+    detector: opt.Detector = "sim",
     odometry: opt.Odometry = Source.PRIVILEGED,
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
@@ -46,7 +47,7 @@ def drive(
     opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
-                          opt.slot_sources(lateral, longitudinal, pedestrians, odometry))
+                          opt.slot_sources(lateral, longitudinal, pedestrians, odometry), detector=detector)
     except ValueError as e:
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")

@@ -32,6 +32,7 @@ def eval_(
     lateral: opt.Lateral = Source.PRIVILEGED,
     longitudinal: opt.Longitudinal = Source.PRIVILEGED,
     pedestrians: opt.Pedestrians = Source.PRIVILEGED,
+    detector: opt.Detector = "sim",
     odometry: opt.Odometry = Source.PRIVILEGED,
     json_path: opt.JsonOut = None,
     redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
@@ -61,7 +62,7 @@ def eval_(
         fail(f"--engine must be local or ray, got '{engine}'")
     try:
         plan = EvalPlan(tuple(dict.fromkeys(names)), tuple(dict.fromkeys(condition)), tuple(parse_seeds(seeds)),
-                        opt.slot_sources(lateral, longitudinal, pedestrians, odometry), duration)
+                        opt.slot_sources(lateral, longitudinal, pedestrians, odometry), duration, detector)
         files = scan_runs(plan, out)
         if not redo:
             refuse_other_settings(files, out)

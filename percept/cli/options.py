@@ -26,6 +26,8 @@ Lateral = Annotated[Source, typer.Option("--lateral", help=_SLOT.format(task="La
 Longitudinal = Annotated[Source, typer.Option("--longitudinal", help=_SLOT.format(
     task="Longitudinal (lead range, following, braking)"))]
 Pedestrians = Annotated[Source, typer.Option("--pedestrians", help=_SLOT.format(task="Pedestrian"))]
+Detector = Annotated[str, typer.Option("--detector", help="People model of the vision pedestrian slot: sim "
+                                       "(trained on rendered people), inria (OpenCV's) or a model file.")]
 Odometry = Annotated[Source, typer.Option("--odometry", help=_SLOT.format(task="Odometry"))]
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",
                                                  dir_okay=False)]

@@ -10,7 +10,12 @@ from percept.sensors.boxes import iou, iou_matrix
 
 from .metrics import DetectionScore, FrameMatch, eligible, match_detections, score_frames
 from .pyramid import Detection, detect_multiscale, group, pyramid_scales, windows_at_scale
+from .constrained import ConstrainedSearch, SearchConfig, SearchStats, person_box
+from .tracking import PersonTrack, PersonTracker, TrackConfig
+from .slot import PedestrianDebug, PedestrianSlot, window_of
 
-__all__ = ["DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",
+__all__ = ["ConstrainedSearch", "PedestrianDebug", "PedestrianSlot", "PersonTrack", "PersonTracker", "SearchConfig",
+           "SearchStats", "TrackConfig", "person_box", "window_of",
+           "DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",
            "detect_multiscale", "eligible", "group", "hog_descriptor", "iou", "iou_matrix", "match_detections",
            "pyramid_scales", "score_frames", "windows_at_scale"]

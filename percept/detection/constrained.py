@@ -6,14 +6,22 @@ projection) and is fy H / Z pixels tall; the 64x128 window holds a person 96 px 
 Z = fy H / (96 s). People are 1.0-2.1 m tall, so each scale admits a narrow band of feet rows, and only the
 corridor's columns (within ``half_width_m`` of the ego path) at those depths: every other window is impossible
 and never scored. For each scale the band is cropped from the image (with the window's height above it), resized
-once and its HOG blocks computed once (``hog.block_grid``); scales below 1 (people under 96 px, the far field
-near the horizon) upsample their strip, which is small. ``SearchStats`` counts the windows scored against those
-of the full pyramid over the same scales.
+once and its HOG blocks computed once (``hog.block_grid``).
+
+Cells of ``cell_px`` = 4 pixels on the strip resized by 0.5 / s see what Dalal & Triggs' 8-pixel cells see on the
+strip resized by 1 / s (the window is then 32x64 px): a quarter of the pixels at every scale, so the far field
+(people of 24-48 px, s < 0.5, near the horizon) is upsampled by at most 2 rather than 4 — the "approximate
+neighbouring scales" idea of Dollar et al., "Fast Feature Pyramids for Object Detection", PAMI 2014.
+
+``search`` takes the levels (scale indices) to search and regions of interest (windows predicted by a tracker,
+searched at their neighbouring scales only): the vision slot spreads the levels over frames and searches around
+its tracks every frame. ``SearchStats`` counts the windows scored against those of the full pyramid.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Iterable, Sequence
 
 import cv2
 import numpy as np
@@ -27,37 +35,51 @@ PERSON_PX = 96
 """Height of the person inside a 64x128 window [px]."""
 FEET_MARGIN_PX = 16
 """Window rows below the person's feet [px]."""
+Box = tuple[float, float, float, float]
 
 
 @dataclass(frozen=True)
 class SearchConfig:
     """heights_m: plausible person heights [m]; min_person_px: the smallest person searched for [px];
-    min_range_m, max_range_m: depths searched [m]; half_width_m: the corridor about the ego path (its lane and the
-    verges beside it) [m]; step: scale step of the pyramid; threshold: smallest window score kept;
+    min_range_m, max_range_m: depths searched [m]; half_width_m: the corridor about the ego path (its lane, the
+    next lane's width and the verge) [m]; step: scale step of the pyramid; cell_px: HOG cell on the resized strip
+    [px] (8 = Dalal & Triggs' own scale, 4 = a quarter of the pixels); threshold: smallest window score kept;
     group_threshold: as ``detectMultiScale``'s."""
 
     heights_m: tuple[float, float] = (1.0, 2.1)
     min_person_px: float = 24.0
     min_range_m: float = 4.0
     max_range_m: float = 40.0
-    half_width_m: float = 7.0
-    step: float = 1.05
+    half_width_m: float = 5.5
+    step: float = 1.1
+    cell_px: int = 4
     threshold: float = 0.0
-    group_threshold: int = 2
+    group_threshold: int = 1
 
 
 @dataclass(frozen=True)
 class SearchStats:
-    """windows: windows scored; full_windows: windows a full pyramid over the same scales would score; scales."""
+    """windows: windows scored; full_windows: windows a full pyramid over the same scales would score (8-pixel
+    stride, every scale); levels: scales searched."""
 
     windows: int
     full_windows: int
-    scales: int
+    levels: int
 
     @property
     def removed(self) -> float:
         """Fraction of the full pyramid's windows the constraint never scores."""
         return 1.0 - self.windows / self.full_windows if self.full_windows else 0.0
+
+
+def person_box(window: Box) -> Box:
+    """The person inside a detection window (u0, v0, u1, v1): the middle 96/128 of its height (16/128 above the
+    head and below the feet), 0.4 of the person's height wide about the window's centre."""
+    u0, v0, u1, v1 = window
+    m = (v1 - v0) * FEET_MARGIN_PX / WINDOW_PX[1]
+    h = (v1 - v0) - 2 * m
+    cu = (u0 + u1) / 2
+    return (cu - 0.2 * h, v0 + m, cu + 0.2 * h, v1 - m)
 
 
 class ConstrainedSearch:
@@ -77,9 +99,9 @@ class ConstrainedSearch:
         self.full_windows = int(sum(max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0)
                                     * max(int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0) for s in self.scales))
 
-    def _region(self, scale: float, path: EgoPath) -> tuple[int, int, int, int] | None:
-        """The image region (u0, v0, u1, v1) that holds every plausible window at ``scale``, or None."""
-        cam, cfg = self.rig.camera, self.cfg
+    def region(self, level: int, path: EgoPath) -> tuple[int, int, int, int] | None:
+        """The image region (u0, v0, u1, v1) that holds every plausible window at scale ``level``, or None."""
+        cam, cfg, scale = self.rig.camera, self.cfg, float(self.scales[level])
         h_lo, h_hi = cfg.heights_m
         # Z = fy H / (96 s) for the shortest and the tallest person, within the searched depths
         z_near = max(cam.fy * h_lo / (PERSON_PX * scale), cfg.min_range_m)
@@ -94,31 +116,70 @@ class ConstrainedSearch:
         v_top = uv[:, 1].min() - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
         v_bot = uv[:, 1].max() + FEET_MARGIN_PX * scale
         u0, u1 = uv[:, 0].min() - WINDOW_PX[0] * scale / 2, uv[:, 0].max() + WINDOW_PX[0] * scale / 2
-        box = (int(max(np.floor(u0), 0)), int(max(np.floor(v_top), 0)), int(min(np.ceil(u1), cam.width)),
-               int(min(np.ceil(v_bot), cam.height)))
-        if box[2] - box[0] < WINDOW_PX[0] * scale or box[3] - box[1] < WINDOW_PX[1] * scale:
-            return None
-        return box
+        return self._clip((u0, v_top, u1, v_bot), scale)
 
-    def search(self, image: np.ndarray, path: EgoPath) -> tuple[list[Detection], SearchStats]:
-        cfg = self.cfg
-        boxes, scores, windows = [], [], 0
-        for s in self.scales:
-            region = self._region(float(s), path)
-            if region is None:
-                continue
-            u0, v0, u1, v1 = region
-            size = (max(int(round((u1 - u0) / s)), WINDOW_PX[0]), max(int(round((v1 - v0) / s)), WINDOW_PX[1]))
-            crop = cv2.resize(image[v0:v1, u0:u1], size, interpolation=cv2.INTER_LINEAR)
-            model_scores = self.model.score_map(block_grid(crop))
-            windows += model_scores.size
-            x, y = np.nonzero(model_scores >= cfg.threshold)
-            sx, sy = (u1 - u0) / size[0], (v1 - v0) / size[1]
-            boxes.append(np.column_stack([u0 + x * CELL_PX * sx, v0 + y * CELL_PX * sy,
-                                          np.full(len(x), WINDOW_PX[0] * sx), np.full(len(x), WINDOW_PX[1] * sy)]))
-            scores.append(model_scores[x, y])
-        stats = SearchStats(windows, self.full_windows, len(self.scales))
-        if not boxes:
-            return [], stats
-        b = np.round(np.concatenate(boxes)).astype(np.int32)
-        return group(b, np.concatenate(scores), cfg.group_threshold), stats
+    def _clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
+        cam = self.rig.camera
+        b = (int(max(np.floor(box[0]), 0)), int(max(np.floor(box[1]), 0)), int(min(np.ceil(box[2]), cam.width)),
+             int(min(np.ceil(box[3]), cam.height)))
+        if b[2] - b[0] < WINDOW_PX[0] * scale or b[3] - b[1] < WINDOW_PX[1] * scale:
+            return None
+        return b
+
+    def level_of(self, window: Box) -> int:
+        """The level whose window height is nearest that of ``window``."""
+        k = np.log((window[3] - window[1]) / WINDOW_PX[1] / self.scales[0]) / np.log(self.cfg.step)
+        return int(np.clip(np.round(k), 0, len(self.scales) - 1))
+
+    def _roi_regions(self, rois: Sequence[Box]) -> list[tuple[int, tuple[int, int, int, int]]]:
+        """(level, region) around each predicted window: its level and the next ones, half a window either side."""
+        out = []
+        for r in rois:
+            k0 = self.level_of(r)
+            for k in range(max(k0 - 1, 0), min(k0 + 2, len(self.scales))):
+                s = float(self.scales[k])
+                cu, cv = (r[0] + r[2]) / 2, (r[1] + r[3]) / 2
+                # the window at this scale, centred on the prediction, grown by half a window either way
+                half_w, half_h = WINDOW_PX[0] * s, 0.75 * WINDOW_PX[1] * s
+                box = self._clip((cu - half_w, cv - half_h, cu + half_w, cv + half_h), s)
+                if box is not None:
+                    out.append((k, box))
+        return out
+
+    def _scan(self, image: np.ndarray, level: int, region: tuple[int, int, int, int]):
+        """Windows of one region at one scale: boxes (N, 4) as (x, y, w, h) and scores (N,), and the count."""
+        cfg, s = self.cfg, float(self.scales[level])
+        u0, v0, u1, v1 = region
+        c = cfg.cell_px
+        # the strip resized so that c-pixel cells see what 8-pixel cells see at scale s: f = (c / 8) / s
+        f = c / CELL_PX / s
+        size = (max(int(round((u1 - u0) * f)), 8 * c), max(int(round((v1 - v0) * f)), 16 * c))
+        crop = cv2.resize(image[v0:v1, u0:u1], size, interpolation=cv2.INTER_LINEAR)
+        scores = self.model.score_map(block_grid(crop, c))
+        x, y = np.nonzero(scores >= cfg.threshold)
+        sx, sy = (u1 - u0) / size[0], (v1 - v0) / size[1]
+        boxes = np.column_stack([u0 + x * c * sx, v0 + y * c * sy, np.full(len(x), 8 * c * sx),
+                                 np.full(len(x), 16 * c * sy)])
+        return boxes, scores[x, y], scores.size
+
+    def windows(self, image: np.ndarray, path: EgoPath, levels: Iterable[int] | None = None,
+                rois: Sequence[Box] = ()) -> tuple[np.ndarray, np.ndarray, SearchStats]:
+        """Every window scoring at least the threshold, before grouping: boxes (N, 4) as (x, y, w, h) [px], scores
+        (N,), and the counts."""
+        todo = [(k, self.region(k, path)) for k in (range(len(self.scales)) if levels is None else levels)]
+        todo = [t for t in todo if t[1] is not None] + self._roi_regions(rois)
+        boxes, scores, windows = [np.zeros((0, 4))], [np.zeros(0, np.float32)], 0
+        for k, region in todo:
+            b, sc, n = self._scan(image, k, region)
+            boxes.append(b)
+            scores.append(sc)
+            windows += n
+        stats = SearchStats(windows, self.full_windows, len({k for k, _ in todo}))
+        return np.concatenate(boxes), np.concatenate(scores), stats
+
+    def search(self, image: np.ndarray, path: EgoPath, levels: Iterable[int] | None = None,
+               rois: Sequence[Box] = ()) -> tuple[list[Detection], SearchStats]:
+        """Detections (windows, best first) at ``levels`` (default: every scale) over the corridor, and at the
+        neighbouring scales of each region of interest."""
+        boxes, scores, stats = self.windows(image, path, levels, rois)
+        return group(np.round(boxes).astype(np.int32), scores, self.cfg.group_threshold), stats

@@ -28,33 +28,40 @@ BINS = 9
 BLOCKS = ((WINDOW_PX[0] - BLOCK_PX) // CELL_PX + 1, (WINDOW_PX[1] - BLOCK_PX) // CELL_PX + 1)
 """Blocks across and down one window: (7, 15)."""
 BLOCK_LEN = 4 * BINS
+SIM_MODEL_PATH = Path(__file__).parent / "models" / "people_sim.npz"
+"""The shipped sim-trained people model."""
 DESCRIPTOR_LEN = BLOCKS[0] * BLOCKS[1] * BLOCK_LEN
 
 
-def hog_descriptor(win_px: tuple[int, int] = WINDOW_PX) -> cv2.HOGDescriptor:
+def hog_descriptor(win_px: tuple[int, int] = WINDOW_PX, cell_px: int = CELL_PX) -> cv2.HOGDescriptor:
     """OpenCV's HOG with Dalal & Triggs' parameters (those of its default people detector) for windows of
     ``win_px`` (width, height) [px]: 8x8 cells, 16x16 blocks at an 8-pixel stride, 9 bins, L2-Hys at 0.2, gamma
-    correction, the block's Gaussian weighting."""
-    return cv2.HOGDescriptor(win_px, (BLOCK_PX, BLOCK_PX), (CELL_PX, CELL_PX), (CELL_PX, CELL_PX), BINS, 1, -1.0,
-                             cv2.HOGDescriptor_L2Hys, 0.2, True, 64, False)
+    correction, the block's Gaussian weighting. ``cell_px`` other than 8 scales cells, blocks and stride together
+    (a 4-pixel cell sees what an 8-pixel cell sees in the image enlarged twice)."""
+    c = int(cell_px)
+    return cv2.HOGDescriptor(win_px, (2 * c, 2 * c), (c, c), (c, c), BINS, 1, -1.0, cv2.HOGDescriptor_L2Hys, 0.2,
+                             True, 64, False)
 
 
-_DESCRIPTORS: dict[tuple[int, int], cv2.HOGDescriptor] = {}
+_DESCRIPTORS: dict[tuple[int, int, int], cv2.HOGDescriptor] = {}
 
 
-def block_grid(image: np.ndarray) -> np.ndarray:
+def block_grid(image: np.ndarray, cell_px: int = CELL_PX) -> np.ndarray:
     """Every HOG block of ``image`` (grey or BGR uint8, at least one window): (nbx, nby, 36) float32, block (bx, by)
-    at pixel (8 bx, 8 by). Columns and rows past the last whole block are not covered."""
+    at pixel (c bx, c by) for cells of c = ``cell_px`` pixels (a window is 8 c x 16 c px). Columns and rows past
+    the last whole block are not covered."""
     h, w = image.shape[:2]
-    if w < WINDOW_PX[0] or h < WINDOW_PX[1]:
-        raise ValueError(f"image of {w}x{h} px is smaller than the {WINDOW_PX[0]}x{WINDOW_PX[1]} detection window")
-    nbx, nby = (w - BLOCK_PX) // CELL_PX + 1, (h - BLOCK_PX) // CELL_PX + 1
-    size = (BLOCK_PX + CELL_PX * (nbx - 1), BLOCK_PX + CELL_PX * (nby - 1))
+    c = int(cell_px)
+    win = (WINDOW_PX[0] * c // CELL_PX, WINDOW_PX[1] * c // CELL_PX)
+    if w < win[0] or h < win[1]:
+        raise ValueError(f"image of {w}x{h} px is smaller than the {win[0]}x{win[1]} detection window")
+    nbx, nby = (w - 2 * c) // c + 1, (h - 2 * c) // c + 1
+    size = (2 * c + c * (nbx - 1), 2 * c + c * (nby - 1), c)
     hog = _DESCRIPTORS.get(size)
     if hog is None:
-        hog = _DESCRIPTORS.setdefault(size, hog_descriptor(size))
+        hog = _DESCRIPTORS.setdefault(size, hog_descriptor(size[:2], c))
     # one window over the whole image: its descriptor is every block, x-major (bx, by, 36)
-    d = hog.compute(image, (CELL_PX, CELL_PX), (0, 0), [(0, 0)])
+    d = hog.compute(image, (c, c), (0, 0), [(0, 0)])
     return d.reshape(nbx, nby, BLOCK_LEN)
 
 
@@ -79,12 +86,24 @@ class LinearModel:
         return cls(d[:DESCRIPTOR_LEN].copy(), float(d[DESCRIPTOR_LEN]), "inria")
 
     @classmethod
+    def sim(cls) -> "LinearModel":
+        """percept's own model, trained on rendered people by ``percept train-detector`` (shipped in the package,
+        its training record beside it in ``people_sim.json``)."""
+        return cls.load(SIM_MODEL_PATH)
+
+    @classmethod
+    def named(cls, name: str) -> "LinearModel":
+        """'inria', 'sim' or the path of a model file; ValueError when the file is missing or corrupt."""
+        return cls.inria() if name == "inria" else cls.sim() if name == "sim" else cls.load(Path(name))
+
+    @classmethod
     def load(cls, path: Path) -> "LinearModel":
         """A model saved by ``save`` (an .npz with ``weights`` and ``bias``); ValueError when missing or corrupt."""
         path = Path(path)
         try:
             with np.load(path, allow_pickle=False) as z:
-                return cls(np.asarray(z["weights"], np.float32), float(z["bias"]), str(path))
+                name = "sim" if path == SIM_MODEL_PATH else str(path)
+                return cls(np.asarray(z["weights"], np.float32), float(z["bias"]), name)
         except FileNotFoundError:
             raise ValueError(f"model file {path} does not exist") from None
         except (OSError, KeyError, ValueError, EOFError) as e:
@@ -109,12 +128,13 @@ class LinearModel:
         """Score of the window at every block position of ``blocks`` (nbx, nby, 36): (nbx - 6, nby - 14)."""
         nbx, nby, _ = blocks.shape
         nx, ny = nbx - BLOCKS[0] + 1, nby - BLOCKS[1] + 1
-        w = self.weights.reshape(BLOCKS[0] * BLOCKS[1], BLOCK_LEN)
-        # every block against every weight vector at once: P[k, bx, by] = w_k . B(bx, by), k = 15 i + j
-        p = (w @ blocks.reshape(-1, BLOCK_LEN).T).reshape(-1, nbx, nby)
+        w = self.weights.reshape(BLOCKS[0], BLOCKS[1], BLOCK_LEN)
         s = np.full((nx, ny), self.bias, np.float32)
-        for i in range(BLOCKS[0]):
-            for j in range(BLOCKS[1]):
+        for j in range(BLOCKS[1]):
+            # the blocks that weight row j meets (rows j .. j + ny - 1) against its 7 weight vectors at once:
+            # P[bx, y, i] = w_ij . B(bx, y + j)
+            p = (blocks[:, j:j + ny].reshape(-1, BLOCK_LEN) @ w[:, j].T).reshape(nbx, ny, BLOCKS[0])
+            for i in range(BLOCKS[0]):
                 # s(x, y) += w_ij . B(x + i, y + j)
-                s += p[i * BLOCKS[1] + j, i:i + nx, j:j + ny]
+                s += p[i:i + nx, :, i]
         return s

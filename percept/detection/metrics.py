@@ -116,3 +116,45 @@ def score_frames(matches: list[FrameMatch]) -> dict:
                        fn=sum(m.fn for m in matches), frames=len(matches))
     return {"recall": s.recall, "precision": s.precision, "fppi": s.fppi,
             "tp": s.tp, "fp": s.fp, "fn": s.fn, "frames": s.frames}
+
+
+HEIGHT_BINS_PX = ((24.0, 40.0, "24-40"), (40.0, float("inf"), ">=40"))
+"""Ground-truth height bins [px] for recall: the far field and the rest."""
+
+
+class DetectionTally:
+    """Per-frame matching accumulated over a run: totals for recall / precision / FPPI and recall per height bin
+    (``HEIGHT_BINS_PX``), and the range at which each object was first matched."""
+
+    def __init__(self) -> None:
+        self.matches: list[FrameMatch] = []
+        self.bin_hits = {name: [0, 0] for _, _, name in HEIGHT_BINS_PX}
+        self.first_range_m: dict = {}
+
+    def add(self, det_boxes, det_scores, gt_boxes, gt_eligible, gt_ids=(), gt_range_m=()) -> FrameMatch:
+        """One frame: detections against ground truth (ineligible boxes are ignore regions); ``gt_ids`` and
+        ``gt_range_m`` (optional, one per box) record first-detection ranges."""
+        gt = np.asarray(gt_boxes, dtype=np.float64).reshape(-1, 4)
+        keep = np.asarray(gt_eligible, dtype=bool).reshape(-1)
+        m = match_detections(np.asarray(det_boxes, dtype=np.float64).reshape(-1, 4), det_scores, gt, keep)
+        self.matches.append(m)
+        hit = {g for _, g in m.pairs}
+        for g in np.flatnonzero(keep):
+            h = gt[g, 3] - gt[g, 1]
+            for lo, hi, name in HEIGHT_BINS_PX:
+                if lo <= h < hi:
+                    self.bin_hits[name][0] += int(g in hit)
+                    self.bin_hits[name][1] += 1
+        for g in hit:
+            if len(gt_ids) and gt_ids[g] not in self.first_range_m:
+                self.first_range_m[gt_ids[g]] = float(gt_range_m[g])
+        return m
+
+    def result(self) -> dict:
+        """score_frames' keys plus ``recall_by_height`` {bin: recall or None} and ``first_detection_range_m`` (the
+        median over objects of the range of their first match, None when none was matched)."""
+        out = score_frames(self.matches)
+        out["recall_by_height"] = {k: (h / n if n else None) for k, (h, n) in self.bin_hits.items()}
+        first = list(self.first_range_m.values())
+        out["first_detection_range_m"] = float(np.median(first)) if first else None
+        return out

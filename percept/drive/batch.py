@@ -87,13 +87,14 @@ class Job:
 class EvalPlan:
     """scenarios, conditions: names; seeds: the seeds of every (scenario, condition); slots: Source per task name
     (missing ones privileged); duration_s: None = each scenario's own. Validated here: a bad name, condition or
-    slot raises ValueError before any run starts."""
+    slot raises ValueError before any run starts. detector: the vision pedestrian slot's people model."""
 
     scenarios: tuple[str, ...]
     conditions: tuple[str, ...]
     seeds: tuple[int, ...]
     slots: dict = field(default_factory=dict)
     duration_s: float | None = None
+    detector: str = "sim"
 
     def __post_init__(self) -> None:
         if not self.scenarios or not self.conditions or not self.seeds:
@@ -105,7 +106,7 @@ class EvalPlan:
 
     def config(self, job: Job) -> DriveConfig:
         return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
-                           dict(self.slots))
+                           dict(self.slots), detector=self.detector)
 
     @property
     def jobs(self) -> list[Job]:

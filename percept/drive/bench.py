@@ -42,8 +42,8 @@ class StageCost:
                 "ratio": None if r is None else round(r, 3), "target_ms": self.target_ms}
 
 
-def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2) -> float:
-    """Median wall time of ``fn`` in milliseconds."""
+def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2, mean: bool = False) -> float:
+    """Median (or mean) wall time of ``fn`` in milliseconds."""
     for _ in range(warmup):
         fn()
     times = []
@@ -51,7 +51,7 @@ def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2) -> float:
         t0 = time.perf_counter()
         fn()
         times.append((time.perf_counter() - t0) * 1e3)
-    return float(np.median(times))
+    return float(np.mean(times) if mean else np.median(times))
 
 
 def _cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], object]:
@@ -99,7 +99,8 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
 def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int = 0,
                progress: Callable[[], None] | None = None) -> StageCost:
     """A task's vision slot on rendered frames of its bench scenario (640x480, one thread); the slots upstream of
-    it are privileged (computed beforehand, not timed)."""
+    it are privileged (computed beforehand, not timed). A slot that spreads its work over frames (``sweep_frames``)
+    is timed on consecutive frames and reported as its mean cost; the others as their median."""
     from percept.sims import SimWorld, WorldConfig
 
     if task.vision is None:
@@ -118,7 +119,8 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
         world.step()
     slot = task.vision(ctx)
     shot = _cycle(shots, progress)
-    ms = median_ms(lambda: slot.step(*shot()), frames)
+    spread = getattr(slot, "sweep_frames", 1) > 1
+    ms = median_ms(lambda: slot.step(*shot()), frames, mean=spread)
     peer, peer_ms = None, None
     if task.bench_peer is not None:
         peer, run = task.bench_peer([f for f, _ in shots])
@@ -137,3 +139,14 @@ def sgbm_full_frame(frames: list) -> tuple[str, Callable]:
     def run(frame) -> None:
         sgbm.compute(cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY), cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY))
     return "OpenCV StereoSGBM, full frame", run
+
+
+def people_detector_full_frame(frames: list) -> tuple[str, Callable]:
+    """The stock way to find people: OpenCV's HOG ``detectMultiScale`` with its default (INRIA) people detector
+    over the whole frame (8-pixel stride, 8-pixel padding, scale step 1.05)."""
+    hog = cv2.HOGDescriptor()
+    hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
+
+    def run(frame) -> None:
+        hog.detectMultiScale(frame.left, winStride=(8, 8), padding=(8, 8), scale=1.05)
+    return "OpenCV HOG detectMultiScale (default people detector), full frame", run

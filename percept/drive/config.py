@@ -18,13 +18,14 @@ MAX_DURATION_S = 24 * 3600.0
 @dataclass(frozen=True)
 class DriveConfig:
     """world: scenario, seed, condition, rig; duration_s: None = the scenario's default [s]; sources: task name ->
-    Source (missing = privileged); tasks: the slot table. Validated on construction (ValueError naming the bad
-    value)."""
+    Source (missing = privileged); tasks: the slot table; detector: the vision pedestrian slot's people model
+    ('sim', 'inria' or a model file). Validated on construction (ValueError naming the bad value)."""
 
     world: WorldConfig = field(default_factory=WorldConfig)
     duration_s: float | None = None
     sources: dict = field(default_factory=dict)
     tasks: tuple[Task, ...] = TASKS
+    detector: str = "sim"
 
     def __post_init__(self) -> None:
         d = self.duration_s
@@ -43,6 +44,11 @@ class DriveConfig:
             if clean[name] is Source.VISION and names[name].vision is None:
                 raise ValueError(f"the {name} slot has no vision implementation yet; use --{name} privileged")
         object.__setattr__(self, "sources", {t.name: clean.get(t.name, Source.PRIVILEGED) for t in self.tasks})
+        if self.detector not in ("sim", "inria"):
+            from pathlib import Path
+
+            if not Path(self.detector).is_file():
+                raise ValueError(f"--detector must be sim, inria or a model file, got '{self.detector}'")
 
     def source(self, task: str) -> Source:
         return self.sources[task]

@@ -27,7 +27,8 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     world = SimWorld(cfg.world)
     feed = TruthFeed()
     lm = world.landmark_map()
-    agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed),
+    agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed,
+                                                       cfg.detector),
                   world.cruise_speed_mps)
     scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
                                              world.crossing_pedestrians, agent.following.time_gap))
@@ -62,6 +63,8 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
               "duration_s": round(sim_s, 4), "frames": frames, "realtime_factor": sim_s / wall if wall > 0 else None,
               "slots": {name: src.value for name, src in cfg.sources.items()}, **safety.result()}
     result.update({t.group: scorers[t.name].result() for t in cfg.tasks})
+    if cfg.source("pedestrians") is Source.VISION:
+        result["pedestrians"]["detector"] = cfg.detector
     result["timing_ms"] = timing_json(cfg, slot_ms, render_ms if render else None, frames)
     return result
 

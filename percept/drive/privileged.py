@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from percept.sensors import BrakingRequest, EgoPath, Frame, LaneEstimate, Lead, ObjectKind, PoseEstimate
+from percept.sensors.conflict import CORRIDOR_MARGIN_M, PERSON_HALF_M, person_conflict
 from percept.sensors.vehicle import EGO_WIDTH_M, bumper_gap_m
 
 
@@ -56,6 +57,12 @@ class InPath:
     entering: bool
 
 
+def true_centre_y(lane, x_m: float) -> float:
+    """The true lane's centre in the vehicle frame x_m ahead [m] (``LaneTruth``)."""
+    # y_c = -offset - tan(heading) x + kappa x^2 / 2
+    return -lane.offset_m - math.tan(lane.heading_rad) * x_m + lane.curvature_1pm * x_m * x_m / 2
+
+
 def path_objects(gt, horizon_s: float = 4.0) -> list[InPath]:
     """Objects ahead that are in the true ego lane's corridor now or (pedestrians) will enter it."""
     lane = gt.lane
@@ -66,20 +73,15 @@ def path_objects(gt, horizon_s: float = 4.0) -> list[InPath]:
         x, y = o.position_m[0], o.position_m[1]
         if x <= 0:
             continue
-        # lane centre in the vehicle frame at distance x: y_c = -offset - heading x + kappa x^2 / 2
-        yc = -lane.offset_m - math.tan(lane.heading_rad) * x + lane.curvature_1pm * x * x / 2
-        half = EGO_WIDTH_M / 2 + 0.4 + (o.size_m[1] / 2 if o.kind is ObjectKind.VEHICLE else 0.3)
+        yc = true_centre_y(lane, x)
         vx = o.speed_mps * math.cos(o.yaw_rad)
         vy = o.speed_mps * math.sin(o.yaw_rad)
-        now = abs(y - yc) < half
-        entering = False
-        if o.kind is ObjectKind.PEDESTRIAN and not now and abs(vy) > 0.2:
-            # a person walking across the carriageway: yield while within a lane of our corridor (either way),
-            # or if they will step into it before the ego gets there (or within the horizon)
-            t = min(horizon_s, x / max(gt.speed_mps, 1.0))
-            y_future = y + vy * t
-            entering = (abs(y - yc) < half + lane.width_m or abs(y_future - yc) < half
-                        or (y - yc) * (y_future - yc) < 0)
+        if o.kind is ObjectKind.PEDESTRIAN:
+            c = person_conflict(x, y, vy, yc, lane.width_m, gt.speed_mps, horizon_s)
+            now, entering = c.now, c.entering
+        else:
+            half = o.size_m[1] / 2 if o.kind is ObjectKind.VEHICLE else PERSON_HALF_M
+            now, entering = abs(y - yc) < EGO_WIDTH_M / 2 + CORRIDOR_MARGIN_M + half, False
         if now or entering:
             out.append(InPath(o, bumper_gap_m(o.distance_m), vx, now, entering))
     return out

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from percept.sensors import Source
+
 if TYPE_CHECKING:
     from .batch import EvalPlan, Job
 
@@ -30,6 +32,7 @@ def run_settings(plan: EvalPlan) -> dict:
     cfg = plan.config(plan.jobs[0])
     return {"percept": version("percept"), "duration_s": plan.duration_s,
             "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
+            "detector": cfg.detector if cfg.source("pedestrians") is Source.VISION else None,
             "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
                       "autopilot": cfg.world.autopilot}}
 

@@ -11,17 +11,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from percept.detection.constrained import SearchConfig
+from percept.detection.metrics import DetectionTally, eligible
 from percept.lanes.metrics import centering, rmse_columns
 from percept.longitudinal.metrics import range_abs_rel_err, range_abs_rel_err_by_bin, ttc_abs_err_s
 from percept.odometry.metrics import ate_rmse_m, kitti_drift
 from percept.sensors import ObjectKind
 from percept.sensors.vehicle import EGO_WIDTH_M
 
-from .privileged import InPath, Obstacle
+from .privileged import InPath, Obstacle, true_centre_y
 
 STOP_SPEED_MPS = 0.5
 PHANTOM_DECEL_MPS2 = -3.0
 """A commanded deceleration below this with nothing in the path to justify it is a phantom brake [m/s²]."""
+PHANTOM_MIN_SPEED_MPS = 2.0
+"""Below this speed a hard deceleration is the end of a stop, not a phantom brake [m/s]."""
 STEADY_REL_MPS = 0.5
 STEADY_S = 2.0
 """Following is steady once the ego's and the lead's speeds have stayed within STEADY_REL_MPS [m/s] of each other
@@ -106,7 +110,7 @@ class LongitudinalScorer:
         self.steady_gaps_s: list[float] = []
         self._calm_since_s: float | None = None
         self.phantom_brakes = 0
-        self._braking_for_nothing = False
+        self._braking = False
 
     def update(self, lead, debug, step: StepTruth) -> None:
         gt, obstacle = step.truth, step.in_path
@@ -122,13 +126,15 @@ class LongitudinalScorer:
                 self.steady_gaps_s.append(obstacle.gap_m / gt.speed_mps)
         else:
             self._calm_since_s = None
-        # phantom brake: a hard deceleration with nothing in the path within the stopping distance at 3 m/s^2 + 10 m
+        # phantom brake: a hard deceleration that begins, above a walking pace, with nothing in the path within the
+        # stopping distance at 3 m/s^2 + 10 m (a braking that began for something may hold on to a standstill after
+        # it has gone)
         reach = gt.speed_mps ** 2 / (2 * -PHANTOM_DECEL_MPS2) + 10.0
         justified = obstacle is not None and obstacle.gap_m <= reach
-        phantom = step.accel_mps2 < PHANTOM_DECEL_MPS2 and not justified
-        if phantom and not self._braking_for_nothing:
+        braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
+        if braking and not self._braking and not justified:
             self.phantom_brakes += 1
-        self._braking_for_nothing = phantom
+        self._braking = braking
         if self.ctx.vision and lead is not None:
             truth = [p for p in step.ahead if p.now]
             if truth:
@@ -155,10 +161,15 @@ class LongitudinalScorer:
 
 
 class PedestrianScorer:
-    """Stops for crossing pedestrians and false stops (detection scores join with the vision slot)."""
+    """Stops for crossing pedestrians and false stops; with the vision slot, its reported people (confirmed tracks'
+    boxes) against the true boxes of every frame. A true pedestrian counts (``eligible``: at least 24 px tall and
+    half visible) inside the searched domain (the search's depths and corridor about the true lane centre); the
+    others are ignore regions."""
 
     def __init__(self, ctx: ScoreContext):
         self.ctx = ctx
+        self.tally = DetectionTally() if ctx.vision else None
+        self.domain = SearchConfig()
         self.crossing_seen: dict = {}
         self.crossing_stopped: dict = {}
         self.false_stops = 0
@@ -180,10 +191,31 @@ class PedestrianScorer:
                 obstacle and obstacle.kind is ObjectKind.VEHICLE):
             self.false_stops += 1
         self._stopped = stopped
+        if self.tally is not None and debug is not None:
+            self._score_detections(debug, gt)
+
+    def _score_detections(self, debug, gt) -> None:
+        lane, dom = gt.lane, self.domain
+        boxes, ok, ids, ranges = [], [], [], []
+        for o in gt.objects:
+            if o.kind is not ObjectKind.PEDESTRIAN or o.box_px is None:
+                continue
+            yc = true_centre_y(lane, o.position_m[0])
+            inside = (dom.min_range_m <= o.distance_m <= dom.max_range_m
+                      and abs(o.position_m[1] - yc) <= dom.half_width_m)
+            boxes.append(o.box_px)
+            ok.append(inside and eligible(np.asarray(o.box_px), min(max(o.visible, 0.0), 1.0)))
+            ids.append(o.obj_id)
+            ranges.append(o.distance_m)
+        people = debug.reported
+        self.tally.add([t.box_px for t in people], [t.score for t in people], boxes, ok, ids, ranges)
 
     def result(self) -> dict:
         stops = [bool(self.crossing_stopped.get(k, False)) for k in sorted(self.crossing_seen)]
-        return {"recall": None, "precision": None, "fppi": None, "first_detection_range_m": None,
+        det = self.tally.result() if self.tally is not None else {}
+        return {"recall": det.get("recall"), "precision": det.get("precision"), "fppi": det.get("fppi"),
+                "recall_by_height": det.get("recall_by_height"),
+                "first_detection_range_m": det.get("first_detection_range_m"),
                 "stops": stops if self.ctx.crossing_pedestrians else None,
                 # false stops (for a person on the verge, or for nothing) are scored where there are pedestrians
                 "false_stops": self.false_stops if self.ctx.pedestrians else None}

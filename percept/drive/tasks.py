@@ -26,13 +26,14 @@ class Slot(Protocol):
 
 @dataclass(frozen=True)
 class SlotContext:
-    """What a slot factory may use: the rig, the frame period [s], the landmark map (None without signs); truth is
-    for privileged slots only."""
+    """What a slot factory may use: the rig, the frame period [s], the landmark map (None without signs), the
+    people model of the vision pedestrian slot ('sim', 'inria' or a file); truth is for privileged slots only."""
 
     rig: StereoRig
     dt_s: float
     landmarks: LandmarkMap | None
     truth: TruthFeed
+    detector: str = "sim"
 
 
 @dataclass(frozen=True)
@@ -80,6 +81,18 @@ def _sgbm_peer(frames: list):
     return sgbm_full_frame(frames)
 
 
+def _pedestrian_slot(ctx: SlotContext) -> Slot:
+    from percept.detection import LinearModel, PedestrianSlot
+
+    return PedestrianSlot(ctx.rig, ctx.dt_s, LinearModel.named(ctx.detector))
+
+
+def _people_peer(frames: list):
+    from .bench import people_detector_full_frame
+
+    return people_detector_full_frame(frames)
+
+
 def _lane_slot(ctx: SlotContext) -> Slot:
     from percept.lanes import LaneSlot
 
@@ -103,9 +116,10 @@ TASKS: tuple[Task, ...] = (
                    Headline("phantom brakes", "phantom_brakes", "{}")),
          help="the lead ahead (following, emergency braking)", budget_ms=3.0, bench_peer=_sgbm_peer),
     Task("pedestrians", "pedestrians", "pedestrians", priv.PrivilegedPedestrians,
-         PedestrianScorer, recorder="percept.review.parts:pedestrians", upstream=("lateral",),
+         PedestrianScorer, vision=_pedestrian_slot, recorder="percept.review.parts:pedestrians", upstream=("lateral",),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}")),
-         help="people in or stepping into the path (braking requests)"),
+         help="people in or stepping into the path (braking requests)", bench_scenario="crossing",
+         bench_peer=_people_peer),
     Task("odometry", "odometry", "odometry", priv.PrivilegedOdometry, OdometryScorer,
          recorder="percept.review.parts:odometry",
          headline=(Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),

@@ -38,6 +38,10 @@ class AutopilotVehicle(IDMVehicle):
         self.speed = max(self.speed, 0.0)
 
 
+SIMULATION_HZ = 15
+"""Simulation steps (and camera frames) per second."""
+
+
 class PerceptEnv(AbstractEnv):
     """Config keys beyond highway-env's: ``scenario`` (a Scenario), ``scenario_seed`` (int), ``autopilot`` (bool)."""
 
@@ -48,8 +52,8 @@ class PerceptEnv(AbstractEnv):
             "observation": {"type": "Kinematics"},  # replaced by NoObservation in define_spaces
             "action": {"type": "ContinuousAction", "acceleration_range": ACCEL_RANGE_MPS2,
                        "steering_range": STEER_RANGE_RAD, "clip": True},
-            "simulation_frequency": 15,
-            "policy_frequency": 15,
+            "simulation_frequency": SIMULATION_HZ,
+            "policy_frequency": SIMULATION_HZ,
             "screen_width": 640,
             "screen_height": 480,
             "scenario": None,

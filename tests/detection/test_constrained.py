@@ -5,7 +5,7 @@ full pyramid's windows over the same scales."""
 import numpy as np
 import pytest
 
-from percept.detection import LinearModel
+from percept.detection import LinearModel, window_of
 from percept.detection.constrained import PERSON_PX, ConstrainedSearch, SearchConfig
 from percept.sensors import EgoPath, ObjectKind, StereoRig, iou
 from percept.sims import SimWorld, WorldConfig
@@ -18,14 +18,6 @@ def crossing_frame():
         w.step(0.0, 0.0)
     frame, gt = w.observe()
     return w.cfg.rig, frame, gt
-
-
-def window_of(box):
-    """The 64x128 detection window around a person's tight box (the person is 96/128 of its height)."""
-    u0, v0, u1, v1 = box
-    h = (v1 - v0) * 128 / PERSON_PX
-    cu = (u0 + u1) / 2
-    return (cu - h / 4, v0 - h * 16 / 128, cu + h / 4, v1 + h * 16 / 128)
 
 
 def test_the_constrained_search_finds_a_far_person_and_skips_most_windows(crossing_frame):
@@ -46,5 +38,5 @@ def test_no_scale_admits_a_person_outside_the_searched_depths():
     search = ConstrainedSearch(StereoRig(), LinearModel.inria(), SearchConfig(min_range_m=10.0, max_range_m=20.0))
     path = EgoPath.straight(10.0)
     # a 2.1 m person at 5 m would be 233 px tall: no window that large is ever scored
-    big = [s for s in search.scales if search._region(float(s), path) is not None and s * PERSON_PX > 150]
+    big = [s for k, s in enumerate(search.scales) if search.region(k, path) is not None and s * PERSON_PX > 150]
     assert not big and np.all(np.diff(search.scales) > 0)

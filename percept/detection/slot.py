@@ -1,0 +1,114 @@
+"""The vision pedestrians slot: the constrained HOG search, tracking on the ground plane, and a braking request
+for the nearest person in the ego path or walking into it.
+
+Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over the corridor (every level once in
+``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
+frame, the neighbouring levels around each tracked person's predicted window. Only confirmed tracks act; a track
+walking sideways counts as walking only when its lateral speed is clear of its own uncertainty (twice its
+standard deviation), so that people standing or walking along the verge do not cause braking. The conflict rule
+is the privileged slot's (``percept.sensors.conflict``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from percept.sensors import BrakingRequest, EgoPath, Frame, ObjectKind, StereoRig
+from percept.sensors.conflict import person_conflict
+
+from .constrained import FEET_MARGIN_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
+from .hog import WINDOW_PX, LinearModel
+from .pyramid import Detection
+from .tracking import PersonTrack, PersonTracker, TrackConfig
+
+DEFAULT_LANE_WIDTH_M = 3.5
+"""Lane width assumed when the path follows no lane [m]."""
+
+
+@dataclass(frozen=True)
+class PedestrianDebug:
+    """detections: this frame's windows (best first); tracks: every track after this frame; levels: the pyramid
+    levels swept over the corridor this frame; stats: the search's window counts (None on a dropped frame);
+    request_track: the track the braking request is for, or None."""
+
+    detections: tuple[Detection, ...]
+    tracks: tuple[PersonTrack, ...]
+    levels: tuple[int, ...]
+    stats: SearchStats | None
+    request_track: int | None
+
+    @property
+    def reported(self) -> tuple[PersonTrack, ...]:
+        """The people the slot reports as seen: confirmed tracks detected within the last few frames (tracks
+        coasting longer still act on braking)."""
+        return tuple(t for t in self.tracks if t.seen)
+
+
+def window_of(person: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    """The detection window around a person box: the person is its middle 96/128 rows, the window is 1:2."""
+    u0, v0, u1, v1 = person
+    h = (v1 - v0) * WINDOW_PX[1] / (WINDOW_PX[1] - 2 * FEET_MARGIN_PX)
+    cu, cv = (u0 + u1) / 2, (v0 + v1) / 2
+    return (cu - h / 4, cv - h / 2, cu + h / 4, cv + h / 2)
+
+
+class PedestrianSlot:
+    """``step(frame, upstream)`` -> (BrakingRequest or None, PedestrianDebug); upstream["lateral"]: the ego path."""
+
+    def __init__(self, rig: StereoRig, dt_s: float, model: LinearModel | None = None,
+                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 4):
+        if sweep_frames < 1:
+            raise ValueError(f"sweep_frames must be at least 1, got {sweep_frames}")
+        self.search = ConstrainedSearch(rig, model if model is not None else LinearModel.inria(), search)
+        self.tracker = PersonTracker(rig, dt_s, tracking)
+        self.sweep_frames = sweep_frames
+        self.cam_x = float(rig.camera_position()[0])
+        self._speed = 0.0
+
+    def reset(self) -> None:
+        self.tracker.reset()
+        self._speed = 0.0
+
+    def _ego_speed(self, frame: Frame) -> float:
+        """The wheel speed, or the last good one when the sample is not a finite, plausible speed."""
+        v = frame.wheel_speed_mps
+        if isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v < 100.0:
+            self._speed = float(v)
+        return self._speed
+
+    def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
+        speed = self._ego_speed(frame)
+        path = upstream.get("lateral") or EgoPath.straight(speed)
+        predicted = self.tracker.predict(speed)
+        if frame.left is None:
+            tracks = self.tracker.update([], [], seen=False)
+            dets, levels, stats = [], (), None
+        else:
+            n = len(self.search.scales)
+            levels = tuple(k for k in range(n) if k % self.sweep_frames == frame.index % self.sweep_frames)
+            dets, stats = self.search.search(frame.left, path, levels, rois=[window_of(b) for b in predicted])
+            tracks = self.tracker.update([person_box(d.box_px) for d in dets], [d.score for d in dets])
+        request, rid = self._request(tracks, path, speed)
+        return request, PedestrianDebug(tuple(dets), tuple(tracks), levels, stats, rid)
+
+    def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
+        lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M
+        best = None
+        for t in tracks:
+            if not t.confirmed:
+                continue
+            x, y = t.position_m
+            vy = t.velocity_mps[1]
+            # walking sideways only when the lateral speed stands clear of its uncertainty
+            vy_eff = vy if abs(vy) > 2 * t.sigma_vy_mps else 0.0
+            c = person_conflict(x, y, vy_eff, float(path.centre_y(x)), lane_w, speed)
+            if c.any and (best is None or x < best[0].position_m[0]):
+                best = (t, c)
+        if best is None:
+            return None, None
+        t, c = best
+        why = "pedestrian in the path" if c.now else "pedestrian stepping into the path"
+        # range: the left camera's depth of the feet; its rate: the person's own x speed less the ego's
+        return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed, why, ObjectKind.PEDESTRIAN,
+                              t.track_id), t.track_id

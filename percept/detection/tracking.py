@@ -1,0 +1,193 @@
+"""People tracked on the ground plane: each detection's feet (the bottom centre of its person box) projected onto
+the road through the rig, a constant-velocity Kalman filter (filterpy) per person over (x, y, vx, vy) in the
+vehicle frame with the ego's own motion as its control input, greedy nearest-neighbour association inside a
+Mahalanobis gate, confirmation after ``confirm_hits`` hits, and coasting through misses and dropped frames.
+
+Ground-contact range: a feet row v below the horizon lies at depth Z = fy h / (v - v_horizon) for a camera h
+above the road, so a row error sigma_v gives sigma_Z = Z^2 sigma_v / (fy h): the measurement noise grows with Z^2.
+References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Tracking and Navigation" (2001), the
+white-noise-acceleration model (ch. 6) and gating (ch. 7).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.common import Q_discrete_white_noise
+from filterpy.kalman import KalmanFilter
+
+from percept.sensors import StereoRig
+
+Box = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class TrackConfig:
+    """confirm_hits: hits before a track is reported; max_misses: frames a track coasts without a detection (it
+    keeps acting on braking); report_misses: frames without a detection after which it is no longer reported as
+    seen;
+    accel_mps2: the people's white-noise acceleration [m/s²]; row_sigma_frac: feet-row noise as a fraction of the
+    person's height; col_sigma_frac: column noise as a fraction of the height; gate_chi2: squared Mahalanobis
+    gate (2 degrees of freedom, 99 %)."""
+
+    confirm_hits: int = 3
+    max_misses: int = 8
+    report_misses: int = 2
+    accel_mps2: float = 0.7
+    row_sigma_frac: float = 0.05
+    col_sigma_frac: float = 0.08
+    gate_chi2: float = 9.21
+
+
+@dataclass(frozen=True)
+class PersonTrack:
+    """A tracked person. track_id; position_m: (x, y) of the feet in the vehicle frame [m]; velocity_mps: (vx, vy)
+    over the ground [m/s] (the ego's own motion removed); sigma_vy_mps: standard deviation of vy; height_m: the
+    person's estimated height; box_px: (u0, v0, u1, v1) the person box in the left image (predicted when not seen
+    this frame); score: the last detection's score; hits; misses: frames since the last detection; confirmed;
+    seen: confirmed and detected within the last ``report_misses`` frames (what the slot reports as seen)."""
+
+    track_id: int
+    position_m: tuple[float, float]
+    velocity_mps: tuple[float, float]
+    sigma_vy_mps: float
+    height_m: float
+    box_px: Box
+    score: float
+    hits: int
+    misses: int
+    confirmed: bool
+    seen: bool
+
+
+class _Track:
+    def __init__(self, tid: int, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float,
+                 cfg: TrackConfig):
+        kf = KalmanFilter(dim_x=4, dim_z=2)
+        kf.x = np.array([xy[0], xy[1], 0.0, 0.0])
+        kf.H = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
+        kf.P = np.diag([r[0, 0], r[1, 1], 4.0, 2.0])
+        self.kf, self.id, self.height_m, self.box, self.score = kf, tid, height_m, box, score
+        self.hits, self.misses, self.cfg = 1, 0, cfg
+
+    def predict(self, dt: float, ego_speed_mps: float) -> None:
+        kf = self.kf
+        kf.F = np.array([[1.0, 0, dt, 0], [0, 1.0, 0, dt], [0, 0, 1.0, 0], [0, 0, 0, 1.0]])
+        kf.Q = Q_discrete_white_noise(2, dt, self.cfg.accel_mps2 ** 2, block_size=2, order_by_dim=False)
+        # x_k+1 = x_k + vx dt - v_ego dt: the ego's own travel moves everything back
+        kf.predict(u=np.array([ego_speed_mps * dt]), B=np.array([[-1.0], [0.0], [0.0], [0.0]]))
+
+    def update(self, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float) -> None:
+        self.kf.update(xy, R=r)
+        # the height: a running mean of the per-frame estimates
+        self.height_m += (height_m - self.height_m) / min(self.hits + 1, 10)
+        self.box, self.score = box, score
+        self.hits += 1
+        self.misses = 0
+
+
+class PersonTracker:
+    """Detections (person boxes in the left image) -> tracked people on the ground plane."""
+
+    def __init__(self, rig: StereoRig, dt_s: float, cfg: TrackConfig = TrackConfig()):
+        self.rig, self.dt_s, self.cfg = rig, dt_s, cfg
+        self.cam_x = float(rig.camera_position()[0])
+        self.tracks: list[_Track] = []
+        self._next_id = 1
+
+    def reset(self) -> None:
+        self.tracks, self._next_id = [], 1
+
+    def measure(self, box: Box) -> tuple[np.ndarray, np.ndarray, float] | None:
+        """A person box -> feet (x, y) [m], its 2x2 covariance and the person's height [m]; None above the
+        horizon or nearer than the camera."""
+        cam, h_cam = self.rig.camera, self.rig.mount_height_m
+        u0, v0, u1, v1 = box
+        h_px = v1 - v0
+        dv = v1 - self.rig.horizon_row
+        if dv < 1.0:
+            return None
+        xy = self.rig.image_to_ground(np.array([[(u0 + u1) / 2, v1]]))[0]
+        z = xy[0] - self.cam_x
+        if z <= 0.5:
+            return None
+        # sigma_Z = Z^2 sigma_v / (fy h); sigma_Y = Z sigma_u / fx
+        s_x = max(z * z * self.cfg.row_sigma_frac * h_px / (cam.fy * h_cam), 0.1)
+        s_y = max(z * self.cfg.col_sigma_frac * h_px / cam.fx, 0.05)
+        # H = h_px Z / fy
+        return xy, np.diag([s_x * s_x, s_y * s_y]), float(h_px * z / cam.fy)
+
+    def predicted_box(self, t: _Track) -> Box:
+        """The person box the track predicts in the left image: its feet projected, its height above them."""
+        x, y = t.kf.x[0], t.kf.x[1]
+        pts = np.array([[x, y, 0.0], [x, y, t.height_m]])
+        uv, _ = self.rig.project_vehicle_points(pts)
+        h = max(uv[0, 1] - uv[1, 1], 1.0)
+        cu = uv[0, 0]
+        return (cu - 0.2 * h, uv[0, 1] - h, cu + 0.2 * h, uv[0, 1])
+
+    def predict(self, ego_speed_mps: float) -> list[Box]:
+        """Advance every track one frame; the predicted person boxes (for the search's regions of interest)."""
+        for t in self.tracks:
+            t.predict(self.dt_s, ego_speed_mps)
+        boxes = [self.predicted_box(t) for t in self.tracks]
+        # a track that has walked (or been driven) out of the image, or behind the camera, has gone
+        w = self.rig.camera.width
+        keep = [i for i, (t, b) in enumerate(zip(self.tracks, boxes)) if t.kf.x[0] - self.cam_x > 0.5
+                and b[2] > 0 and b[0] < w]
+        self.tracks = [self.tracks[i] for i in keep]
+        return [boxes[i] for i in keep]
+
+    def update(self, boxes: list[Box], scores: list[float], seen: bool = True) -> list[PersonTrack]:
+        """Associate this frame's person boxes with the predicted tracks; ``seen`` False (a dropped frame): no
+        detections and no misses counted."""
+        meas = [(m, b, s) for b, s in zip(boxes, scores) if (m := self.measure(b)) is not None]
+        pairs = self._associate(meas)
+        used = set()
+        for ti, mi in pairs:
+            (xy, r, hm), b, s = meas[mi]
+            self.tracks[ti].update(xy, r, hm, b, s)
+            used.add(mi)
+        matched = {ti for ti, _ in pairs}
+        for i, t in enumerate(self.tracks):
+            if seen and i not in matched:
+                t.misses += 1
+        self.tracks = [t for t in self.tracks if t.misses <= self.cfg.max_misses]
+        for mi, ((xy, r, hm), b, s) in enumerate(meas):
+            if mi not in used:
+                self.tracks.append(_Track(self._next_id, xy, r, hm, b, s, self.cfg))
+                self._next_id += 1
+        return [self._public(t) for t in self.tracks]
+
+    def _associate(self, meas: list) -> list[tuple[int, int]]:
+        """Greedy pairs (track, measurement) by squared Mahalanobis distance inside the gate."""
+        cands = []
+        for ti, t in enumerate(self.tracks):
+            hx = t.kf.H @ t.kf.x
+            hp = t.kf.H @ t.kf.P @ t.kf.H.T
+            for mi, ((xy, r, _), _, _) in enumerate(meas):
+                d = xy - hx
+                # d^2 = (z - H x)^T S^-1 (z - H x), S = H P H^T + R
+                d2 = float(d @ np.linalg.solve(hp + r, d))
+                if d2 <= self.cfg.gate_chi2:
+                    cands.append((d2, ti, mi))
+        pairs, tu, mu = [], set(), set()
+        for _, ti, mi in sorted(cands):
+            if ti not in tu and mi not in mu:
+                pairs.append((ti, mi))
+                tu.add(ti)
+                mu.add(mi)
+        return pairs
+
+    def _public(self, t: _Track) -> PersonTrack:
+        x = t.kf.x
+        box = t.box if t.misses == 0 else self.predicted_box(t)
+        w, h = self.rig.camera.width, self.rig.camera.height
+        # boxes are of what the image shows: clipped to it
+        box = (min(max(box[0], 0.0), w), min(max(box[1], 0.0), h), min(max(box[2], 0.0), w), min(max(box[3], 0.0), h))
+        return PersonTrack(t.id, (float(x[0]), float(x[1])), (float(x[2]), float(x[3])),
+                           float(np.sqrt(max(t.kf.P[3, 3], 0.0))), float(t.height_m),
+                           tuple(float(c) for c in box), float(t.score), t.hits, t.misses,
+                           t.hits >= self.cfg.confirm_hits,
+                           t.hits >= self.cfg.confirm_hits and t.misses <= self.cfg.report_misses)

@@ -1,0 +1,37 @@
+"""Rendered frames with their ground truth, from a closed-loop run on the privileged slots (so the ego drives as a
+perfect stack would: it stops for people, follows leads). Used to measure how the renderer looks to a detector,
+to collect training crops for the sim-trained people model and to score detectors frame by frame.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from percept.sims import WorldConfig, check_condition
+
+from .config import DriveConfig
+from .loop import run_drive
+
+FrameFn = Callable[[int, object, object], None]
+"""fn(seed, frame, ground_truth): called with each sampled ``Frame`` and its ``GroundTruth``."""
+
+
+class _Sampler:
+    def __init__(self, seed: int, every: int, fn: FrameFn):
+        self.seed, self.every, self.fn = seed, every, fn
+
+    def log_step(self, frame, truth, step) -> None:
+        if frame.index % self.every == 0 and frame.left is not None:
+            self.fn(self.seed, frame, truth.truth)
+
+
+def for_each_frame(scenario: str, seeds, fn: FrameFn, every: int = 1, condition: str = "clear",
+                   duration_s: float | None = None) -> None:
+    """Drive ``scenario`` on the privileged slots for each seed and call ``fn`` on every ``every``-th rendered
+    frame (dropped frames are skipped)."""
+    if every < 1:
+        raise ValueError(f"every must be a positive frame count, got {every}")
+    cond = check_condition(condition)
+    for seed in seeds:
+        cfg = DriveConfig(WorldConfig(scenario, seed=int(seed), condition=cond), duration_s=duration_s)
+        run_drive(cfg, recorder_factory=lambda world, s=int(seed): _Sampler(s, every, fn))

@@ -1,0 +1,53 @@
+"""The vision pedestrians slot: in the closed loop it stops for a crossing person and its reported people are
+scored against the truth; dropped frames, a black frame and a NaN wheel speed degrade gracefully."""
+
+import math
+
+import numpy as np
+import pytest
+
+from percept.detection import PedestrianSlot
+from percept.drive import DriveConfig, run_drive
+from percept.sensors import EgoPath, Frame, ImuSample, StereoRig
+from percept.sims import WorldConfig
+
+
+@pytest.fixture(scope="module")
+def crossing_run():
+    # seed 3: a person crosses in front of the ego within the first 32 s
+    return run_drive(DriveConfig(WorldConfig("crossing", seed=3), duration_s=32.0,
+                                 sources={"pedestrians": "vision"}))
+
+
+def test_the_car_stops_for_the_crossing_person_on_vision(crossing_run):
+    r = crossing_run
+    p = r["pedestrians"]
+    assert r["pedestrian_collisions"] == 0 and r["collisions"] == 0
+    assert p["stops"] and all(p["stops"]), p
+    assert p["false_stops"] == 0 and r["longitudinal"]["phantom_brakes"] == 0
+    assert p["detector"] == "sim" and r["timing_ms"]["pedestrians"] > 0
+
+
+def test_its_people_are_scored_against_the_truth(crossing_run):
+    p = crossing_run["pedestrians"]
+    assert p["recall"] >= 0.8 and p["precision"] >= 0.8 and p["fppi"] <= 0.1, p
+    assert set(p["recall_by_height"]) == {"24-40", ">=40"}
+    assert 20.0 <= p["first_detection_range_m"] <= 41.0
+
+
+def frame(index: int, left, speed: float = 10.0) -> Frame:
+    return Frame(index, index / 15, left, left, ImuSample(np.zeros(3), np.zeros(3)), speed)
+
+
+def test_dropped_and_black_frames_and_a_nan_wheel_speed_degrade_gracefully():
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(10.0)
+    black = np.zeros((480, 640, 3), np.uint8)
+    request, debug = slot.step(frame(0, black), {"lateral": path})
+    assert request is None and debug.detections == () and debug.stats.windows > 0
+    request, debug = slot.step(frame(1, None), {"lateral": path})  # dropped: nothing searched
+    assert request is None and debug.stats is None and debug.levels == ()
+    request, debug = slot.step(frame(2, black, speed=math.nan), {})  # no path: a straight corridor
+    assert request is None and slot._speed == 10.0  # the last good wheel speed is kept
+    with pytest.raises(ValueError, match="sweep_frames"):
+        PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=0)
