@@ -51,7 +51,7 @@ class SearchConfig:
     min_range_m: float = 4.0
     max_range_m: float = 40.0
     half_width_m: float = 5.5
-    step: float = 1.1
+    step: float = 1.2
     cell_px: int = 4
     threshold: float = 0.0
     group_threshold: int = 1
@@ -126,17 +126,17 @@ class ConstrainedSearch:
             return None
         return b
 
-    def level_of(self, window: Box) -> int:
-        """The level whose window height is nearest that of ``window``."""
+    def levels_around(self, window: Box) -> range:
+        """The two levels whose window heights bracket that of ``window`` (one at the ends of the pyramid)."""
         k = np.log((window[3] - window[1]) / WINDOW_PX[1] / self.scales[0]) / np.log(self.cfg.step)
-        return int(np.clip(np.round(k), 0, len(self.scales) - 1))
+        lo = int(np.clip(np.floor(k), 0, len(self.scales) - 1))
+        return range(lo, min(lo + 2, len(self.scales)))
 
     def _roi_regions(self, rois: Sequence[Box]) -> list[tuple[int, tuple[int, int, int, int]]]:
-        """(level, region) around each predicted window: its level and the next ones, half a window either side."""
+        """(level, region) around each predicted window: the levels bracketing it, half a window either side."""
         out = []
         for r in rois:
-            k0 = self.level_of(r)
-            for k in range(max(k0 - 1, 0), min(k0 + 2, len(self.scales))):
+            for k in self.levels_around(r):
                 s = float(self.scales[k])
                 cu, cv = (r[0] + r[2]) / 2, (r[1] + r[3]) / 2
                 # the window at this scale, centred on the prediction, grown by half a window either way

@@ -1,5 +1,6 @@
-"""The vision pedestrians slot: the constrained HOG search, tracking on the ground plane, and a braking request
-for the nearest person in the ego path or walking into it.
+"""The vision pedestrians slot: the constrained HOG search, each person's range from their ground contact and the
+stereo pair, tracking on the ground plane, and a braking request for the nearest person in the ego path or
+walking into it.
 
 Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over the corridor (every level once in
 ``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
@@ -14,12 +15,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import cv2
+
 from percept.sensors import BrakingRequest, EgoPath, Frame, ObjectKind, StereoRig
 from percept.sensors.conflict import person_conflict
 
 from .constrained import FEET_MARGIN_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
 from .hog import WINDOW_PX, LinearModel
 from .pyramid import Detection
+from .stereo_range import box_depth
 from .tracking import PersonTrack, PersonTracker, TrackConfig
 
 DEFAULT_LANE_WIDTH_M = 3.5
@@ -57,7 +61,7 @@ class PedestrianSlot:
     """``step(frame, upstream)`` -> (BrakingRequest or None, PedestrianDebug); upstream["lateral"]: the ego path."""
 
     def __init__(self, rig: StereoRig, dt_s: float, model: LinearModel | None = None,
-                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 4):
+                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 6):
         if sweep_frames < 1:
             raise ValueError(f"sweep_frames must be at least 1, got {sweep_frames}")
         self.search = ConstrainedSearch(rig, model if model is not None else LinearModel.inria(), search)
@@ -88,9 +92,22 @@ class PedestrianSlot:
             n = len(self.search.scales)
             levels = tuple(k for k in range(n) if k % self.sweep_frames == frame.index % self.sweep_frames)
             dets, stats = self.search.search(frame.left, path, levels, rois=[window_of(b) for b in predicted])
-            tracks = self.tracker.update([person_box(d.box_px) for d in dets], [d.score for d in dets])
+            boxes = [person_box(d.box_px) for d in dets]
+            tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame, boxes))
         request, rid = self._request(tracks, path, speed)
         return request, PedestrianDebug(tuple(dets), tuple(tracks), levels, stats, rid)
+
+    def _stereo(self, frame: Frame, boxes: list) -> list:
+        """Each box's stereo depth (Z, sigma_Z) [m], searched about its ground-contact depth; None where it fails."""
+        if not boxes or frame.right is None:
+            return [None] * len(boxes)
+        left = cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY)
+        right = cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY)
+        out = []
+        for b in boxes:
+            m = self.tracker.measure(b)
+            out.append(None if m is None else box_depth(left, right, b, self.tracker.rig, m[0][0] - self.cam_x))
+        return out
 
     def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M

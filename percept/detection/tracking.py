@@ -17,7 +17,7 @@ import numpy as np
 from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
-from percept.sensors import StereoRig
+from percept.sensors import StereoRig, iou_matrix
 
 Box = tuple[float, float, float, float]
 
@@ -70,6 +70,7 @@ class _Track:
         kf.P = np.diag([r[0, 0], r[1, 1], 4.0, 2.0])
         self.kf, self.id, self.height_m, self.box, self.score = kf, tid, height_m, box, score
         self.hits, self.misses, self.cfg = 1, 0, cfg
+        self.predicted = box  # the person box predicted for the current frame
 
     def predict(self, dt: float, ego_speed_mps: float) -> None:
         kf = self.kf
@@ -99,24 +100,36 @@ class PersonTracker:
     def reset(self) -> None:
         self.tracks, self._next_id = [], 1
 
-    def measure(self, box: Box) -> tuple[np.ndarray, np.ndarray, float] | None:
-        """A person box -> feet (x, y) [m], its 2x2 covariance and the person's height [m]; None above the
-        horizon or nearer than the camera."""
+    def measure(self, box: Box, stereo: tuple[float, float] | None = None
+                ) -> tuple[np.ndarray, np.ndarray, float] | None:
+        """A person box (and, when given, its stereo depth and standard deviation [m]) -> feet (x, y) [m], its 2x2
+        covariance and the person's height [m]; None above the horizon or nearer than the camera. Ground contact
+        and stereo are fused by their inverse variances."""
         cam, h_cam = self.rig.camera, self.rig.mount_height_m
         u0, v0, u1, v1 = box
         h_px = v1 - v0
-        dv = v1 - self.rig.horizon_row
-        if dv < 1.0:
+        if v1 - self.rig.horizon_row < 1.0:
             return None
         xy = self.rig.image_to_ground(np.array([[(u0 + u1) / 2, v1]]))[0]
         z = xy[0] - self.cam_x
         if z <= 0.5:
             return None
-        # sigma_Z = Z^2 sigma_v / (fy h); sigma_Y = Z sigma_u / fx
-        s_x = max(z * z * self.cfg.row_sigma_frac * h_px / (cam.fy * h_cam), 0.1)
+        # sigma_Z = Z^2 sigma_v / (fy h)
+        var_z = max(z * z * self.cfg.row_sigma_frac * h_px / (cam.fy * h_cam), 0.1) ** 2
+        if stereo is not None:
+            z_s, s_s = stereo
+            # inverse-variance fusion: z = (z_g / s_g^2 + z_s / s_s^2) / (1 / s_g^2 + 1 / s_s^2)
+            w_g, w_s = 1.0 / var_z, 1.0 / (s_s * s_s)
+            z_new = (z * w_g + z_s * w_s) / (w_g + w_s)
+            var_z = 1.0 / (w_g + w_s)
+            # the same ray from the camera, at the fused depth
+            cy = float(self.rig.camera_position()[1])
+            xy = np.array([self.cam_x + z_new, cy + (xy[1] - cy) * z_new / z])
+            z = z_new
+        # sigma_Y = Z sigma_u / fx
         s_y = max(z * self.cfg.col_sigma_frac * h_px / cam.fx, 0.05)
         # H = h_px Z / fy
-        return xy, np.diag([s_x * s_x, s_y * s_y]), float(h_px * z / cam.fy)
+        return xy, np.diag([var_z, s_y * s_y]), float(h_px * z / cam.fy)
 
     def predicted_box(self, t: _Track) -> Box:
         """The person box the track predicts in the left image: its feet projected, its height above them."""
@@ -137,12 +150,16 @@ class PersonTracker:
         keep = [i for i, (t, b) in enumerate(zip(self.tracks, boxes)) if t.kf.x[0] - self.cam_x > 0.5
                 and b[2] > 0 and b[0] < w]
         self.tracks = [self.tracks[i] for i in keep]
+        for t, b in zip(self.tracks, [boxes[i] for i in keep]):
+            t.predicted = b
         return [boxes[i] for i in keep]
 
-    def update(self, boxes: list[Box], scores: list[float], seen: bool = True) -> list[PersonTrack]:
-        """Associate this frame's person boxes with the predicted tracks; ``seen`` False (a dropped frame): no
-        detections and no misses counted."""
-        meas = [(m, b, s) for b, s in zip(boxes, scores) if (m := self.measure(b)) is not None]
+    def update(self, boxes: list[Box], scores: list[float], seen: bool = True,
+               stereo: list | None = None) -> list[PersonTrack]:
+        """Associate this frame's person boxes (with their stereo depths, None where unmatched) with the predicted
+        tracks; ``seen`` False (a dropped frame): no detections and no misses counted."""
+        stereo = stereo if stereo is not None else [None] * len(boxes)
+        meas = [(m, b, s) for b, s, z in zip(boxes, scores, stereo) if (m := self.measure(b, z)) is not None]
         pairs = self._associate(meas)
         used = set()
         for ti, mi in pairs:
@@ -155,7 +172,9 @@ class PersonTracker:
                 t.misses += 1
         self.tracks = [t for t in self.tracks if t.misses <= self.cfg.max_misses]
         for mi, ((xy, r, hm), b, s) in enumerate(meas):
-            if mi not in used:
+            # a detection on a person already tracked (a second window on them) starts no track of its own
+            taken = [t.box if t.misses == 0 else t.predicted for t in self.tracks]
+            if mi not in used and not (taken and iou_matrix(np.array([b]), np.array(taken)).max() > 0.3):
                 self.tracks.append(_Track(self._next_id, xy, r, hm, b, s, self.cfg))
                 self._next_id += 1
         return [self._public(t) for t in self.tracks]
@@ -182,7 +201,7 @@ class PersonTracker:
 
     def _public(self, t: _Track) -> PersonTrack:
         x = t.kf.x
-        box = t.box if t.misses == 0 else self.predicted_box(t)
+        box = t.box if t.misses == 0 else t.predicted
         w, h = self.rig.camera.width, self.rig.camera.height
         # boxes are of what the image shows: clipped to it
         box = (min(max(box[0], 0.0), w), min(max(box[1], 0.0), h), min(max(box[2], 0.0), w), min(max(box[3], 0.0), h))

@@ -212,7 +212,7 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
 
 
 def _stats(values: list) -> dict | None:
-    v = [x for x in values if x is not None and not isinstance(x, (list, dict, bool))]
+    v = [x for x in values if x is not None and not isinstance(x, (list, dict, bool, str))]
     if not v:
         return None
     a = np.asarray(v, dtype=float)

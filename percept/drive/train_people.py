@@ -87,9 +87,10 @@ class _Collector:
                 continue
             w = window_of(o.box_px)
             hw = w[3] - w[1]
-            # a copy moved and resized by up to a stride and half a scale step
-            d = self.rng.uniform(-0.04, 0.04, 3) * hw
-            for win in (w, (w[0] + d[0], w[1] + d[1] - d[2], w[2] + d[0], w[3] + d[1] + d[2])):
+            # a copy moved by up to a stride and resized by up to half the search's scale step
+            half_step = (self.plan.search.step - 1.0) / 2
+            d = self.rng.uniform(-1.0, 1.0, 3) * np.array([0.04, 0.04, half_step / 2]) * hw
+            for win in (w, (w[0] + d[0] - d[2] / 2, w[1] + d[1] - d[2], w[2] + d[0] + d[2] / 2, w[3] + d[1] + d[2])):
                 crop = window_crop(image, win)
                 if crop is not None:
                     self.pos.append(crop)

@@ -20,6 +20,8 @@ over trunk, shirt over trousers, face over hair), never by rounding noise.
 from __future__ import annotations
 
 import math
+import os
+EXP = set(os.environ.get('PEDEXP', '').split(','))
 
 import numpy as np
 
@@ -62,7 +64,7 @@ class _Figure:
         d[2] = 0.0
         return p + bias * d / (np.linalg.norm(d) + 1e-12)
 
-    def limb(self, p0, p1, r0: float, r1: float, color, bias: float = 0.0, caps: tuple = (True, True)) -> None:
+    def limb(self, p0, p1, r0: float, r1: float, color, bias: float = 0.0, caps: tuple = (True, True), shade: float = 1.0) -> None:
         """A tapered view-facing quad from p0 (half-width r0) to p1 (half-width r1) with round caps.
 
         Each half (either side of the axis) is a rectangle plus a parallelogram for the taper; the half
@@ -81,13 +83,13 @@ class _Figure:
         if r0 > 1.9 * r1:  # too steep a taper for one rectangle + parallelogram per half: split it
             rm = r0 / 1.8
             pm = p0 + (r0 - rm) / (r0 - r1) * axis
-            self.limb(p0, pm, r0, rm, color, caps=(caps[0], False))
-            self.limb(pm, p1, rm, r1, color, caps=(False, caps[1]))
+            self.limb(p0, pm, r0, rm, color, caps=(caps[0], False), shade=shade)
+            self.limb(pm, p1, rm, r1, color, caps=(False, caps[1]), shade=shade)
             return
         lit = 1.0 if side @ SUN_DIR >= 0 else -1.0
         for sgn in (lit, -lit):
             s = sgn * side
-            k = 1.0 + (0.13 * abs(float(side @ SUN_DIR)) + 0.04) * (1 if sgn == lit else -1)
+            k = 1.0 + shade * float(os.environ.get('SHADE', '1')) * (0.13 * abs(float(side @ SUN_DIR)) + 0.04) * (1 if sgn == lit else -1)
             col = tuple(min(255.0, c * k) for c in color)
             # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
             over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
@@ -204,8 +206,15 @@ def _legs(fig: _Figure, body: _Body) -> None:
     hip_z, thigh, shank = 0.53 * h, 0.245 * h, 0.246 * h
     foot_l, ankle_h = 0.155 * h, 0.039 * h
     for sgn, cl in body.sides:
+        far = float(sgn * left @ body.vdir) < 0
+        dk = 0.75 if ("far" in EXP and far) else 1.0
+        pants, skin = _scaled(body.pants, dk), _scaled(body.skin, dk)
         if body.walking:
-            a, knee_flex, toe_down = (math.radians(float(np.interp(cl, GAIT_C, t))) for t in (HIP, KNEE, FOOT))
+            tabs = [np.array(eval(os.environ[n])) if n in os.environ else t for n, t in (("THIP", HIP), ("TKNEE", KNEE), ("TFOOT", FOOT))]
+            a, knee_flex, toe_down = (math.radians(float(np.interp(cl, GAIT_C, t))) for t in tabs)
+            knee_flex *= float(os.environ.get("KNEE", "1"))
+            toe_down *= float(os.environ.get("FOOTK", "1"))
+            a *= float(os.environ.get("HIPK", "1"))
             stance_y = 0.05 * h
         else:
             a, knee_flex, toe_down, stance_y = 0.02 * sgn, 0.03, 0.0, 0.055 * h
@@ -215,12 +224,12 @@ def _legs(fig: _Figure, body: _Body) -> None:
         ankle = knee + shank * seg(b_ang)
         if body.shorts:
             mid = hip + 0.55 * thigh * seg(a)
-            fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, bias=0.005)
-            fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, body.skin, bias=0.004, caps=(False, True))
-            fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, bias=0.005)
+            fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, pants, bias=0.005)
+            fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, skin, bias=0.004, caps=(False, True))
+            fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, skin, bias=0.005)
         else:
-            fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, bias=0.005)
-            fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, bias=0.005)
+            fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, pants, bias=0.005)
+            fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, pants, bias=0.005)
         # the shoe, pitched toe-down at heel-off and toe-up at heel strike
         f_dir = math.cos(toe_down) * fwd - math.sin(toe_down) * UP
         f_up = math.sin(toe_down) * fwd + math.cos(toe_down) * UP
@@ -232,14 +241,15 @@ def _legs(fig: _Figure, body: _Body) -> None:
 def _trunk(fig: _Figure, body: _Body) -> None:
     """Pelvis (trousers), torso (shirt) with a lighter chest, shoulders sloping to the neck."""
     trunk, across, hips, shirt = body.trunk, body.across, body.hips, body.shirt
+    TS = 0.0 if "trunk0" in EXP else 1.0
     fig.limb(trunk(0.465, -0.004), trunk(0.6), across(0.098, 0.086, hips), across(0.086, 0.079, hips),
-             body.pants, caps=(False, False))
+             body.pants, caps=(False, False), shade=TS)
     fig.limb(trunk(0.54), trunk(0.67, 0.006), across(0.09, 0.082, hips), across(0.086, 0.082, hips),
-             _scaled(shirt, 0.95), bias=0.01, caps=(False, False))
+             _scaled(shirt, 0.95), bias=0.01, caps=(False, False), shade=TS)
     fig.limb(trunk(0.665, 0.006), trunk(0.785, 0.004), across(0.087, 0.084), across(0.104, 0.09),
-             shirt, bias=0.01, caps=(False, False))
+             shirt, bias=0.01, caps=(False, False), shade=TS)
     fig.limb(trunk(0.78, 0.004), trunk(0.845), across(0.125, 0.086), across(0.055, 0.058),
-             shirt, bias=0.011, caps=(False, False))
+             shirt, bias=0.011, caps=(False, False), shade=TS)
 
 
 def _head(fig: _Figure, body: _Body) -> None:
@@ -270,9 +280,12 @@ def _arms(fig: _Figure, body: _Body) -> None:
     build, hips, skin = body.build, body.hips, body.skin
     sleeve = _scaled(body.shirt, 0.93)
     for sgn, cl in body.sides:
+        far = float(sgn * left @ body.vdir) < 0
+        dk = 0.75 if ("far" in EXP and far) else 1.0
+        sleeve, skin = _scaled(_scaled(body.shirt, 0.93), dk), _scaled(body.skin, dk)
         if body.walking:
             hip_a = math.radians(float(np.interp(cl, GAIT_C, HIP)))
-            a = -0.8 * (hip_a - math.radians(9.0))
+            a = -(1.3 if "swing" in EXP else 0.8) * (hip_a - math.radians(9.0))
             a2 = a + 0.3 + 0.8 * max(0.0, a)
         else:
             a, a2 = 0.0, 0.12
@@ -296,5 +309,7 @@ def pedestrian_patches(b: PatchBuilder, obj: ObjectState, view_world: np.ndarray
     fig = _Figure(view, obj.obj_id)
     # the patches in the order they have always been added (legs, trunk, head, arms): it is part of the output
     for part in (_legs, _trunk, _head, _arms):
+        if part.__name__.strip("_") in EXP:
+            continue
         part(fig, body)
     fig.emit(b)

@@ -1,0 +1,48 @@
+"""A person's stereo depth: a textured patch shifted by a known disparity is recovered to a fraction of a pixel;
+featureless or ambiguous patches give nothing."""
+
+import cv2
+import numpy as np
+import pytest
+
+from percept.detection.stereo_range import box_depth
+from percept.sensors import StereoRig
+
+
+def pair(disparity_px: float, texture: bool = True):
+    """A left image with a textured 'person' block on a textured background, the right image with the block
+    shifted left by the disparity (the background at a fifth of it)."""
+    rng = np.random.default_rng(3)
+    # smooth texture, as a rendered or photographed surface has (white noise would lock to whole pixels)
+    bg = cv2.GaussianBlur(rng.integers(40, 160, (480, 900)).astype(np.float32), (0, 0), 1.5)
+    person = (cv2.GaussianBlur(rng.integers(0, 255, (120, 50)).astype(np.float32), (0, 0), 1.5) * 2 - 60
+              if texture else np.full((120, 50), 90.0))
+    left, right = bg[:, 100:740].copy(), np.empty((480, 640), np.float32)
+    u = np.arange(640, dtype=np.float32)
+    for v in range(480):  # the background further away: a fifth of the disparity
+        right[v] = np.interp(u + disparity_px / 5, np.arange(900) - 100.0, bg[v])
+    left[200:320, 300:350] = person
+    xs = np.arange(50, dtype=np.float32)
+    for v in range(120):
+        right[200 + v, 280:360] = np.interp(np.arange(280, 360) + disparity_px - 300.0, xs, person[v])
+    return left.astype(np.uint8), right.astype(np.uint8)
+
+
+@pytest.mark.parametrize("d", [8.3, 14.6, 30.2])
+def test_the_depth_of_a_shifted_patch(d):
+    rig = StereoRig()
+    fb = rig.camera.fx * rig.baseline_m
+    left, right = pair(d)
+    z, sigma = box_depth(left, right, (300.0, 200.0, 350.0, 320.0), rig, z_guess_m=fb / d * 1.2)
+    assert fb / z == pytest.approx(d, abs=0.15)
+    # sigma_Z = Z^2 sigma_d / (f b)
+    assert sigma == pytest.approx(z * z * 0.4 / fb)
+
+
+def test_featureless_or_out_of_image_patches_give_nothing():
+    rig = StereoRig()
+    left, right = pair(10.0, texture=False)
+    assert box_depth(left, right, (300.0, 200.0, 350.0, 320.0), rig, 30.0) is None
+    left, right = pair(10.0)
+    assert box_depth(left, right, (-20.0, 200.0, 30.0, 320.0), rig, 30.0) is None
+    assert box_depth(left, right, (300.0, 200.0, 302.0, 320.0), rig, 30.0) is None
