@@ -164,7 +164,9 @@ class PedestrianScorer:
     """Stops for crossing pedestrians and false stops; with the vision slot, its reported people (confirmed tracks'
     boxes) against the true boxes of every frame. A true pedestrian counts (``eligible``: at least 24 px tall and
     half visible) inside the searched domain (the search's depths and corridor about the true lane centre); the
-    others are ignore regions."""
+    others are ignore regions. ``verge_brakes``: hard brakings (below -3 m/s², above a walking pace) that begin on a
+    braking request for a person who is not crossing (the request's person: the truth's id for the privileged slot,
+    the true pedestrian nearest the requesting track for the vision slot)."""
 
     def __init__(self, ctx: ScoreContext):
         self.ctx = ctx
@@ -173,7 +175,9 @@ class PedestrianScorer:
         self.crossing_seen: dict = {}
         self.crossing_stopped: dict = {}
         self.false_stops = 0
+        self.verge_brakes = 0
         self._stopped = False
+        self._braking = False
 
     def update(self, request, debug, step: StepTruth) -> None:
         gt, obstacle = step.truth, step.in_path
@@ -191,8 +195,25 @@ class PedestrianScorer:
                 obstacle and obstacle.kind is ObjectKind.VEHICLE):
             self.false_stops += 1
         self._stopped = stopped
+        braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
+        if braking and not self._braking and request is not None:
+            person = self._requested_person(request, debug, gt)
+            self.verge_brakes += int(person is not None and not person.crossing)
+        self._braking = braking
         if self.tally is not None and debug is not None:
             self._score_detections(debug, gt)
+
+    @staticmethod
+    def _requested_person(request, debug, gt):
+        """The true pedestrian a braking request is for, or None."""
+        people = [o for o in gt.objects if o.kind is ObjectKind.PEDESTRIAN]
+        tracks = {t.track_id: t for t in getattr(debug, "tracks", ())}
+        if request.obj_id in tracks:  # a vision track: the true person nearest it on the ground, within 3 m
+            x, y = tracks[request.obj_id].position_m
+            near = min(people, key=lambda o: np.hypot(o.position_m[0] - x, o.position_m[1] - y), default=None)
+            ok = near is not None and np.hypot(near.position_m[0] - x, near.position_m[1] - y) < 3.0
+            return near if ok else None
+        return next((o for o in people if o.obj_id == request.obj_id), None)
 
     def _score_detections(self, debug, gt) -> None:
         lane, dom = gt.lane, self.domain
@@ -218,7 +239,8 @@ class PedestrianScorer:
                 "first_detection_range_m": det.get("first_detection_range_m"),
                 "stops": stops if self.ctx.crossing_pedestrians else None,
                 # false stops (for a person on the verge, or for nothing) are scored where there are pedestrians
-                "false_stops": self.false_stops if self.ctx.pedestrians else None}
+                "false_stops": self.false_stops if self.ctx.pedestrians else None,
+                "verge_brakes": self.verge_brakes if self.ctx.pedestrians else None}
 
 
 class OdometryScorer:
