@@ -4,9 +4,9 @@ walking into it.
 
 Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over the corridor (every level once in
 ``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
-frame, the neighbouring levels around each tracked person's predicted window. Only confirmed tracks act; a track
-walking sideways counts as walking only when its lateral speed is clear of its own uncertainty (twice its
-standard deviation), so that people standing or walking along the verge do not cause braking. The conflict rule
+frame, the two levels around each tracked person's predicted window. Only confirmed tracks act; a track walking
+sideways counts as walking only when its lateral speed is clear of its own uncertainty (1.5 standard deviations,
+and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause braking. The conflict rule
 is the privileged slot's (``percept.sensors.conflict``).
 """
 
@@ -28,6 +28,8 @@ from .tracking import PersonTrack, PersonTracker, TrackConfig
 
 DEFAULT_LANE_WIDTH_M = 3.5
 """Lane width assumed when the path follows no lane [m]."""
+WALK_MIN_MPS = 0.3
+"""A track's lateral speed below this is standing, whatever its uncertainty [m/s]."""
 
 
 @dataclass(frozen=True)
@@ -118,7 +120,7 @@ class PedestrianSlot:
             x, y = t.position_m
             vy = t.velocity_mps[1]
             # walking sideways only when the lateral speed stands clear of its uncertainty
-            vy_eff = vy if abs(vy) > 2 * t.sigma_vy_mps else 0.0
+            vy_eff = vy if abs(vy) > max(WALK_MIN_MPS, 1.5 * t.sigma_vy_mps) else 0.0
             c = person_conflict(x, y, vy_eff, float(path.centre_y(x)), lane_w, speed)
             if c.any and (best is None or x < best[0].position_m[0]):
                 best = (t, c)

@@ -28,8 +28,9 @@ class TrackConfig:
     keeps acting on braking); report_misses: frames without a detection after which it is no longer reported as
     seen;
     accel_mps2: the people's white-noise acceleration [m/s²]; row_sigma_frac: feet-row noise as a fraction of the
-    person's height; col_sigma_frac: column noise as a fraction of the height; gate_chi2: squared Mahalanobis
-    gate (2 degrees of freedom, 99 %)."""
+    person's height; col_sigma_frac: column noise as a fraction of the height; iou_gate: smallest overlap of a
+    detection with a track's predicted box that pairs them; gate_chi2: squared Mahalanobis gate on the ground (2
+    degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s)."""
 
     confirm_hits: int = 3
     max_misses: int = 8
@@ -37,7 +38,9 @@ class TrackConfig:
     accel_mps2: float = 0.7
     row_sigma_frac: float = 0.05
     col_sigma_frac: float = 0.08
+    iou_gate: float = 0.3
     gate_chi2: float = 9.21
+    sigma_v0_mps: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -67,7 +70,7 @@ class _Track:
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([xy[0], xy[1], 0.0, 0.0])
         kf.H = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
-        kf.P = np.diag([r[0, 0], r[1, 1], 4.0, 2.0])
+        kf.P = np.diag([r[0, 0], r[1, 1], cfg.sigma_v0_mps ** 2, cfg.sigma_v0_mps ** 2])
         self.kf, self.id, self.height_m, self.box, self.score = kf, tid, height_m, box, score
         self.hits, self.misses, self.cfg = 1, 0, cfg
         self.predicted = box  # the person box predicted for the current frame
@@ -180,19 +183,24 @@ class PersonTracker:
         return [self._public(t) for t in self.tracks]
 
     def _associate(self, meas: list) -> list[tuple[int, int]]:
-        """Greedy pairs (track, measurement) by squared Mahalanobis distance inside the gate."""
+        """Greedy pairs (track, measurement): first by the overlap of the detection with the track's predicted box
+        (IoU >= ``iou_gate``: robust to the far field's range noise), then by squared Mahalanobis distance on the
+        ground inside the gate."""
         cands = []
         for ti, t in enumerate(self.tracks):
             hx = t.kf.H @ t.kf.x
             hp = t.kf.H @ t.kf.P @ t.kf.H.T
-            for mi, ((xy, r, _), _, _) in enumerate(meas):
+            for mi, ((xy, r, _), box, _) in enumerate(meas):
+                overlap = float(iou_matrix(np.array([box]), np.array([t.predicted]))[0, 0])
                 d = xy - hx
                 # d^2 = (z - H x)^T S^-1 (z - H x), S = H P H^T + R
                 d2 = float(d @ np.linalg.solve(hp + r, d))
-                if d2 <= self.cfg.gate_chi2:
-                    cands.append((d2, ti, mi))
+                if overlap >= self.cfg.iou_gate:
+                    cands.append((0, -overlap, ti, mi))
+                elif d2 <= self.cfg.gate_chi2:
+                    cands.append((1, d2, ti, mi))
         pairs, tu, mu = [], set(), set()
-        for _, ti, mi in sorted(cands):
+        for _, _, ti, mi in sorted(cands):
             if ti not in tu and mi not in mu:
                 pairs.append((ti, mi))
                 tu.add(ti)
