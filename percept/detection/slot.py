@@ -5,8 +5,8 @@ walking into it.
 Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over the corridor (every level once in
 ``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
 frame, the two levels around each tracked person's predicted window. Only confirmed tracks act; a track walking
-sideways counts as walking only when its lateral speed is clear of its own uncertainty (1.5 standard deviations,
-and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause braking. The conflict rule
+sideways counts as walking only when it has ``WALK_HITS`` detections and its lateral speed is a person's and clear
+of its own uncertainty (1.5 standard deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause braking. The conflict rule
 is the privileged slot's (``percept.sensors.conflict``).
 """
 
@@ -30,6 +30,10 @@ DEFAULT_LANE_WIDTH_M = 3.5
 """Lane width assumed when the path follows no lane [m]."""
 WALK_MIN_MPS = 0.3
 """A track's lateral speed below this is standing, whatever its uncertainty [m/s]."""
+WALK_MAX_MPS = 3.0
+"""A lateral speed above this is no person's walk but a tracking error [m/s]."""
+WALK_HITS = 8
+"""Detections a track needs before its speed is trusted (about half a second)."""
 
 
 @dataclass(frozen=True)
@@ -119,8 +123,11 @@ class PedestrianSlot:
                 continue
             x, y = t.position_m
             vy = t.velocity_mps[1]
-            # walking sideways only when the lateral speed stands clear of its uncertainty
-            vy_eff = vy if abs(vy) > max(WALK_MIN_MPS, 1.5 * t.sigma_vy_mps) else 0.0
+            # walking sideways only when the track is old enough to have a speed, the speed is a person's and it
+            # stands clear of its uncertainty
+            walking = (t.hits >= WALK_HITS and abs(vy) <= WALK_MAX_MPS
+                       and abs(vy) > max(WALK_MIN_MPS, 1.5 * t.sigma_vy_mps))
+            vy_eff = vy if walking else 0.0
             c = person_conflict(x, y, vy_eff, float(path.centre_y(x)), lane_w, speed)
             if c.any and (best is None or x < best[0].position_m[0]):
                 best = (t, c)

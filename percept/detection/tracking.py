@@ -37,7 +37,7 @@ class TrackConfig:
     report_misses: int = 2
     accel_mps2: float = 0.7
     row_sigma_frac: float = 0.05
-    col_sigma_frac: float = 0.08
+    col_sigma_frac: float = 0.15
     iou_gate: float = 0.3
     gate_chi2: float = 9.21
     sigma_v0_mps: float = 1.0
