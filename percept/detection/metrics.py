@@ -151,10 +151,12 @@ class DetectionTally:
         return m
 
     def result(self) -> dict:
-        """score_frames' keys plus ``recall_by_height`` {bin: recall or None} and ``first_detection_range_m`` (the
-        median over objects of the range of their first match, None when none was matched)."""
+        """score_frames' keys plus ``recall_by_height`` {bin: recall or None}, ``matched_by_height`` {bin: [matched,
+        eligible]} (counts, for pooling runs) and ``first_detection_range_m`` (the median over objects of the range
+        of their first match, None when none was matched)."""
         out = score_frames(self.matches)
         out["recall_by_height"] = {k: (h / n if n else None) for k, (h, n) in self.bin_hits.items()}
+        out["matched_by_height"] = {k: [h, n] for k, (h, n) in self.bin_hits.items()}
         first = list(self.first_range_m.values())
         out["first_detection_range_m"] = float(np.median(first)) if first else None
         return out

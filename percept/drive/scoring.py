@@ -236,6 +236,9 @@ class PedestrianScorer:
         det = self.tally.result() if self.tally is not None else {}
         return {"recall": det.get("recall"), "precision": det.get("precision"), "fppi": det.get("fppi"),
                 "recall_by_height": det.get("recall_by_height"),
+                # the counts behind the rates, so that a batch can pool its runs' frames
+                "counts": {k: det[k] for k in ("tp", "fp", "fn", "frames")} | {"by_height": det["matched_by_height"]}
+                if det else None,
                 "first_detection_range_m": det.get("first_detection_range_m"),
                 "stops": stops if self.ctx.crossing_pedestrians else None,
                 # false stops (for a person on the verge, or for nothing) are scored where there are pedestrians
