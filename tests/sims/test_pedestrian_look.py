@@ -4,7 +4,7 @@ Protocol (from the issue): cv2.HOGDescriptor with the default people detector, `
 winStride=(8, 8), padding=(8, 8), scale=1.05)``, default hit threshold (0) and grouping. The ground
 truth is the pedestrian's tight silhouette box grown to the detector's convention: a 1:2 window in
 which the person fills the middle 3/4 of the height. A pedestrian counts as found when a detection
-overlaps that window with IoU >= 0.5. Pedestrians 100-250 px tall must be found at least 80% of the time.
+overlaps that window with IoU >= 0.5. Pedestrians 100-250 px tall must be found at least 90% of the time.
 """
 
 from __future__ import annotations
@@ -111,7 +111,7 @@ def test_inria_people_detector_finds_rendered_pedestrians(road):
                 missed.append((o.obj_id, round(o.pose.yaw_rad, 2), o.speed_mps, box, round(best, 2)))
     total = found + len(missed)
     assert total >= 20
-    assert found / total >= 0.8, f"found {found}/{total}; missed (id, yaw, speed, box, best IoU): {missed}"
+    assert found / total >= 0.9, f"found {found}/{total}; missed (id, yaw, speed, box, best IoU): {missed}"
 
 
 def _outline_points(batch, i: int) -> np.ndarray:
