@@ -15,7 +15,7 @@ def train_detector(
     out: Annotated[Path, typer.Option("--out", dir_okay=False, help="Model file to write (.npz); its training "
                                       "record goes beside it as the same name with .json.")] = Path("people_sim.npz"),
     seeds: Annotated[str, typer.Option("--seeds", help="Training seeds of the crossing scenario (A-B, N or "
-                                       "A,B,C); none may be an evaluation seed (0-19, 100-119).")] = "1000-1011",
+                                       "A,B,C); none may be an evaluation seed (0-19, 100-119).")] = "1000-1009",
     every: Annotated[int, typer.Option("--every", help="Sample every N-th frame, 1 to 100.")] = 3,
     duration: opt.Duration = None,
     c: Annotated[float, typer.Option("--c", help="The linear SVM's C (regularisation), 1e-5 to 10.")] = 0.01,

@@ -31,7 +31,7 @@ class TrainPlan:
     hard negatives kept per frame; c: the SVM's C; jitter_seed: the random generator's seed."""
 
     scenario: str = "crossing"
-    seeds: tuple[int, ...] = tuple(range(1000, 1012))
+    seeds: tuple[int, ...] = tuple(range(1000, 1010))
     conditions: tuple[str, ...] = ("clear", "night", "rain")
     every: int = 3
     duration_s: float | None = None

@@ -27,7 +27,9 @@ class LaneTruth:
 @dataclass(frozen=True)
 class ObjectTruth:
     """kind: what it is; box_px: (u0, v0, u1, v1) in the left image or None when not seen;
-    visible: 0..1 unoccluded share of its silhouette; distance_m: left-camera depth of the nearest point of its
+    visible: 0..1 share of it the left camera sees: the unoccluded share of its silhouette in the image, times the
+    share of its 3D box's projection that the image frame holds (a person half out of the frame is half visible);
+    distance_m: left-camera depth of the nearest point of its
     3D box; position_m: (3,) box centre in the vehicle frame; size_m: (length, width, height); yaw_rad: heading
     relative to the ego; speed_mps; crossing: pedestrians that cross the road; marker_id: landmark sign id."""
 
@@ -99,6 +101,22 @@ def lane_truth(ego) -> LaneTruth:
     return LaneTruth(-float(lat_hw), rel, k, float(lane.width_at(s)), tuple(ego.lane_index))
 
 
+def in_frame_share(rig: StereoRig, points_v: np.ndarray) -> float:
+    """Share of the box that bounds the projections of ``points_v`` (vehicle frame) inside the left image; 1 when
+    some point is behind the camera (the projection is not a box then)."""
+    uv, z = rig.project_vehicle_points(points_v)
+    if np.any(z <= 0.1):
+        return 1.0
+    (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
+    area = (u1 - u0) * (v1 - v0)
+    if area <= 0:
+        return 1.0
+    cam = rig.camera
+    # the part of the box inside [0, W] x [0, H]
+    inside = max(min(u1, cam.width) - max(u0, 0.0), 0.0) * max(min(v1, cam.height) - max(v0, 0.0), 0.0)
+    return float(inside / area)
+
+
 def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visible: float,
                  crossing: bool) -> ObjectTruth:
     """Vehicle-frame position and camera distance of one object."""
@@ -112,5 +130,7 @@ def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visibl
     pts = np.column_stack([c[0] + cy * local[:, 0] - sy * local[:, 1], c[1] + sy * local[:, 0] + cy * local[:, 1],
                            local[:, 2]])
     z = rig.cam_from_vehicle(Side.LEFT).apply(pts)[:, 2]
+    if box_px is not None:
+        visible *= in_frame_share(rig, pts)
     return ObjectTruth(state.obj_id, state.kind, box_px, float(visible), float(z.min()),
                        (float(c[0]), float(c[1]), H / 2), (L, W, H), yaw, state.speed_mps, crossing, state.marker_id)
