@@ -28,7 +28,7 @@ from .tracking import PersonTrack, PersonTracker, TrackConfig
 
 DEFAULT_LANE_WIDTH_M = 3.5
 """Lane width assumed when the path follows no lane [m]."""
-WALK_MIN_MPS = 0.3
+WALK_MIN_MPS = 0.5
 """A track's lateral speed below this is standing, whatever its uncertainty [m/s]."""
 WALK_MAX_MPS = 3.0
 """A lateral speed above this is no person's walk but a tracking error [m/s]."""
