@@ -146,6 +146,17 @@ def test_jobs_cover_the_plan():
     assert len(plan.jobs) == 12 and Job("curves", "rain", 2) in plan.jobs
 
 
+def test_the_people_model_is_a_setting_only_where_the_pedestrian_slot_sees():
+    from percept.drive.resume import run_settings
+
+    sim = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"})
+    inria = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="inria")
+    assert run_settings(sim)["detector"] == "sim" and run_settings(inria)["detector"] == "inria"
+    assert run_settings(EvalPlan(("crossing",), ("clear",), (0,)))["detector"] is None
+    with pytest.raises(ValueError, match="--detector must be"):
+        EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="missing.npz")
+
+
 def _files(folder) -> dict:
     return {p.name: p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
 
