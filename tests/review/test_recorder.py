@@ -56,8 +56,9 @@ def columns_by_entity(path: Path) -> dict[str, dict[str, int]]:
     return out
 
 
-def record(path: Path, sources: dict, options: RecordOptions = RecordOptions(), duration_s: float = 1.0) -> dict:
-    cfg = DriveConfig(WorldConfig("highway", 0), duration_s, sources)
+def record(path: Path, sources: dict, options: RecordOptions = RecordOptions(), duration_s: float = 1.0,
+           scenario: str = "highway") -> dict:
+    cfg = DriveConfig(WorldConfig(scenario, 0), duration_s, sources)
     holder = {}
 
     def factory(world):
@@ -119,6 +120,18 @@ def test_the_vision_longitudinal_slot_records_each_cue_beside_the_fused_estimate
                                                     "/world/ego/camera/left/longitudinal/lead"]:
         assert entity in cols, entity
     assert cols["/longitudinal/range_m/stereo"]["Scalars:scalars"] >= 20
+
+
+def test_the_vision_pedestrian_slot_draws_its_detections_and_tracks(tmp_path):
+    path = tmp_path / "crossing.rrd"
+    record(path, {"pedestrians": "vision"}, duration_s=4.0, scenario="crossing")
+    cols = columns_by_entity(path)
+    for entity in ("/world/ego/camera/left/pedestrians/detections", "/world/ego/camera/left/pedestrians/people",
+                   "/world/ego/pedestrians/people"):
+        assert entity in cols, entity
+    # people on the image are drawn with the stored images, around the car every frame
+    assert 0 < cols["/world/ego/camera/left/pedestrians/people"]["Boxes2D:half_sizes"] <= images(cols)
+    assert cols["/world/ego/pedestrians/people"]["Points3D:positions"] == 60
 
 
 def test_the_camera_rate_sets_how_many_images_are_stored(privileged, tmp_path):
