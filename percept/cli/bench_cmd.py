@@ -13,8 +13,9 @@ from .common import check_outputs, console, fmt, progress_bar, write_json
 
 def bench(
     json_path: opt.JsonOut = None,
-    frames: Annotated[int, typer.Option("--frames", help="Timed calls per stage, 1 to 10,000 (the median is "
-                                                         "reported).")] = 30,
+    frames: Annotated[int, typer.Option("--frames", help="Timed calls per stage, 1 to 10,000 (slots: the mean "
+                                                         "over consecutive frames; render and peers: the "
+                                                         "median).")] = 30,
 ):
     """Per-stage cost on one thread (stages named by the run JSON's timing_ms keys), against the named peers
     measured in the same run (ratio = ours / peer)."""
@@ -29,7 +30,8 @@ def bench(
         tick = lambda: bar.advance(task)  # noqa: E731
         results = [bench_render(frames, progress=tick)] + [bench_task(t, TASKS, frames, progress=tick)
                                                            for t in tasks]
-    t = Table(title="percept bench (one thread, median ms per call)")
+    t = Table(title="percept bench (one thread, ms per call: slots the mean over consecutive frames, the rest the "
+                    "median)")
     for col in ("stage", "what", "ms", "target ms", "peer", "peer ms", "ratio"):
         t.add_column(col, justify="left" if col in ("stage", "what", "peer") else "right")
     for r in results:

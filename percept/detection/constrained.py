@@ -72,14 +72,22 @@ class SearchStats:
         return 1.0 - self.windows / self.full_windows if self.full_windows else 0.0
 
 
+PERSON_WIDTH_FRAC = 0.4
+"""Width of a person box as a fraction of its height."""
+
+
+def standing_box(cu: float, v_feet: float, height_px: float) -> Box:
+    """The person box (u0, v0, u1, v1) of someone ``height_px`` tall whose feet are at (cu, v_feet)."""
+    half = PERSON_WIDTH_FRAC / 2 * height_px
+    return (cu - half, v_feet - height_px, cu + half, v_feet)
+
+
 def person_box(window: Box) -> Box:
     """The person inside a detection window (u0, v0, u1, v1): the middle 96/128 of its height (16/128 above the
-    head and below the feet), 0.4 of the person's height wide about the window's centre."""
+    head and below the feet), ``PERSON_WIDTH_FRAC`` of the person's height wide about the window's centre."""
     u0, v0, u1, v1 = window
     m = (v1 - v0) * FEET_MARGIN_PX / WINDOW_PX[1]
-    h = (v1 - v0) - 2 * m
-    cu = (u0 + u1) / 2
-    return (cu - 0.2 * h, v0 + m, cu + 0.2 * h, v1 - m)
+    return standing_box((u0 + u1) / 2, v1 - m, (v1 - v0) - 2 * m)
 
 
 class ConstrainedSearch:

@@ -6,8 +6,9 @@ Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over t
 ``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
 frame, the two levels around each tracked person's predicted window. Only confirmed tracks act; a track walking
 sideways counts as walking only when it has ``WALK_HITS`` detections and its lateral speed is a person's and clear
-of its own uncertainty (1.5 standard deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause braking. The conflict rule
-is the privileged slot's (``percept.sensors.conflict``).
+of its own uncertainty (1.5 standard deviations, and at least ``WALK_MIN_MPS``), so that people standing or
+walking along the verge do not cause braking. The conflict rule is the privileged slot's
+(``percept.sensors.conflict``).
 """
 
 from __future__ import annotations
@@ -99,21 +100,18 @@ class PedestrianSlot:
             levels = tuple(k for k in range(n) if k % self.sweep_frames == frame.index % self.sweep_frames)
             dets, stats = self.search.search(frame.left, path, levels, rois=[window_of(b) for b in predicted])
             boxes = [person_box(d.box_px) for d in dets]
-            tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame, boxes))
+            tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame) if boxes else None)
         request, rid = self._request(tracks, path, speed)
         return request, PedestrianDebug(tuple(dets), tuple(tracks), levels, stats, rid)
 
-    def _stereo(self, frame: Frame, boxes: list) -> list:
-        """Each box's stereo depth (Z, sigma_Z) [m], searched about its ground-contact depth; None where it fails."""
-        if not boxes or frame.right is None:
-            return [None] * len(boxes)
+    def _stereo(self, frame: Frame):
+        """A box's stereo depth (Z, sigma_Z) [m] in this frame, searched about its ground-contact depth (None where
+        it fails), for the tracker's measurements; None without a right image."""
+        if frame.right is None:
+            return None
         left = cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY)
         right = cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY)
-        out = []
-        for b in boxes:
-            m = self.tracker.measure(b)
-            out.append(None if m is None else box_depth(left, right, b, self.tracker.rig, m[0][0] - self.cam_x))
-        return out
+        return lambda box, z_ground_m: box_depth(left, right, box, self.tracker.rig, z_ground_m)
 
     def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M

@@ -12,6 +12,7 @@ white-noise-acceleration model (ch. 6) and gating (ch. 7).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from filterpy.common import Q_discrete_white_noise
@@ -19,7 +20,11 @@ from filterpy.kalman import KalmanFilter
 
 from percept.sensors import StereoRig, iou_matrix
 
+from .constrained import standing_box
+
 Box = tuple[float, float, float, float]
+StereoDepth = Callable[[Box, float], "tuple[float, float] | None"]
+"""(person box, its ground-contact depth [m]) -> (stereo depth, its standard deviation) [m] or None."""
 
 
 @dataclass(frozen=True)
@@ -103,11 +108,10 @@ class PersonTracker:
     def reset(self) -> None:
         self.tracks, self._next_id = [], 1
 
-    def measure(self, box: Box, stereo: tuple[float, float] | None = None
-                ) -> tuple[np.ndarray, np.ndarray, float] | None:
-        """A person box (and, when given, its stereo depth and standard deviation [m]) -> feet (x, y) [m], its 2x2
-        covariance and the person's height [m]; None above the horizon or nearer than the camera. Ground contact
-        and stereo are fused by their inverse variances."""
+    def measure(self, box: Box, stereo: StereoDepth | None = None) -> tuple[np.ndarray, np.ndarray, float] | None:
+        """A person box -> feet (x, y) [m], its 2x2 covariance and the person's height [m]; None above the horizon
+        or nearer than the camera. ``stereo(box, z_ground_m)``, when given, returns the box's stereo depth and its
+        standard deviation [m] (or None), fused with the ground contact's by their inverse variances."""
         cam, h_cam = self.rig.camera, self.rig.mount_height_m
         u0, v0, u1, v1 = box
         h_px = v1 - v0
@@ -119,8 +123,8 @@ class PersonTracker:
             return None
         # sigma_Z = Z^2 sigma_v / (fy h)
         var_z = max(z * z * self.cfg.row_sigma_frac * h_px / (cam.fy * h_cam), 0.1) ** 2
-        if stereo is not None:
-            z_s, s_s = stereo
+        if stereo is not None and (zs := stereo(box, z)) is not None:
+            z_s, s_s = zs
             # inverse-variance fusion: z = (z_g / s_g^2 + z_s / s_s^2) / (1 / s_g^2 + 1 / s_s^2)
             w_g, w_s = 1.0 / var_z, 1.0 / (s_s * s_s)
             z_new = (z * w_g + z_s * w_s) / (w_g + w_s)
@@ -139,9 +143,7 @@ class PersonTracker:
         x, y = t.kf.x[0], t.kf.x[1]
         pts = np.array([[x, y, 0.0], [x, y, t.height_m]])
         uv, _ = self.rig.project_vehicle_points(pts)
-        h = max(uv[0, 1] - uv[1, 1], 1.0)
-        cu = uv[0, 0]
-        return (cu - 0.2 * h, uv[0, 1] - h, cu + 0.2 * h, uv[0, 1])
+        return standing_box(uv[0, 0], uv[0, 1], max(uv[0, 1] - uv[1, 1], 1.0))
 
     def predict(self, ego_speed_mps: float) -> list[Box]:
         """Advance every track one frame; the predicted person boxes (for the search's regions of interest)."""
@@ -158,11 +160,10 @@ class PersonTracker:
         return [boxes[i] for i in keep]
 
     def update(self, boxes: list[Box], scores: list[float], seen: bool = True,
-               stereo: list | None = None) -> list[PersonTrack]:
-        """Associate this frame's person boxes (with their stereo depths, None where unmatched) with the predicted
-        tracks; ``seen`` False (a dropped frame): no detections and no misses counted."""
-        stereo = stereo if stereo is not None else [None] * len(boxes)
-        meas = [(m, b, s) for b, s, z in zip(boxes, scores, stereo) if (m := self.measure(b, z)) is not None]
+               stereo: StereoDepth | None = None) -> list[PersonTrack]:
+        """Associate this frame's person boxes (measured with ``stereo`` when given, see ``measure``) with the
+        predicted tracks; ``seen`` False (a dropped frame): no detections and no misses counted."""
+        meas = [(m, b, s) for b, s in zip(boxes, scores) if (m := self.measure(b, stereo)) is not None]
         pairs = self._associate(meas)
         used = set()
         for ti, mi in pairs:
@@ -187,11 +188,14 @@ class PersonTracker:
         (IoU >= ``iou_gate``: robust to the far field's range noise), then by squared Mahalanobis distance on the
         ground inside the gate."""
         cands = []
+        if not meas or not self.tracks:
+            return []
+        overlaps = iou_matrix(np.array([b for _, b, _ in meas]), np.array([t.predicted for t in self.tracks]))
         for ti, t in enumerate(self.tracks):
             hx = t.kf.H @ t.kf.x
             hp = t.kf.H @ t.kf.P @ t.kf.H.T
             for mi, ((xy, r, _), box, _) in enumerate(meas):
-                overlap = float(iou_matrix(np.array([box]), np.array([t.predicted]))[0, 0])
+                overlap = float(overlaps[mi, ti])
                 d = xy - hx
                 # d^2 = (z - H x)^T S^-1 (z - H x), S = H P H^T + R
                 d2 = float(d @ np.linalg.solve(hp + r, d))

@@ -20,7 +20,8 @@ from .tasks import SlotContext, Task
 
 @dataclass(frozen=True)
 class StageCost:
-    """stage: the ``timing_ms`` key; what: what was timed; ms: median milliseconds per call; peer: the peer's name
+    """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (mean or median, see
+    ``bench_task``); peer: the peer's name
     and peer_ms its cost in the same run (None where no peer does the same job); ratio = ms / peer_ms; target_ms:
     the stage's budget, if any."""
 
@@ -99,8 +100,9 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
 def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int = 0,
                progress: Callable[[], None] | None = None) -> StageCost:
     """A task's vision slot on rendered frames of its bench scenario (640x480, one thread); the slots upstream of
-    it are privileged (computed beforehand, not timed). A slot that spreads its work over frames (``sweep_frames``)
-    is timed on consecutive frames and reported as its mean cost; the others as their median."""
+    it are privileged (computed beforehand, not timed). A slot keeps state from frame to frame (trackers, filters,
+    a search spread over frames), so it is timed on consecutive frames and reported as its mean cost; the stateless
+    peer as its median."""
     from percept.sims import SimWorld, WorldConfig
 
     if task.vision is None:
@@ -119,8 +121,7 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
         world.step()
     slot = task.vision(ctx)
     shot = _cycle(shots, progress)
-    spread = getattr(slot, "sweep_frames", 1) > 1
-    ms = median_ms(lambda: slot.step(*shot()), frames, mean=spread)
+    ms = median_ms(lambda: slot.step(*shot()), frames, mean=True)
     peer, peer_ms = None, None
     if task.bench_peer is not None:
         peer, run = task.bench_peer([f for f, _ in shots])
