@@ -21,9 +21,8 @@ from .tasks import SlotContext, Task
 @dataclass(frozen=True)
 class StageCost:
     """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (mean or median, see
-    ``bench_task``); peer: the peer's name
-    and peer_ms its cost in the same run (None where no peer does the same job); ratio = ms / peer_ms; target_ms:
-    the stage's budget, if any."""
+    ``bench_task``); peer: the peer's name and peer_ms its cost in the same run (None where no peer does the same
+    job); ratio = ms / peer_ms; target_ms: the stage's budget, if any."""
 
     stage: str
     what: str
