@@ -19,11 +19,14 @@ def train_detector(
     every: Annotated[int, typer.Option("--every", help="Sample every N-th frame, 1 to 100.")] = 3,
     duration: opt.Duration = None,
     c: Annotated[float, typer.Option("--c", help="The linear SVM's C (regularisation), 1e-5 to 10.")] = 0.01,
+    condition: Annotated[list[str] | None, typer.Option(
+        "--condition", help="Conditions rotated over the seeds, in order (repeat the option; a condition may "
+        "repeat to weight it). Default: clear, night, rain.")] = None,
 ):
     """Render pedestrians and backgrounds, cut 64x128 windows (as the constrained search sees them, 4-pixel cells),
     train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it and train again.
 
-    The conditions rotate over the seeds (clear, night, rain). The model is selected with `--model FILE` in
+    The conditions rotate over the seeds (by default clear, night, rain). The model is selected with `--model FILE` in
     `percept detect`; the one shipped in the package (`--model sim`) was made by this command's defaults.
     """
     from percept.drive.batch import parse_seeds
@@ -32,7 +35,8 @@ def train_detector(
     opt.check_number("--every", every, 1, 100)
     opt.check_number("--c", c, 1e-5, 10.0)
     try:
-        plan = TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c)
+        conditions = {"conditions": tuple(condition)} if condition else {}
+        plan = TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c, **conditions)
     except ValueError as e:
         fail(str(e))
     record_path = out.with_suffix(".json")

@@ -18,6 +18,7 @@ import numpy as np
 from percept.detection import ConstrainedSearch, LinearModel, SearchConfig, iou_matrix, window_of
 from percept.detection.training import features, hard_negatives, train_linear_svm, window_crop
 from percept.sensors import EgoPath, LaneEstimate, ObjectKind, StereoRig
+from percept.sims.world import check_condition
 
 from .samples import for_each_frame
 
@@ -48,6 +49,8 @@ class TrainPlan:
             raise ValueError(f"training seeds {clash} are evaluation seeds (0-19, 100-119); choose others")
         if not self.seeds:
             raise ValueError("give at least one training seed")
+        for name in self.conditions:
+            check_condition(name)
 
 
 def _truth_path(gt) -> EgoPath:

@@ -1,0 +1,85 @@
+"""The pieces every visual odometry here shares: corners spread over the image, KLT tracking, pose covariance.
+
+References: Rosten & Drummond 2006, "Machine learning for high-speed corner detection" (FAST); Bouguet 2000,
+"Pyramidal implementation of the Lucas Kanade feature tracker"; Hartley & Zisserman, sec. 5.2 (covariance
+of an estimate from the Jacobian of its cost).
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+# below this mean intensity (or standard deviation) a frame has nothing to track: dark or featureless
+MIN_CONTRAST_GREY = 2.0
+
+
+def to_gray(image: np.ndarray) -> np.ndarray:
+    """(H, W, 3) BGR or (H, W) grey uint8 -> (H, W) grey uint8."""
+    img = np.asarray(image)
+    if img.ndim == 3 and img.shape[2] == 3:
+        return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    if img.ndim == 2:
+        return img if img.dtype == np.uint8 else np.clip(img, 0, 255).astype(np.uint8)
+    raise ValueError(f"expected an (H, W) or (H, W, 3) image, got shape {img.shape}")
+
+
+def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], threshold: int,
+                   mask: np.ndarray | None = None) -> np.ndarray:
+    """FAST corners, the strongest few per grid cell so that they cover the image: (N, 2) float32 [px]."""
+    if float(gray.std()) < MIN_CONTRAST_GREY:
+        return np.zeros((0, 2), np.float32)
+    kps = cv2.FastFeatureDetector_create(threshold, True).detect(gray, mask)
+    if not kps:
+        return np.zeros((0, 2), np.float32)
+    pts = np.float32([k.pt for k in kps])
+    resp = np.float32([k.response for k in kps])
+    h, w = gray.shape
+    gx, gy = grid
+    cell = (np.minimum(pts[:, 0] * gx // w, gx - 1) + gx * np.minimum(pts[:, 1] * gy // h, gy - 1)).astype(int)
+    per_cell = max(1, int(np.ceil(max_corners / (gx * gy))))
+    # strongest first, then the rank of each corner within its cell
+    order = np.lexsort((-resp, cell))
+    c_sorted = cell[order]
+    first = np.searchsorted(c_sorted, c_sorted, side="left")
+    rank = np.arange(len(order)) - first
+    keep = order[rank < per_cell]
+    keep = keep[np.argsort(-resp[keep])][:max_corners]
+    return pts[keep]
+
+
+def track(prev: np.ndarray, cur: np.ndarray, pts: np.ndarray, win_px: int, levels: int,
+          guess: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """KLT from ``prev`` to ``cur``, starting from ``guess`` (N, 2) when given: the points' new positions (N, 2)
+    float32 and which were tracked (N,) bool (found, and still inside the image)."""
+    if len(pts) == 0:
+        return np.zeros((0, 2), np.float32), np.zeros(0, bool)
+    p0 = np.ascontiguousarray(pts, dtype=np.float32).reshape(-1, 1, 2)
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.03)
+    if guess is None:
+        p1, st, _err = cv2.calcOpticalFlowPyrLK(prev, cur, p0, None, winSize=(win_px, win_px), maxLevel=levels,
+                                                criteria=criteria)
+    else:
+        p1, st, _err = cv2.calcOpticalFlowPyrLK(prev, cur, p0, np.ascontiguousarray(guess, np.float32).reshape(
+            -1, 1, 2), winSize=(win_px, win_px), maxLevel=levels, criteria=criteria,
+            flags=cv2.OPTFLOW_USE_INITIAL_FLOW)
+    p1 = p1.reshape(-1, 2)
+    h, w = cur.shape[:2]
+    ok = (st.ravel() == 1) & np.all(np.isfinite(p1), axis=1)
+    ok &= (p1[:, 0] >= 0) & (p1[:, 0] <= w - 1) & (p1[:, 1] >= 0) & (p1[:, 1] <= h - 1)
+    return p1, ok
+
+
+def pose_covariance(points: np.ndarray, pixels: np.ndarray, K: np.ndarray, rvec: np.ndarray,
+                    tvec: np.ndarray) -> np.ndarray:
+    """(6, 6) covariance of (rvec [rad], tvec [m]) of a PnP solution from its reprojection residuals."""
+    proj, J = cv2.projectPoints(points, rvec, tvec, K, None)
+    r = (proj.reshape(-1, 2) - pixels).ravel()
+    J = J[:, :6]
+    dof = max(len(r) - 6, 1)
+    # sigma^2 = |r|^2 / (2N - 6); Sigma = sigma^2 (J^T J)^-1, with a floor of 0.1 px on sigma (subpixel limit)
+    sigma2 = max(float(r @ r) / dof, 0.01)
+    try:
+        return sigma2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return np.diag([1.0, 1.0, 1.0, 100.0, 100.0, 100.0])

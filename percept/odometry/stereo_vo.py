@@ -1,0 +1,164 @@
+"""Stereo visual odometry: keyframe points with stereo depth, KLT tracking, PnP with RANSAC.
+
+At a keyframe, corners (FAST, strongest per grid cell) in the left image get their depth from the right image
+(KLT along the row of a rectified pair, Z = f b / d); in later frames they are tracked with KLT and the camera
+pose relative to the keyframe comes from PnP with RANSAC (points on moving vehicles and pedestrians disagree
+with the static world's motion and fall out as outliers) refined by Levenberg-Marquardt on the inliers. A new
+keyframe starts when too few inliers are left. References: Nistér, Naroditsky & Bergen 2004, "Visual
+odometry" (CVPR); Geiger, Ziegler & Stiller 2011, "StereoScan" (IV); Hartley & Zisserman, ch. 6-7 (PnP).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .features import detect_corners, pose_covariance, to_gray, track
+from .types import VOStep
+
+
+@dataclass(frozen=True)
+class StereoVOConfig:
+    """max_features: corners per keyframe; grid: cells (columns, rows) the corners are spread over;
+    fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels;
+    max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
+    point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
+    ransac_px: PnP RANSAC reprojection threshold."""
+
+    max_features: int = 400
+    grid: tuple[int, int] = (10, 6)
+    fast_threshold: int = 5
+    win_px: int = 15
+    levels: int = 3
+    max_row_err_px: float = 0.7
+    min_disparity_px: float = 0.5
+    min_inliers: int = 12
+    keyframe_inliers: int = 60
+    ransac_px: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:
+            raise ValueError("need max_features >= 20, min_inliers >= 6 and keyframe_inliers >= min_inliers")
+        if not (self.win_px >= 5 and self.levels >= 0 and self.ransac_px > 0 and self.min_disparity_px > 0):
+            raise ValueError("win_px >= 5, levels >= 0, ransac_px > 0 and min_disparity_px > 0 are required")
+
+
+def _inverse(T: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    # T^-1 = [R^T, -R^T t]
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return out
+
+
+def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = cv2.Rodrigues(rvec)[0]
+    T[:3, 3] = tvec.ravel()
+    return T
+
+
+class StereoVO:
+    """Frame-to-keyframe stereo odometry of a rectified pair. K: (3, 3) intrinsics of both cameras [px];
+    baseline_m: distance between the optical centres [m] (the right camera is at +b along the left's x)."""
+
+    def __init__(self, K: np.ndarray, baseline_m: float, camera_height_m: float | None = None,
+                 config: StereoVOConfig = StereoVOConfig()):
+        K = np.asarray(K, dtype=np.float64)
+        if K.shape != (3, 3) or not np.all(np.isfinite(K)) or K[0, 0] <= 0:
+            raise ValueError(f"K must be a finite (3, 3) intrinsic matrix, got {K.tolist()}")
+        if not (np.isfinite(baseline_m) and baseline_m > 0):
+            raise ValueError(f"baseline_m must be positive, got {baseline_m}")
+        if camera_height_m is not None and not (np.isfinite(camera_height_m) and camera_height_m > 0):
+            raise ValueError(f"camera_height_m must be positive, got {camera_height_m}")
+        self.K, self.baseline_m, self.config = K, float(baseline_m), config
+        self.camera_height_m = camera_height_m
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the keyframe: the next frame starts a new one."""
+        self._kf_points: np.ndarray | None = None  # (N, 3) keyframe camera frame [m]
+        self._pixels: np.ndarray | None = None  # (N, 2) where they are in the previous left image
+        self._prev: np.ndarray | None = None  # previous left image (grey)
+        self._T_kf_prev = np.eye(4)  # previous camera in the keyframe's frame
+        self._cov_prev = np.zeros((6, 6))
+
+    def process(self, left: np.ndarray | None, right: np.ndarray | None) -> VOStep:
+        """Motion from the previous processed frame to this one. A missing image (dropped frame) returns a failed
+        step and keeps the keyframe, so tracking resumes on the next frame."""
+        if left is None or right is None:
+            return VOStep.failed("dropped frame")
+        gl, gr = to_gray(left), to_gray(right)
+        if gl.shape != gr.shape:
+            raise ValueError(f"left and right images differ in size: {gl.shape} and {gr.shape}")
+        if self._kf_points is None or self._prev is None or self._prev.shape != gl.shape:
+            return self._start_keyframe(gl, gr, "first frame")
+        step = self._track(gl)
+        if step.ok and step.inliers >= self.config.keyframe_inliers:
+            self._prev = gl
+            return step
+        # too few inliers left: this frame (whose motion is already measured when ok) becomes the keyframe
+        new = self._start_keyframe(gl, gr, step.reason or "keyframe")
+        return VOStep(step.T_prev_cur, step.covariance, step.ok, step.tracked, step.inliers, step.quality, True,
+                      step.reason) if step.ok else new
+
+    def _start_keyframe(self, gl: np.ndarray, gr: np.ndarray, reason: str) -> VOStep:
+        c = self.config
+        corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold)
+        self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
+        self._kf_points = self._pixels = None
+        if len(corners) < c.min_inliers:
+            return VOStep.failed(f"{reason}: only {len(corners)} corners (dark or featureless)", keyframe=True)
+        matched, ok = track(gl, gr, corners, c.win_px, c.levels, self._disparity_guess(corners))
+        d = corners[:, 0] - matched[:, 0]
+        ok &= (np.abs(corners[:, 1] - matched[:, 1]) <= c.max_row_err_px) & (d >= c.min_disparity_px)
+        if ok.sum() < c.min_inliers:
+            return VOStep.failed(f"{reason}: only {int(ok.sum())} stereo matches", keyframe=True)
+        px, d = corners[ok], d[ok]
+        fx, fy, cx, cy = self.K[0, 0], self.K[1, 1], self.K[0, 2], self.K[1, 2]
+        # Z = f b / d; X = (u - cx) Z / fx; Y = (v - cy) Z / fy
+        z = fx * self.baseline_m / d
+        self._kf_points = np.column_stack([(px[:, 0] - cx) * z / fx, (px[:, 1] - cy) * z / fy, z])
+        self._pixels = px
+        return VOStep.failed(reason, tracked=len(px), keyframe=True)
+
+    def _disparity_guess(self, px: np.ndarray) -> np.ndarray | None:
+        """Where a corner should be in the right image if it were on a level road seen from a level camera of
+        known height (the near road's disparity is beyond KLT's pyramid reach); points above it (things
+        standing up) are closer to the guess than to zero. None without a camera height."""
+        if self.camera_height_m is None:
+            return None
+        # road at row v: Z = fy h / (v - cy), so d = fx b / Z = b (v - cy) fx / (fy h); 80 % of it
+        d = 0.8 * self.baseline_m * np.maximum(px[:, 1] - self.K[1, 2], 0.0) * self.K[0, 0] / (
+            self.K[1, 1] * self.camera_height_m)
+        return np.column_stack([px[:, 0] - d, px[:, 1]])
+
+    def _track(self, gl: np.ndarray) -> VOStep:
+        c = self.config
+        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels)
+        self._kf_points, self._pixels = self._kf_points[ok], moved[ok]
+        n = len(self._pixels)
+        if n < c.min_inliers:
+            return VOStep.failed(f"only {n} points tracked", tracked=n)
+        # minimal solutions by EPnP inside RANSAC (no initial guess to lead it astray), then LM on the inliers
+        found, rvec, tvec, inl = cv2.solvePnPRansac(self._kf_points, self._pixels, self.K, None,
+                                                    iterationsCount=100, reprojectionError=c.ransac_px,
+                                                    confidence=0.999, flags=cv2.SOLVEPNP_EPNP)
+        if not found or inl is None or len(inl) < c.min_inliers:
+            return VOStep.failed(f"PnP found {0 if inl is None else len(inl)} inliers of {n}", tracked=n)
+        idx = inl.ravel()
+        rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
+        if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+            return VOStep.failed("PnP diverged", tracked=n)
+        # keep the inliers only: outliers (moving objects, bad tracks) would pull later frames too
+        self._kf_points, self._pixels = self._kf_points[idx], self._pixels[idx]
+        cov = pose_covariance(self._kf_points, self._pixels, self.K, rvec, tvec)
+        # T_kf_cur = (T_cur_kf)^-1, where PnP gives p_cur = R p_kf + t
+        T_kf_cur = _inverse(_matrix(rvec, tvec))
+        # T_prev_cur = T_kf_prev^-1 T_kf_cur; both poses carry their own error (their correlation is ignored)
+        T_prev_cur = _inverse(self._T_kf_prev) @ T_kf_cur
+        step_cov = cov + self._cov_prev
+        self._T_kf_prev, self._cov_prev = T_kf_cur, cov
+        return VOStep(T_prev_cur, step_cov, True, n, len(idx), len(idx) / n)
