@@ -71,6 +71,7 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
     """One stereo pair of the ``highway`` scenario vs highway-env's top-down render of the same world."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     from percept.sims import SimWorld, WorldConfig
+    from percept.sims.coords import hw_pose
     from percept.sims.snapshot import scene_from_road
 
     cv2.setNumThreads(1)
@@ -110,7 +111,7 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     world = SimWorld(WorldConfig(task.bench_scenario, seed=seed, autopilot=True))
     feed = TruthFeed()
     lm = world.landmark_map()
-    ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed)
+    ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, start_pose=hw_pose(world.ego))
     by_name = {t.name: t for t in tasks}
     upstream = {u: by_name[u].privileged(ctx) for u in task.upstream}
     shots = []

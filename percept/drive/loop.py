@@ -7,6 +7,7 @@ from typing import Callable
 
 from percept.sensors import Source
 from percept.sims import SimWorld
+from percept.sims.coords import hw_pose
 
 from .agent import Agent
 from .config import DriveConfig
@@ -28,7 +29,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     feed = TruthFeed()
     lm = world.landmark_map()
     agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed,
-                                                       cfg.detector),
+                                                       cfg.detector, hw_pose(world.ego)),
                   world.cruise_speed_mps)
     scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
                                              world.crossing_pedestrians, agent.following.time_gap))

@@ -15,7 +15,6 @@ from percept.detection.constrained import SearchConfig
 from percept.detection.metrics import DetectionTally, eligible
 from percept.lanes.metrics import centering, rmse_columns
 from percept.longitudinal.metrics import range_abs_rel_err, range_abs_rel_err_by_bin, ttc_abs_err_s
-from percept.odometry.metrics import ate_rmse_m, kitti_drift
 from percept.sensors import ObjectKind
 from percept.sensors.vehicle import EGO_WIDTH_M
 
@@ -244,38 +243,3 @@ class PedestrianScorer:
                 # false stops (for a person on the verge, or for nothing) are scored where there are pedestrians
                 "false_stops": self.false_stops if self.ctx.pedestrians else None,
                 "verge_brakes": self.verge_brakes if self.ctx.pedestrians else None}
-
-
-class OdometryScorer:
-    """Drift (KITTI's protocol scaled to the run) and ATE of the fused pose (vision); VO-only and landmark fixes
-    when the slot's debug carries ``vo_pose`` / ``landmark_fix``."""
-
-    def __init__(self, ctx: ScoreContext):
-        self.ctx = ctx
-        self.true: list[list[float]] = []
-        self.fused: list[list[float]] = []
-        self.vo: list[list[float]] = []
-        self.fixes = 0
-
-    def update(self, pose, debug, step: StepTruth) -> None:
-        if not self.ctx.vision or pose is None:
-            return
-        e = step.truth.ego
-        self.true.append([e.x_m, e.y_m, e.yaw_rad])
-        self.fused.append([pose.pose.x_m, pose.pose.y_m, pose.pose.yaw_rad])
-        vo = getattr(debug, "vo_pose", None)
-        if vo is not None:
-            self.vo.append([vo.x_m, vo.y_m, vo.yaw_rad])
-        self.fixes += int(bool(getattr(debug, "landmark_fix", False)))
-
-    def result(self) -> dict:
-        if not self.fused:
-            return {"drift_pct_vo": None, "drift_pct_fused": None, "ate_rmse_vo_m": None, "ate_rmse_fused_m": None,
-                    "landmark_fixes": None}
-        true = np.asarray(self.true)
-        vo_ok = len(self.vo) == len(self.true)
-        return {"drift_pct_vo": kitti_drift(np.asarray(self.vo), true)["drift_pct"] if vo_ok else None,
-                "drift_pct_fused": kitti_drift(np.asarray(self.fused), true)["drift_pct"],
-                "ate_rmse_vo_m": ate_rmse_m(np.asarray(self.vo), true) if vo_ok else None,
-                "ate_rmse_fused_m": ate_rmse_m(np.asarray(self.fused), true),
-                "landmark_fixes": self.fixes}

@@ -11,11 +11,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable, Protocol
 
-from percept.sensors import Frame, LandmarkMap, StereoRig
+from percept.sensors import Frame, LandmarkMap, Pose2D, StereoRig
 
 from . import privileged as priv
 from .privileged import TruthFeed
-from .scoring import LaneScorer, LongitudinalScorer, OdometryScorer, PedestrianScorer, ScoreContext
+from .odometry_scoring import OdometryScorer
+from .scoring import LaneScorer, LongitudinalScorer, PedestrianScorer, ScoreContext
 
 
 class Slot(Protocol):
@@ -27,13 +28,15 @@ class Slot(Protocol):
 @dataclass(frozen=True)
 class SlotContext:
     """What a slot factory may use: the rig, the frame period [s], the landmark map (None without signs), the
-    people model of the vision pedestrian slot ('sim', 'inria' or a file); truth is for privileged slots only."""
+    people model of the vision pedestrian slot ('sim', 'inria' or a file), the known start pose (where odometry
+    starts; None = the origin); truth is for privileged slots only."""
 
     rig: StereoRig
     dt_s: float
     landmarks: LandmarkMap | None
     truth: TruthFeed
     detector: str = "sim"
+    start_pose: Pose2D | None = None
 
 
 @dataclass(frozen=True)
@@ -93,6 +96,12 @@ def _people_peer(frames: list):
     return people_detector_full_frame(frames)
 
 
+def _odometry_slot(ctx: SlotContext) -> Slot:
+    from percept.odometry import OdometrySlot
+
+    return OdometrySlot(ctx.rig, ctx.dt_s, ctx.landmarks, ctx.start_pose or Pose2D(0.0, 0.0, 0.0))
+
+
 def _lane_slot(ctx: SlotContext) -> Slot:
     from percept.lanes import LaneSlot
 
@@ -121,11 +130,13 @@ TASKS: tuple[Task, ...] = (
                    Headline("verge brakes", "verge_brakes", "{}")),
          help="people in or stepping into the path (braking requests)", bench_scenario="crossing",
          bench_peer=_people_peer),
-    Task("odometry", "odometry", "odometry", priv.PrivilegedOdometry, OdometryScorer,
+    Task("odometry", "odometry", "odometry", priv.PrivilegedOdometry, OdometryScorer, vision=_odometry_slot,
          recorder="percept.review.parts:odometry",
-         headline=(Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),
-                   Headline("ATE fused [m]", "ate_rmse_fused_m", "{:.2f}")),
-         help="where the car is, and its speed"),
+         headline=(Headline("drift VO [%]", "drift_pct_vo", "{:.2f}"),
+                   Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),
+                   Headline("ATE with landmarks [m]", "ate_rmse_landmarks_m", "{:.2f}"),
+                   Headline("inside 3 sigma", "consistency_3sigma", "{:.3f}")),
+         help="where the car is, and its speed", bench_scenario="loop", budget_ms=5.0),
 )
 
 

@@ -1,0 +1,78 @@
+"""Scoring the odometry task: every trajectory the vision slot reports, side by side, against the true path.
+
+KITTI's drift (segment lengths scaled to the run), ATE RMSE from the known start pose and the final position
+error for visual odometry alone, dead reckoning (IMU + wheel speed), fused (+ VO) and the slot's estimate
+(+ landmark fixes); consistency: the share of frames whose position error lies inside the filter's 3-sigma
+ellipse (normalised estimation error squared <= chi2(2 dof, 99.73 %) = 11.83).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from percept.odometry.metrics import ate_rmse_m, final_position_error_m, kitti_drift, path_length_m
+
+# P(chi2 with 2 dof <= 11.83) = 0.9973, the probability of a 1-D +-3 sigma interval
+NEES_3SIGMA_2DOF = 11.83
+TRAJECTORIES = ("vo", "dead_reckoning", "fused", "landmarks")
+
+
+def _pose(p) -> list[float]:
+    return [p.x_m, p.y_m, p.yaw_rad]
+
+
+def inside_3sigma(errors_xy: np.ndarray, covariances: np.ndarray) -> float | None:
+    """Share of frames whose (N, 2) position error is inside the (N, 2, 2) covariance's 3-sigma ellipse."""
+    if not len(errors_xy):
+        return None
+    # NEES_k = e_k^T P_k^-1 e_k, with a floor on P for the exactly known start
+    P = covariances + np.eye(2) * 1e-9
+    nees = np.einsum("ki,kij,kj->k", errors_xy, np.linalg.inv(P), errors_xy)
+    return float(np.mean(nees <= NEES_3SIGMA_2DOF))
+
+
+class OdometryScorer:
+    """Collects the true pose and each trajectory of the vision slot (``OdometryDebug``) frame by frame."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.true: list[list[float]] = []
+        self.paths: dict[str, list[list[float]]] = {k: [] for k in TRAJECTORIES}
+        self.cov = {"fused": [], "landmarks": []}
+        self.fixes = self.sightings = self.vo_failed = 0
+
+    def update(self, pose, debug, step) -> None:
+        if not self.ctx.vision or pose is None or debug is None:
+            return
+        e = step.truth.ego
+        self.true.append([e.x_m, e.y_m, e.yaw_rad])
+        for key, p in (("vo", debug.vo_pose), ("dead_reckoning", debug.dead_reckoning_pose),
+                       ("fused", debug.fused_pose), ("landmarks", pose.pose)):
+            self.paths[key].append(_pose(p))
+        self.cov["fused"].append(debug.fused_covariance[:2, :2])
+        self.cov["landmarks"].append(pose.covariance[:2, :2])
+        self.fixes += debug.fixes
+        self.sightings += len(debug.sightings)
+        self.vo_failed += int(len(self.true) > 1 and not debug.vo_step.ok)
+
+    def result(self) -> dict:
+        keys = [f"{m}_{k}" for k in TRAJECTORIES for m in ("drift_pct", "rot_drift_deg_per_100m")]
+        keys += [f"{m}_{k}_m" for k in TRAJECTORIES for m in ("ate_rmse", "final_error")]
+        keys += ["consistency_3sigma", "consistency_3sigma_fused", "path_length_m", "landmark_fixes",
+                 "landmark_sightings", "vo_failed_frames"]
+        if len(self.true) < 2:
+            return dict.fromkeys(keys)
+        true = np.asarray(self.true)
+        out: dict = {}
+        for k, path in self.paths.items():
+            est = np.asarray(path)
+            drift = kitti_drift(est, true)
+            out[f"drift_pct_{k}"] = drift["drift_pct"]
+            out[f"rot_drift_deg_per_100m_{k}"] = drift["rot_drift_deg_per_100m"]
+            out[f"ate_rmse_{k}_m"] = ate_rmse_m(est, true)
+            out[f"final_error_{k}_m"] = final_position_error_m(est, true)
+        for key, k in (("consistency_3sigma", "landmarks"), ("consistency_3sigma_fused", "fused")):
+            out[key] = inside_3sigma(np.asarray(self.paths[k])[:, :2] - true[:, :2], np.asarray(self.cov[k]))
+        out.update(path_length_m=path_length_m(true), landmark_fixes=self.fixes, landmark_sightings=self.sightings,
+                   vo_failed_frames=self.vo_failed)
+        return {k: out[k] for k in keys}

@@ -1,0 +1,207 @@
+"""Pose fusion: an extended Kalman filter (filterpy) over planar pose, speed, gyro bias and wheel-speed scale.
+
+The IMU (yaw rate, forward acceleration) predicts; the wheel speed, visual odometry and landmark fixes update.
+Visual odometry measures the motion between two images, so the filter keeps a copy of the pose at the last
+processed image (stochastic cloning: Roumeliotis & Burdick 2002, "Stochastic cloning: a generalized framework
+for processing relative state measurements", ICRA) and updates with the relative pose between the copy and now.
+A NaN or absurd sensor sample is rejected, never propagated: the prediction then uses the last good reading with
+its uncertainty widened. References: Thrun, Burgard & Fox, *Probabilistic Robotics*, ch. 3 and 7 (EKF, landmark
+updates); Bar-Shalom, Li & Kirubarajan 2001, sec. 5.4 (normalised innovation gating).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import ExtendedKalmanFilter
+
+from percept.sensors import Pose2D, wrap_angle
+
+# state: pose (x, y, yaw), speed, gyro bias, wheel scale, then the clone of the pose at the last image
+X, Y, YAW, V, BG, KW, XC, YC, YAWC = range(9)
+N_STATE = 9
+# 99 % gates of the normalised innovation squared: chi2 with 2 and 3 degrees of freedom
+GATE_CHI2 = {2: 9.21, 3: 11.34}
+
+
+@dataclass(frozen=True)
+class FusionNoise:
+    """gyro_sigma_rps, accel_sigma_mps2: white noise of one IMU sample; gyro_bias_walk [rad/s/sqrt(s)];
+    wheel_sigma_mps: of one wheel-speed sample; wheel_scale_sigma: prior std of the wheel scale error;
+    init_bias_sigma_rps: prior std of the gyro bias; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
+    beyond these is absurd and rejected; vo_scale: multiplies the visual odometry's own covariance."""
+
+    gyro_sigma_rps: float = 0.003
+    accel_sigma_mps2: float = 0.08
+    gyro_bias_walk: float = 0.0003
+    wheel_sigma_mps: float = 0.07
+    wheel_scale_sigma: float = 0.015
+    init_bias_sigma_rps: float = 0.002
+    max_yaw_rate_rps: float = 3.0
+    max_accel_mps2: float = 20.0
+    max_speed_mps: float = 90.0
+    vo_scale: float = 4.0
+
+
+class _Ekf(ExtendedKalmanFilter):
+    """filterpy's EKF with the unicycle motion model's state prediction."""
+
+    def predict_x(self, u=None) -> None:
+        yaw_rate, accel, dt = u
+        x = self.x
+        w = yaw_rate - x[BG, 0]
+        heading = x[YAW, 0] + w * dt / 2
+        # midpoint rule: p += v dt (cos, sin)(psi + w dt / 2); psi += w dt; v += a dt
+        x[X, 0] += x[V, 0] * dt * math.cos(heading)
+        x[Y, 0] += x[V, 0] * dt * math.sin(heading)
+        x[YAW, 0] = wrap_angle(x[YAW, 0] + w * dt)
+        x[V, 0] = max(x[V, 0] + accel * dt, 0.0)
+
+
+def _angle_residual(index: int):
+    def residual(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        r = a - b
+        r[index] = wrap_angle(r[index])
+        return r
+    return residual
+
+
+class PoseFilter:
+    """Planar pose, speed, gyro bias and wheel scale from IMU + wheel speed, updated by visual odometry's relative
+    motion and by landmark positions. ``start``: the known start pose; speed starts from the first wheel reading."""
+
+    def __init__(self, start: Pose2D, noise: FusionNoise = FusionNoise()):
+        self.noise = noise
+        self.kf = _Ekf(N_STATE, 3)
+        self.kf.x = np.zeros((N_STATE, 1))
+        self.kf.x[[X, Y, YAW], 0] = (start.x_m, start.y_m, start.yaw_rad)
+        self.kf.x[KW, 0] = 1.0
+        self.kf.P = np.diag([1e-6, 1e-6, 1e-8, 1.0, noise.init_bias_sigma_rps ** 2, noise.wheel_scale_sigma ** 2,
+                             1e-6, 1e-6, 1e-8])
+        self._last_input = (0.0, 0.0)
+        self._started = False
+        self.rejected = 0
+
+    @property
+    def pose(self) -> Pose2D:
+        x = self.kf.x[:, 0]
+        return Pose2D(float(x[X]), float(x[Y]), float(x[YAW]))
+
+    @property
+    def speed_mps(self) -> float:
+        return float(self.kf.x[V, 0])
+
+    @property
+    def pose_covariance(self) -> np.ndarray:
+        """(3, 3) covariance of (x_m, y_m, yaw_rad)."""
+        return self.kf.P[:3, :3].copy()
+
+    def predict(self, yaw_rate_rps: float, accel_mps2: float, dt: float) -> bool:
+        """Propagate by ``dt`` [s] with one IMU sample; an absurd or NaN sample is replaced by the last good one
+        (with widened noise) and False is returned."""
+        n = self.noise
+        good = (math.isfinite(yaw_rate_rps) and math.isfinite(accel_mps2) and abs(yaw_rate_rps) <= n.max_yaw_rate_rps
+                and abs(accel_mps2) <= n.max_accel_mps2)
+        if good:
+            self._last_input = (yaw_rate_rps, accel_mps2)
+        else:
+            self.rejected += 1
+        w, a = self._last_input
+        widen = 1.0 if good else 25.0
+        x = self.kf.x[:, 0]
+        v, heading = x[V], x[YAW] + (w - x[BG]) * dt / 2
+        F = np.eye(N_STATE)
+        c, s = math.cos(heading), math.sin(heading)
+        # Jacobian of the midpoint unicycle step with respect to yaw, speed and gyro bias
+        F[X, YAW], F[X, V], F[X, BG] = -v * dt * s, dt * c, v * dt * dt * s / 2
+        F[Y, YAW], F[Y, V], F[Y, BG] = v * dt * c, dt * s, -v * dt * dt * c / 2
+        F[YAW, BG] = -dt
+        self.kf.F = F
+        Q = np.zeros((N_STATE, N_STATE))
+        Q[YAW, YAW] = widen * (n.gyro_sigma_rps * dt) ** 2
+        Q[V, V] = widen * (n.accel_sigma_mps2 * dt) ** 2
+        Q[BG, BG] = n.gyro_bias_walk ** 2 * dt
+        Q[KW, KW] = 1e-10 * dt
+        self.kf.Q = Q
+        self.kf.predict(u=(w, a, dt))
+        return good
+
+    def update_wheel(self, wheel_speed_mps: float) -> bool:
+        """Wheel speed = scale x speed. Rejects NaN and absurd readings (returns False)."""
+        if not (math.isfinite(wheel_speed_mps) and -1.0 <= wheel_speed_mps <= self.noise.max_speed_mps):
+            self.rejected += 1
+            return False
+        if not self._started:
+            self.kf.x[V, 0] = max(wheel_speed_mps, 0.0)
+            self._started = True
+        x = self.kf.x[:, 0]
+
+        def H(_x):
+            h = np.zeros((1, N_STATE))
+            h[0, V], h[0, KW] = x[KW], x[V]
+            return h
+        self.kf.update(np.array([[wheel_speed_mps]]), H, lambda s: np.array([[s[KW, 0] * s[V, 0]]]),
+                       R=np.array([[self.noise.wheel_sigma_mps ** 2]]))
+        return True
+
+    def clone(self) -> None:
+        """Remember the current pose as the one of the last processed image (with its correlations)."""
+        x, P = self.kf.x, self.kf.P
+        x[[XC, YC, YAWC]] = x[[X, Y, YAW]]
+        P[[XC, YC, YAWC], :] = P[[X, Y, YAW], :]
+        P[:, [XC, YC, YAWC]] = P[:, [X, Y, YAW]]
+
+    def update_relative(self, dx_m: float, dy_m: float, dyaw_rad: float, cov: np.ndarray) -> bool:
+        """Visual odometry: the vehicle's motion since the clone, in the clone's vehicle frame (dx forward, dy
+        left [m], dyaw [rad]) with its (3, 3) covariance. Gated; False when rejected."""
+        x = self.kf.x[:, 0]
+
+        def hx(s):
+            c, sn = math.cos(s[YAWC, 0]), math.sin(s[YAWC, 0])
+            d = s[[X, Y], 0] - s[[XC, YC], 0]
+            # [dx, dy] = R(-psi_c) (p - p_c); dyaw = psi - psi_c
+            return np.array([[c * d[0] + sn * d[1]], [-sn * d[0] + c * d[1]], [wrap_angle(s[YAW, 0] - s[YAWC, 0])]])
+
+        h = hx(self.kf.x)
+        c, sn = math.cos(x[YAWC]), math.sin(x[YAWC])
+        Hm = np.zeros((3, N_STATE))
+        Hm[0, [X, Y, XC, YC, YAWC]] = c, sn, -c, -sn, h[1, 0]
+        Hm[1, [X, Y, XC, YC, YAWC]] = -sn, c, sn, -c, -h[0, 0]
+        Hm[2, [YAW, YAWC]] = 1.0, -1.0
+        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, hx, self.noise.vo_scale * cov, 2)
+
+    def update_landmark(self, landmark_xy_m: np.ndarray, measured_xy_m: np.ndarray, cov: np.ndarray) -> bool:
+        """A mapped landmark at world ``landmark_xy_m`` (2,) seen at ``measured_xy_m`` (2,) in the vehicle frame
+        with (2, 2) covariance. Gated against wrong matches; False when rejected."""
+        L = np.asarray(landmark_xy_m, float)
+        x = self.kf.x[:, 0]
+        c, sn = math.cos(x[YAW]), math.sin(x[YAW])
+
+        def hx(s):
+            cc, ss = math.cos(s[YAW, 0]), math.sin(s[YAW, 0])
+            d = L - s[[X, Y], 0]
+            # landmark in the vehicle frame: R(-psi) (L - p)
+            return np.array([[cc * d[0] + ss * d[1]], [-ss * d[0] + cc * d[1]]])
+
+        h = hx(self.kf.x)
+        Hm = np.zeros((2, N_STATE))
+        Hm[0, [X, Y, YAW]] = -c, -sn, h[1, 0]
+        Hm[1, [X, Y, YAW]] = sn, -c, -h[0, 0]
+        return self._gated_update(np.asarray(measured_xy_m, float).reshape(2, 1), Hm, hx, cov, None)
+
+    def _gated_update(self, z: np.ndarray, Hm: np.ndarray, hx, R: np.ndarray, angle_index: int | None) -> bool:
+        if not (np.all(np.isfinite(z)) and np.all(np.isfinite(R))):
+            self.rejected += 1
+            return False
+        y = z - hx(self.kf.x)
+        if angle_index is not None:
+            y[angle_index] = wrap_angle(y[angle_index])
+        S = Hm @ self.kf.P @ Hm.T + R
+        # normalised innovation squared y^T S^-1 y against chi2 at 99 %
+        if float((y.T @ np.linalg.solve(S, y))[0, 0]) > GATE_CHI2[len(z)]:
+            return False
+        residual = _angle_residual(angle_index) if angle_index is not None else np.subtract
+        self.kf.update(z, lambda _s: Hm, hx, R=R, residual=residual)
+        return True

@@ -1,0 +1,115 @@
+"""OdometrySlot: the vision odometry slot. Stereo VO, IMU and wheel speed in an EKF, landmark fixes from the map.
+
+Three filters run side by side on the same samples so that every run reports them together: dead reckoning
+(IMU + wheel speed), fused (+ visual odometry) and the slot's estimate (+ landmark fixes); a fourth trajectory
+chains the visual odometry alone.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from percept.sensors import Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig
+
+from .fusion import FusionNoise, PoseFilter
+from .landmarks import LandmarkFinder, LandmarkSighting
+from .stereo_vo import StereoVO
+from .types import VOStep
+
+
+@dataclass(frozen=True)
+class OdometryDebug:
+    """vo_pose: visual odometry alone, chained from the start pose; dead_reckoning_pose: IMU + wheel speed;
+    fused_pose, fused_covariance (3, 3): IMU + wheel + VO without landmark fixes; vo_step: this frame's VO;
+    sightings: mapped signs measured this frame; fixes: how many of them updated the estimate (the others
+    failed the gate); landmark_fix: at least one did; rejected: sensor samples rejected so far (NaN, absurd)."""
+
+    vo_pose: Pose2D
+    dead_reckoning_pose: Pose2D
+    fused_pose: Pose2D
+    fused_covariance: np.ndarray
+    vo_step: VOStep
+    sightings: tuple[LandmarkSighting, ...]
+    fixes: int
+    rejected: int
+
+    @property
+    def landmark_fix(self) -> bool:
+        return self.fixes > 0
+
+
+def _planar(T: np.ndarray) -> tuple[float, float, float]:
+    return float(T[0, 3]), float(T[1, 3]), math.atan2(T[1, 0], T[0, 0])
+
+
+class OdometrySlot:
+    """rig; dt_s: frame period [s]; landmarks: the map (None: no fixes); start: the known start pose."""
+
+    def __init__(self, rig: StereoRig, dt_s: float, landmarks: LandmarkMap | None, start: Pose2D,
+                 noise: FusionNoise = FusionNoise()):
+        self.rig, self.dt_s, self.start, self.noise = rig, dt_s, start, noise
+        self.vo = StereoVO(rig.camera.K, rig.baseline_m, rig.mount_height_m)
+        self.finder = LandmarkFinder(rig, landmarks) if landmarks is not None and len(landmarks) else None
+        T_cv = rig.cam_from_vehicle(Side.LEFT).matrix()
+        self._T_cv, self._T_vc = T_cv, np.linalg.inv(T_cv)
+        # vehicle (dx, dy, dyaw) from camera (rx, ry, rz, tx, ty, tz): dx = tz, dy = -tx + mount_x dyaw, dyaw = -ry
+        J = np.zeros((3, 6))
+        J[0, 5], J[1, 3], J[1, 1], J[2, 1] = 1.0, -1.0, -rig.mount_x_m, -1.0
+        self._J = J
+        self.reset()
+
+    def reset(self) -> None:
+        self.vo.reset()
+        self.dead_reckoning = PoseFilter(self.start, self.noise)
+        self.fused = PoseFilter(self.start, self.noise)
+        self.estimate = PoseFilter(self.start, self.noise)
+        self._vo_T = self.start.world_from_vehicle().matrix()
+        self._last_motion = np.eye(4)
+        self._frames = 0
+
+    @property
+    def filters(self) -> tuple[PoseFilter, ...]:
+        return self.dead_reckoning, self.fused, self.estimate
+
+    def step(self, frame: Frame, upstream: dict) -> tuple[PoseEstimate, OdometryDebug]:
+        imu = frame.imu
+        for f in self.filters:
+            if self._frames:
+                f.predict(float(imu.gyro_rps[2]), float(imu.accel_mps2[0]), self.dt_s)
+            f.update_wheel(float(frame.wheel_speed_mps))
+        self._frames += 1
+        vo = self._visual_odometry(frame)
+        sightings: list[LandmarkSighting] = []
+        fixes = 0
+        if self.finder is not None and frame.left is not None and frame.right is not None:
+            sightings = self.finder.sight(frame.left, frame.right, self.estimate.pose, self.estimate.pose_covariance)
+            for s in sightings:
+                fixes += self.estimate.update_landmark(self.finder.map.position(s.marker_id)[:2], s.position_v_m[:2],
+                                                       s.covariance_xy)
+        est = self.estimate
+        debug = OdometryDebug(Pose2D(*_planar(self._vo_T)), self.dead_reckoning.pose, self.fused.pose,
+                              self.fused.pose_covariance, vo, tuple(sightings), fixes,
+                              sum(f.rejected for f in self.filters))
+        return PoseEstimate(est.pose, est.speed_mps, est.pose_covariance, True), debug
+
+    def _visual_odometry(self, frame: Frame) -> VOStep:
+        """VO on this frame's pair; updates the fused filters and the VO-only chain."""
+        step = self.vo.process(frame.left, frame.right)
+        if frame.left is None or frame.right is None:
+            return step  # dropped: the next image's motion is measured from the last image
+        if step.ok:
+            # the vehicle's motion: T_v = T_vc T_c T_cv (camera motion seen from the vehicle frame)
+            motion = self._T_vc @ step.T_prev_cur @ self._T_cv
+            dx, dy, dyaw = _planar(motion)
+            cov = self._J @ step.covariance @ self._J.T
+            for f in (self.fused, self.estimate):
+                f.update_relative(dx, dy, dyaw, cov)
+            self._last_motion = motion
+        # VO alone: a lost step is bridged with the last measured motion (constant velocity)
+        self._vo_T = self._vo_T @ (self._last_motion if step.ok or self._frames > 1 else np.eye(4))
+        for f in (self.fused, self.estimate):
+            f.clone()
+        return step
