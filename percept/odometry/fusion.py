@@ -1,6 +1,7 @@
 """Pose fusion: an extended Kalman filter (filterpy) over planar pose, speed, gyro bias and wheel-speed scale.
 
-The IMU (yaw rate, forward acceleration) predicts; the wheel speed, visual odometry and landmark fixes update.
+The IMU (yaw rate, forward acceleration) predicts through the kinematic bicycle model (the vehicle centre's
+velocity leans from the heading by the slip angle in a turn; Rajamani, *Vehicle Dynamics and Control*, sec. 2.2); the wheel speed, visual odometry and landmark fixes update.
 Visual odometry measures the motion between two images, so the filter keeps a copy of the pose at the last
 processed image (stochastic cloning: Roumeliotis & Burdick 2002, "Stochastic cloning: a generalized framework
 for processing relative state measurements", ICRA) and updates with the relative pose between the copy and now.
@@ -18,6 +19,7 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 
 from percept.sensors import Pose2D, wrap_angle
+from percept.sensors.vehicle import WHEELBASE_M
 
 # state: pose (x, y, yaw), speed, gyro bias, wheel scale, then the clone of the pose at the last image
 X, Y, YAW, V, BG, KW, XC, YC, YAWC = range(9)
@@ -46,18 +48,27 @@ class FusionNoise:
 
 
 class _Ekf(ExtendedKalmanFilter):
-    """filterpy's EKF with the unicycle motion model's state prediction."""
+    """filterpy's EKF with the kinematic bicycle's state prediction (``slip_arm_m`` set by the owner)."""
+
+    slip_arm_m = WHEELBASE_M / 2
 
     def predict_x(self, u=None) -> None:
         yaw_rate, accel, dt = u
         x = self.x
         w = yaw_rate - x[BG, 0]
-        heading = x[YAW, 0] + w * dt / 2
-        # midpoint rule: p += v dt (cos, sin)(psi + w dt / 2); psi += w dt; v += a dt
-        x[X, 0] += x[V, 0] * dt * math.cos(heading)
-        x[Y, 0] += x[V, 0] * dt * math.sin(heading)
+        course = x[YAW, 0] + slip_angle(w, x[V, 0], self.slip_arm_m)
+        # the centre moves along heading + slip for one step, then the heading and speed change (explicit Euler,
+        # as the vehicle model integrates): p += v dt (cos, sin)(psi + beta); psi += w dt; v += a dt
+        x[X, 0] += x[V, 0] * dt * math.cos(course)
+        x[Y, 0] += x[V, 0] * dt * math.sin(course)
         x[YAW, 0] = wrap_angle(x[YAW, 0] + w * dt)
         x[V, 0] = max(x[V, 0] + accel * dt, 0.0)
+
+
+def slip_angle(yaw_rate_rps: float, speed_mps: float, arm_m: float) -> float:
+    """Kinematic bicycle: the centre's velocity leans from the heading by beta, sin(beta) = r l_r / v, with l_r
+    the centre's distance to the rear axle (whose velocity is along the heading) [rad]."""
+    return math.asin(max(-0.5, min(0.5, yaw_rate_rps * arm_m / max(speed_mps, 1.0))))
 
 
 def _angle_residual(index: int):
@@ -82,7 +93,8 @@ class PoseFilter:
                              1e-6, 1e-6, 1e-8])
         self._last_input = (0.0, 0.0)
         self._started = False
-        self.rejected = 0
+        self.rejected = 0  # sensor samples rejected as NaN or absurd
+        self.gated = 0  # measurements refused by the innovation gate
 
     @property
     def pose(self) -> Pose2D:
@@ -111,12 +123,14 @@ class PoseFilter:
         w, a = self._last_input
         widen = 1.0 if good else 25.0
         x = self.kf.x[:, 0]
-        v, heading = x[V], x[YAW] + (w - x[BG]) * dt / 2
+        v, arm = max(x[V], 1.0), self.kf.slip_arm_m
+        beta = slip_angle(w - x[BG], x[V], arm)
+        c, s = math.cos(x[YAW] + beta), math.sin(x[YAW] + beta)
+        # Jacobian of the step: d beta / d v = -r l_r / (v^2 cos beta), d beta / d b_g = -l_r / (v cos beta)
+        db_dv, db_dbg = -(w - x[BG]) * arm / (v * v * math.cos(beta)), -arm / (v * math.cos(beta))
         F = np.eye(N_STATE)
-        c, s = math.cos(heading), math.sin(heading)
-        # Jacobian of the midpoint unicycle step with respect to yaw, speed and gyro bias
-        F[X, YAW], F[X, V], F[X, BG] = -v * dt * s, dt * c, v * dt * dt * s / 2
-        F[Y, YAW], F[Y, V], F[Y, BG] = v * dt * c, dt * s, -v * dt * dt * c / 2
+        F[X, YAW], F[X, V], F[X, BG] = -x[V] * dt * s, dt * c - x[V] * dt * s * db_dv, -x[V] * dt * s * db_dbg
+        F[Y, YAW], F[Y, V], F[Y, BG] = x[V] * dt * c, dt * s + x[V] * dt * c * db_dv, x[V] * dt * c * db_dbg
         F[YAW, BG] = -dt
         self.kf.F = F
         Q = np.zeros((N_STATE, N_STATE))
@@ -201,6 +215,7 @@ class PoseFilter:
         S = Hm @ self.kf.P @ Hm.T + R
         # normalised innovation squared y^T S^-1 y against chi2 at 99 %
         if float((y.T @ np.linalg.solve(S, y))[0, 0]) > GATE_CHI2[len(z)]:
+            self.gated += 1
             return False
         residual = _angle_residual(angle_index) if angle_index is not None else np.subtract
         self.kf.update(z, lambda _s: Hm, hx, R=R, residual=residual)

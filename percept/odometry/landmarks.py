@@ -124,11 +124,14 @@ class LandmarkFinder:
         if not (c.min_range_m * 0.5 <= pc[2] <= c.max_range_m * 1.5):
             return None
         zc = float(pc[2])
-        # stereo depth error sigma_Z = Z^2 sigma_d / (f b) (sigma_d = sqrt(2) corner sigmas, four corners
-        # averaged but correlated: halved, not quartered); lateral sigma_X = Z sigma_u / f
+        # stereo depth error sigma_Z = Z^2 sigma_d / (f b) (sigma_d = sqrt(2) corner sigmas; four corners averaged
+        # but correlated: halved, not quartered); X = (u - cx) Z / f carries Z's error along the ray:
+        # Sigma_cam = J diag(sigma_u^2, sigma_v^2, sigma_Z^2) J^T, J = d(X, Y, Z) / d(u, v, Z)
         sig_z = zc ** 2 * np.sqrt(2.0) * c.corner_sigma_px / (cam.fx * self.rig.baseline_m) / 2.0
-        sig_x = zc * c.corner_sigma_px / cam.fx
-        cov_cam = np.diag([sig_x ** 2, sig_x ** 2, sig_z ** 2])
+        u, v = cl.mean(axis=0)
+        J = np.array([[zc / cam.fx, 0.0, (u - cam.cx) / cam.fx], [0.0, zc / cam.fy, (v - cam.cy) / cam.fy],
+                      [0.0, 0.0, 1.0]])
+        cov_cam = J @ np.diag([c.corner_sigma_px ** 2, c.corner_sigma_px ** 2, sig_z ** 2]) @ J.T
         R = self._v_from_c.R
         cov_v = (R @ cov_cam @ R.T)[:2, :2] + np.eye(2) * c.face_sigma_m ** 2
         return LandmarkSighting(marker_id, self._v_from_c.apply(pc), cov_v, cl, zc)
