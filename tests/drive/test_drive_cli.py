@@ -57,7 +57,6 @@ def test_drive_default_recording_path(tmp_path, monkeypatch):
     (["--scenario", "motorway"], "unknown scenario 'motorway'"),
     (["--condition", "snow"], "unknown condition 'snow'"),
     (["--lateral", "magic"], "Invalid value for '--lateral'"),
-    (["--odometry", "vision"], "no vision implementation yet"),
     (["--pedestrians", "vision", "--detector", "nope.npz"], "--detector must be sim, inria or a model file"),
     (["--duration", "-3"], "--duration must be a finite number"),
     (["--duration", "inf"], "--duration must be a finite number"),

@@ -99,7 +99,6 @@ def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
     (["--scenario", "highway", "--workers", "0"], "--workers must be a finite number between 1 and 256"),
     (["--scenario", "highway", "--engine", "spark"], "--engine must be local or ray"),
     (["--scenario", "highway", "--condition", "fog"], "condition"),
-    (["--scenario", "highway", "--odometry", "vision"], "no vision implementation yet"),
     (["--scenario", "highway", "--duration", "inf"], "--duration must be a finite number"),
     (["--scenario", "highway", "--duration", "0"], "--duration must be a finite number"),
     (["--scenario", "highway", "--duration", "1e308"], "--duration must be a finite number"),

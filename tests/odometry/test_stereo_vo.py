@@ -1,0 +1,76 @@
+"""Stereo visual odometry on rendered frames against the simulator's truth, and its degraded modes."""
+
+import math
+
+import numpy as np
+import pytest
+
+from percept.odometry import StereoVO, StereoVOConfig
+from percept.sensors import StereoRig
+
+
+def vo_for(rig: StereoRig) -> StereoVO:
+    return StereoVO(rig.camera.K, rig.baseline_m, rig.mount_height_m)
+
+
+def travelled(a, b) -> float:
+    return math.hypot(b.ego.x_m - a.ego.x_m, b.ego.y_m - a.ego.y_m)
+
+
+def test_steps_match_the_true_motion(loop_run):
+    world, shots = loop_run
+    vo = vo_for(world.cfg.rig)
+    est, true = [], []
+    for k, (frame, gt) in enumerate(shots[:60]):
+        step = vo.process(frame.left, frame.right)
+        if k:
+            assert step.ok, step.reason
+            # the camera's forward motion is the car's (straight road, no pitch)
+            est.append(step.T_prev_cur[2, 3])
+            true.append(travelled(shots[k - 1][1], gt))
+            assert step.inliers >= 12 and 0 < step.quality <= 1
+            assert np.all(np.linalg.eigvalsh(step.covariance) > 0)
+    est, true = np.array(est), np.array(true)
+    assert np.median(np.abs(est - true) / true) < 0.02
+    assert abs(est.sum() - true.sum()) / true.sum() < 0.01  # 86 m
+
+
+def test_a_dropped_frame_is_bridged_by_the_next_step(loop_run):
+    world, shots = loop_run
+    vo = vo_for(world.cfg.rig)
+    for frame, _ in shots[:5]:
+        vo.process(frame.left, frame.right)
+    dropped = vo.process(None, None)
+    assert not dropped.ok and dropped.reason == "dropped frame"
+    assert np.array_equal(dropped.T_prev_cur, np.eye(4))
+    step = vo.process(shots[6][0].left, shots[6][0].right)
+    # measured from the last image (frame 4) to frame 6: two frames of motion
+    assert step.ok
+    assert step.T_prev_cur[2, 3] == pytest.approx(travelled(shots[4][1], shots[6][1]), rel=0.03)
+
+
+def test_a_black_frame_fails_softly_and_tracking_restarts(loop_run):
+    world, shots = loop_run
+    vo = vo_for(world.cfg.rig)
+    vo.process(shots[0][0].left, shots[0][0].right)
+    black = np.zeros_like(shots[1][0].left)
+    step = vo.process(black, black)
+    assert not step.ok and "featureless" in step.reason
+    vo.process(shots[2][0].left, shots[2][0].right)  # a new keyframe
+    step = vo.process(shots[3][0].left, shots[3][0].right)
+    assert step.ok and step.T_prev_cur[2, 3] == pytest.approx(travelled(shots[2][1], shots[3][1]), rel=0.05)
+
+
+def test_bad_input_is_refused_with_a_clear_message():
+    rig = StereoRig()
+    with pytest.raises(ValueError, match="baseline_m must be positive"):
+        StereoVO(rig.camera.K, 0.0)
+    with pytest.raises(ValueError, match="finite \\(3, 3\\) intrinsic"):
+        StereoVO(np.eye(2), 0.5)
+    with pytest.raises(ValueError, match="camera_height_m must be positive"):
+        StereoVO(rig.camera.K, 0.5, camera_height_m=-1.0)
+    with pytest.raises(ValueError, match="min_inliers"):
+        StereoVOConfig(min_inliers=2)
+    vo = vo_for(rig)
+    with pytest.raises(ValueError, match="differ in size"):
+        vo.process(np.zeros((480, 640), np.uint8), np.zeros((240, 320), np.uint8))
