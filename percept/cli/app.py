@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import typer
 
-from . import (bench_cmd, calibrate_cmd, detect_cmd, drive_cmd, eval_cmd, lanes_cmd, render_cmd, scenarios_cmd,
-               stereo_cmd, train_cmd, view_cmd)
+from . import (bench_cmd, calibrate_cmd, detect_cmd, drive_cmd, eval_cmd, lanes_cmd, odometry_cmd, render_cmd,
+               scenarios_cmd, stereo_cmd, train_cmd, view_cmd)
 from .common import Command, Group, console, err, fail, progress_bar, run_cli, write_json
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, cls=Group,
@@ -17,6 +17,7 @@ app.command("render", cls=Command)(render_cmd.render)
 app.command("eval", cls=Command)(eval_cmd.eval_)
 app.command("bench", cls=Command)(bench_cmd.bench)
 app.command("stereo", cls=Command)(stereo_cmd.stereo)
+app.command("odometry", cls=Command)(odometry_cmd.odometry)
 app.command("train-detector", cls=Command)(train_cmd.train_detector)
 lanes_cmd.register(app)
 detect_cmd.register(app)

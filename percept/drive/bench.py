@@ -71,7 +71,6 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
     """One stereo pair of the ``highway`` scenario vs highway-env's top-down render of the same world."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     from percept.sims import SimWorld, WorldConfig
-    from percept.sims.coords import hw_pose
     from percept.sims.snapshot import scene_from_road
 
     cv2.setNumThreads(1)
@@ -104,6 +103,7 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     a search spread over frames), so it is timed on consecutive frames and reported as its mean cost; the stateless
     peer as its median."""
     from percept.sims import SimWorld, WorldConfig
+    from percept.sims.coords import hw_pose
 
     if task.vision is None:
         raise ValueError(f"the {task.name} task has no vision slot to time")

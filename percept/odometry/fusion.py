@@ -1,4 +1,5 @@
-"""Pose fusion: an extended Kalman filter (filterpy) over planar pose, speed, gyro bias and wheel-speed scale.
+"""Pose fusion: an extended Kalman filter (filterpy) over planar pose, speed, gyro and accelerometer biases and
+the wheel-speed scale.
 
 The IMU (yaw rate, forward acceleration) predicts through the kinematic bicycle model (the vehicle centre's
 velocity leans from the heading by the slip angle in a turn; Rajamani, *Vehicle Dynamics and Control*, sec. 2.2); the wheel speed, visual odometry and landmark fixes update.
@@ -21,9 +22,10 @@ from filterpy.kalman import ExtendedKalmanFilter
 from percept.sensors import Pose2D, wrap_angle
 from percept.sensors.vehicle import WHEELBASE_M
 
-# state: pose (x, y, yaw), speed, gyro bias, wheel scale, then the clone of the pose at the last image
-X, Y, YAW, V, BG, KW, XC, YC, YAWC = range(9)
-N_STATE = 9
+# state: pose (x, y, yaw), speed, gyro bias, wheel scale, accelerometer bias, then the clone of the pose at the
+# last image
+X, Y, YAW, V, BG, KW, BA, XC, YC, YAWC = range(10)
+N_STATE = 10
 # 99 % gates of the normalised innovation squared: chi2 with 2 and 3 degrees of freedom
 GATE_CHI2 = {2: 9.21, 3: 11.34}
 
@@ -32,7 +34,8 @@ GATE_CHI2 = {2: 9.21, 3: 11.34}
 class FusionNoise:
     """gyro_sigma_rps, accel_sigma_mps2: white noise of one IMU sample; gyro_bias_walk [rad/s/sqrt(s)];
     wheel_sigma_mps: of one wheel-speed sample; wheel_scale_sigma: prior std of the wheel scale error;
-    init_bias_sigma_rps: prior std of the gyro bias; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
+    init_bias_sigma_rps: prior std of the gyro bias; accel_bias_walk [m/s²/sqrt(s)], init_accel_bias_mps2: the
+    accelerometer bias's random walk and prior std; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
     beyond these is absurd and rejected; vo_scale: multiplies the visual odometry's own covariance."""
 
     gyro_sigma_rps: float = 0.003
@@ -41,6 +44,8 @@ class FusionNoise:
     wheel_sigma_mps: float = 0.07
     wheel_scale_sigma: float = 0.015
     init_bias_sigma_rps: float = 0.002
+    accel_bias_walk: float = 0.003
+    init_accel_bias_mps2: float = 0.02
     max_yaw_rate_rps: float = 3.0
     max_accel_mps2: float = 20.0
     max_speed_mps: float = 90.0
@@ -58,11 +63,11 @@ class _Ekf(ExtendedKalmanFilter):
         w = yaw_rate - x[BG, 0]
         course = x[YAW, 0] + slip_angle(w, x[V, 0], self.slip_arm_m)
         # the centre moves along heading + slip for one step, then the heading and speed change (explicit Euler,
-        # as the vehicle model integrates): p += v dt (cos, sin)(psi + beta); psi += w dt; v += a dt
+        # as the vehicle model integrates): p += v dt (cos, sin)(psi + beta); psi += w dt; v += (a - b_a) dt
         x[X, 0] += x[V, 0] * dt * math.cos(course)
         x[Y, 0] += x[V, 0] * dt * math.sin(course)
         x[YAW, 0] = wrap_angle(x[YAW, 0] + w * dt)
-        x[V, 0] = max(x[V, 0] + accel * dt, 0.0)
+        x[V, 0] = max(x[V, 0] + (accel - x[BA, 0]) * dt, 0.0)
 
 
 def slip_angle(yaw_rate_rps: float, speed_mps: float, arm_m: float) -> float:
@@ -80,7 +85,7 @@ def _angle_residual(index: int):
 
 
 class PoseFilter:
-    """Planar pose, speed, gyro bias and wheel scale from IMU + wheel speed, updated by visual odometry's relative
+    """Planar pose, speed, gyro and accelerometer biases and wheel scale from IMU + wheel speed, updated by visual odometry's relative
     motion and by landmark positions. ``start``: the known start pose; speed starts from the first wheel reading."""
 
     def __init__(self, start: Pose2D, noise: FusionNoise = FusionNoise()):
@@ -90,7 +95,7 @@ class PoseFilter:
         self.kf.x[[X, Y, YAW], 0] = (start.x_m, start.y_m, start.yaw_rad)
         self.kf.x[KW, 0] = 1.0
         self.kf.P = np.diag([1e-6, 1e-6, 1e-8, 1.0, noise.init_bias_sigma_rps ** 2, noise.wheel_scale_sigma ** 2,
-                             1e-6, 1e-6, 1e-8])
+                             noise.init_accel_bias_mps2 ** 2, 1e-6, 1e-6, 1e-8])
         self._last_input = (0.0, 0.0)
         self._started = False
         self.rejected = 0  # sensor samples rejected as NaN or absurd
@@ -132,12 +137,14 @@ class PoseFilter:
         F[X, YAW], F[X, V], F[X, BG] = -x[V] * dt * s, dt * c - x[V] * dt * s * db_dv, -x[V] * dt * s * db_dbg
         F[Y, YAW], F[Y, V], F[Y, BG] = x[V] * dt * c, dt * s + x[V] * dt * c * db_dv, x[V] * dt * c * db_dbg
         F[YAW, BG] = -dt
+        F[V, BA] = -dt
         self.kf.F = F
         Q = np.zeros((N_STATE, N_STATE))
         Q[YAW, YAW] = widen * (n.gyro_sigma_rps * dt) ** 2
         Q[V, V] = widen * (n.accel_sigma_mps2 * dt) ** 2
         Q[BG, BG] = n.gyro_bias_walk ** 2 * dt
         Q[KW, KW] = 1e-10 * dt
+        Q[BA, BA] = n.accel_bias_walk ** 2 * dt
         self.kf.Q = Q
         self.kf.predict(u=(w, a, dt))
         return good

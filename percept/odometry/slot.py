@@ -96,20 +96,25 @@ class OdometrySlot:
         return PoseEstimate(est.pose, est.speed_mps, est.pose_covariance, True), debug
 
     def _visual_odometry(self, frame: Frame) -> VOStep:
-        """VO on this frame's pair; updates the fused filters and the VO-only chain."""
+        """VO on this frame's pair; the VO-only chain takes every step, the filters the pose against the last
+        keyframe when the keyframe changes (one independent measurement per keyframe span)."""
         step = self.vo.process(frame.left, frame.right)
         if frame.left is None or frame.right is None:
             return step  # dropped: the next image's motion is measured from the last image
         if step.ok:
-            # the vehicle's motion: T_v = T_vc T_c T_cv (camera motion seen from the vehicle frame)
-            motion = self._T_vc @ step.T_prev_cur @ self._T_cv
-            dx, dy, dyaw = _planar(motion)
-            cov = self._J @ step.covariance @ self._J.T
-            for f in (self.fused, self.estimate):
-                f.update_relative(dx, dy, dyaw, cov)
-            self._last_motion = motion
+            self._last_motion = self._vehicle(step.T_prev_cur)
         # VO alone: a lost step is bridged with the last measured motion (constant velocity)
-        self._vo_T = self._vo_T @ (self._last_motion if step.ok or self._frames > 1 else np.eye(4))
-        for f in (self.fused, self.estimate):
-            f.clone()
+        self._vo_T = self._vo_T @ (self._last_motion if self._frames > 1 else np.eye(4))
+        if step.keyframe:
+            if step.ok and step.T_key_cur is not None:
+                dx, dy, dyaw = _planar(self._vehicle(step.T_key_cur))
+                cov = self._J @ step.key_covariance @ self._J.T
+                for f in (self.fused, self.estimate):
+                    f.update_relative(dx, dy, dyaw, cov)
+            for f in (self.fused, self.estimate):
+                f.clone()
         return step
+
+    def _vehicle(self, T_cam: np.ndarray) -> np.ndarray:
+        """Camera motion -> the vehicle's: T_v = T_vc T_c T_cv."""
+        return self._T_vc @ T_cam @ self._T_cv

@@ -10,7 +10,7 @@ odometry" (CVPR); Geiger, Ziegler & Stiller 2011, "StereoScan" (IV); Hartley & Z
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -60,6 +60,9 @@ def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
     return T
 
 
+RANSAC_SEED = 1234
+
+
 class StereoVO:
     """Frame-to-keyframe stereo odometry of a rectified pair. K: (3, 3) intrinsics of both cameras [px];
     baseline_m: distance between the optical centres [m] (the right camera is at +b along the left's x)."""
@@ -78,7 +81,9 @@ class StereoVO:
         self.reset()
 
     def reset(self) -> None:
-        """Forget the keyframe: the next frame starts a new one."""
+        """Forget the keyframe: the next frame starts a new one. RANSAC's random generator is re-seeded, so that a
+        run gives the same result whatever ran before it in the process."""
+        cv2.setRNGSeed(RANSAC_SEED)
         self._kf_points: np.ndarray | None = None  # (N, 3) keyframe camera frame [m]
         self._pixels: np.ndarray | None = None  # (N, 2) where they are in the previous left image
         self._prev: np.ndarray | None = None  # previous left image (grey)
@@ -101,8 +106,7 @@ class StereoVO:
             return step
         # too few inliers left: this frame (whose motion is already measured when ok) becomes the keyframe
         new = self._start_keyframe(gl, gr, step.reason or "keyframe")
-        return VOStep(step.T_prev_cur, step.covariance, step.ok, step.tracked, step.inliers, step.quality, True,
-                      step.reason) if step.ok else new
+        return replace(step, keyframe=True) if step.ok else new
 
     def _start_keyframe(self, gl: np.ndarray, gr: np.ndarray, reason: str) -> VOStep:
         c = self.config
@@ -161,4 +165,4 @@ class StereoVO:
         T_prev_cur = _inverse(self._T_kf_prev) @ T_kf_cur
         step_cov = cov + self._cov_prev
         self._T_kf_prev, self._cov_prev = T_kf_cur, cov
-        return VOStep(T_prev_cur, step_cov, True, n, len(idx), len(idx) / n)
+        return VOStep(T_prev_cur, step_cov, True, n, len(idx), len(idx) / n, T_key_cur=T_kf_cur, key_covariance=cov)

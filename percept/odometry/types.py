@@ -18,7 +18,11 @@ class VOStep:
     y down, z forward; translation in metres), so that ``p_prev = T_prev_cur @ p_cur``; identity when not ok.
     covariance: (6, 6) of (rotation vector [rad], translation [m]) of T_prev_cur.
     ok: the motion was measured; tracked: features tracked into this frame; inliers: the geometric fit's inliers;
-    quality: inlier share in [0, 1]; keyframe: this frame started a new keyframe; reason: why not ok ("" when ok).
+    quality: inlier share in [0, 1]; keyframe: this frame started a new keyframe; reason: why not ok ("" when ok);
+    T_key_cur, key_covariance: (4, 4) pose of the current camera in the frame of the keyframe it was measured
+    against, and its (6, 6) covariance (None when not measured, or when the estimator has no keyframes). Steps
+    chained from one keyframe share its errors; poses against successive keyframes do not, which is what a filter
+    should be given.
     """
 
     T_prev_cur: np.ndarray
@@ -29,6 +33,8 @@ class VOStep:
     quality: float = 0.0
     keyframe: bool = False
     reason: str = ""
+    T_key_cur: np.ndarray | None = None
+    key_covariance: np.ndarray | None = None
 
     @classmethod
     def failed(cls, reason: str, tracked: int = 0, keyframe: bool = False) -> "VOStep":
