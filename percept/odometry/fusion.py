@@ -36,7 +36,11 @@ class FusionNoise:
     wheel_sigma_mps: of one wheel-speed sample; wheel_scale_sigma: prior std of the wheel scale error;
     init_bias_sigma_rps: prior std of the gyro bias; accel_bias_walk [m/s²/sqrt(s)], init_accel_bias_mps2: the
     accelerometer bias's random walk and prior std; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
-    beyond these is absurd and rejected; vo_scale: multiplies the visual odometry's own covariance."""
+    beyond these is absurd and rejected; vo_scale_translation, vo_scale_rotation: multiply the visual odometry's
+    own variances of translation and of yaw (its covariance comes from the reprojection residuals alone and leaves
+    out the keyframe points' depth error; these factors were measured from its innovations on `loop`);
+    lockout_sightings, lockout_widen: after this many landmark sightings refused in a row, the pose variances are
+    multiplied by lockout_widen."""
 
     gyro_sigma_rps: float = 0.003
     accel_sigma_mps2: float = 0.08
@@ -49,7 +53,10 @@ class FusionNoise:
     max_yaw_rate_rps: float = 3.0
     max_accel_mps2: float = 20.0
     max_speed_mps: float = 90.0
-    vo_scale: float = 4.0
+    vo_scale_translation: float = 9.0
+    vo_scale_rotation: float = 4.0
+    lockout_sightings: int = 3
+    lockout_widen: float = 4.0
 
 
 class _Ekf(ExtendedKalmanFilter):
@@ -100,6 +107,7 @@ class PoseFilter:
         self._started = False
         self.rejected = 0  # sensor samples rejected as NaN or absurd
         self.gated = 0  # measurements refused by the innovation gate
+        self._refused = 0  # landmark sightings refused in a row
 
     @property
     def pose(self) -> Pose2D:
@@ -191,7 +199,10 @@ class PoseFilter:
         Hm[0, [X, Y, XC, YC, YAWC]] = c, sn, -c, -sn, h[1, 0]
         Hm[1, [X, Y, XC, YC, YAWC]] = -sn, c, sn, -c, -h[0, 0]
         Hm[2, [YAW, YAWC]] = 1.0, -1.0
-        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, hx, self.noise.vo_scale * cov, 2)
+        n = self.noise
+        # Sigma = D Sigma_vo D, D = diag(sqrt(k_t), sqrt(k_t), sqrt(k_r))
+        d = np.sqrt([n.vo_scale_translation, n.vo_scale_translation, n.vo_scale_rotation])
+        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, hx, cov * np.outer(d, d), 2)
 
     def update_landmark(self, landmark_xy_m: np.ndarray, measured_xy_m: np.ndarray, cov: np.ndarray) -> bool:
         """A mapped landmark at world ``landmark_xy_m`` (2,) seen at ``measured_xy_m`` (2,) in the vehicle frame
@@ -210,7 +221,14 @@ class PoseFilter:
         Hm = np.zeros((2, N_STATE))
         Hm[0, [X, Y, YAW]] = -c, -sn, h[1, 0]
         Hm[1, [X, Y, YAW]] = sn, -c, -h[0, 0]
-        return self._gated_update(np.asarray(measured_xy_m, float).reshape(2, 1), Hm, hx, cov, None)
+        accepted = self._gated_update(np.asarray(measured_xy_m, float).reshape(2, 1), Hm, hx, cov, None)
+        self._refused = 0 if accepted else self._refused + 1
+        if self._refused >= self.noise.lockout_sightings:
+            # gate lock-out: consistent sightings keep disagreeing with an estimate that is too sure of itself;
+            # widen its pose uncertainty so that the next one can pull it back
+            self.kf.P[[X, Y, YAW], [X, Y, YAW]] *= self.noise.lockout_widen
+            self._refused = 0
+        return accepted
 
     def _gated_update(self, z: np.ndarray, Hm: np.ndarray, hx, R: np.ndarray, angle_index: int | None) -> bool:
         if not (np.all(np.isfinite(z)) and np.all(np.isfinite(R))):

@@ -36,7 +36,7 @@ class StereoVOConfig:
     min_disparity_px: float = 0.5
     min_inliers: int = 12
     keyframe_inliers: int = 60
-    ransac_px: float = 1.0
+    ransac_px: float = 0.7
 
     def __post_init__(self) -> None:
         if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:
@@ -95,27 +95,29 @@ class StereoVO:
         step and keeps the keyframe, so tracking resumes on the next frame."""
         if left is None or right is None:
             return VOStep.failed("dropped frame")
-        gl, gr = to_gray(left), to_gray(right)
-        if gl.shape != gr.shape:
-            raise ValueError(f"left and right images differ in size: {gl.shape} and {gr.shape}")
+        if np.shape(left)[:2] != np.shape(right)[:2]:
+            raise ValueError(f"left and right images differ in size: {np.shape(left)} and {np.shape(right)}")
+        gl = to_gray(left)
         if self._kf_points is None or self._prev is None or self._prev.shape != gl.shape:
-            return self._start_keyframe(gl, gr, "first frame")
+            return self._start_keyframe(gl, right, "first frame")
         step = self._track(gl)
         if step.ok and step.inliers >= self.config.keyframe_inliers:
             self._prev = gl
             return step
         # too few inliers left: this frame (whose motion is already measured when ok) becomes the keyframe
-        new = self._start_keyframe(gl, gr, step.reason or "keyframe")
+        new = self._start_keyframe(gl, right, step.reason or "keyframe")
         return replace(step, keyframe=True) if step.ok else new
 
-    def _start_keyframe(self, gl: np.ndarray, gr: np.ndarray, reason: str) -> VOStep:
+    def _start_keyframe(self, gl: np.ndarray, right: np.ndarray, reason: str) -> VOStep:
+        """Corners of the left image with their stereo depth become the keyframe (the right image is only read
+        here)."""
         c = self.config
         corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold)
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
         self._kf_points = self._pixels = None
         if len(corners) < c.min_inliers:
             return VOStep.failed(f"{reason}: only {len(corners)} corners (dark or featureless)", keyframe=True)
-        matched, ok = track(gl, gr, corners, c.win_px, c.levels, self._disparity_guess(corners))
+        matched, ok = track(gl, to_gray(right), corners, c.win_px, c.levels, self._disparity_guess(corners))
         d = corners[:, 0] - matched[:, 0]
         ok &= (np.abs(corners[:, 1] - matched[:, 1]) <= c.max_row_err_px) & (d >= c.min_disparity_px)
         if ok.sum() < c.min_inliers:

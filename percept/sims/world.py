@@ -66,7 +66,8 @@ class SimWorld:
         self.env.reset(seed=cfg.seed)
         self.dt = 1.0 / self.env.config["simulation_frequency"]
         self.road_geometry = build_road_geometry(self.env.road.network)
-        self.renderer = StereoRenderer(cfg.rig, self.road_geometry, seed=cfg.seed, scenery=cfg.scenery)
+        self.renderer = StereoRenderer(cfg.rig, self.road_geometry, seed=cfg.seed, scenery=cfg.scenery,
+                                       signs_xy=self.landmark_map().positions_m[:, :2])
         self.effects = ConditionEffects(cfg.rig, cfg.condition)
         self.imu = ImuModel(cfg.seed)
         self.ids = ObjectIds()

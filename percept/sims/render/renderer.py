@@ -56,10 +56,11 @@ class StereoImages:
 
 
 class StereoRenderer:
-    """Renders a scenario's world for a stereo rig. Deterministic for a given seed."""
+    """Renders a scenario's world for a stereo rig. Deterministic for a given seed. ``signs_xy`` (N, 2): landmark
+    signs' world positions [m], kept clear of lamp poles."""
 
     def __init__(self, rig: StereoRig, road: RoadGeometry, seed: int = 0, palette: Palette = Palette(),
-                 scenery: bool = True):
+                 scenery: bool = True, signs_xy: np.ndarray | None = None):
         self.rig = rig
         self.road = road
         self.layers = {s: GroundLayer(rig, s, seed, palette) for s in (Side.LEFT, Side.RIGHT)}
@@ -73,7 +74,7 @@ class StereoRenderer:
         self._markers: dict[int, int] = {}
         self._atlas = TextureAtlas(self.textures)
         self.tex = SceneryTextures(panel=0, foliage=1, facades=tuple(facades))
-        self.scenery = build_scenery(road, seed, self.tex) if scenery else PatchBatch.empty()
+        self.scenery = build_scenery(road, seed, self.tex, signs_xy) if scenery else PatchBatch.empty()
         s = self.scenery
         self._scenery_packed = s.pack()
         # bounding circle of each scenery patch on the ground, for the per-frame view-cone test

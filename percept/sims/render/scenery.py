@@ -103,8 +103,16 @@ def _tree(b: PatchBuilder, rng: np.random.Generator, c: np.ndarray, r: float, ax
               repeat=(max(1.0, r / 1.5), max(1.0, canopy_h / 3.0)))
 
 
-def build_scenery(road: RoadGeometry, seed: int, tex: SceneryTextures) -> PatchBatch:
+SIGN_CLEAR_M = 20.0
+"""No lamp pole stands within this distance of a landmark sign [m]: as on a real road, nothing is put in front of
+a sign (poles every 40 m would otherwise hide every sign on one side of a road whenever the two spacings line up)."""
+
+
+def build_scenery(road: RoadGeometry, seed: int, tex: SceneryTextures,
+                  signs_xy: np.ndarray | None = None) -> PatchBatch:
+    """signs_xy: (N, 2) world positions of landmark signs to keep clear of lamp poles [m]."""
     rng = np.random.default_rng(seed + 7919)
+    signs = np.zeros((0, 2)) if signs_xy is None else np.asarray(signs_xy, float).reshape(-1, 2)
     grid = _RoadGrid(road)
     b = PatchBuilder()
     for edge, outward in road.edges:
@@ -128,6 +136,8 @@ def build_scenery(road: RoadGeometry, seed: int, tex: SceneryTextures) -> PatchB
         # lamp poles every 40 m, 2.5 m out
         for i in range(int(rng.integers(0, 40)), n, 40):
             c = edge[i] + 2.5 * normal[i]
+            if len(signs) and np.min(np.hypot(*(signs - c).T)) < SIGN_CLEAR_M:
+                continue
             b.box(np.append(c, 4.0), _frame(edge[max(i - 1, 0)], edge[min(i + 1, n - 1)]), (0.18, 0.18, 8.0), POLE,
                   texture=tex.panel, faces="fblr")
         # trees: clusters 6-25 m out
