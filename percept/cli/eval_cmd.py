@@ -37,8 +37,15 @@ def eval_(
     json_path: opt.JsonOut = None,
     redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
                                                       "settings (other slots, duration or percept version).")] = False,
+    strict: Annotated[bool, opt.flag("--strict", help="Exit 1 when any run has a collision, a pedestrian "
+                                                          "collision or a lane departure (listed, each with the "
+                                                          "command that reproduces it).")] = False,
 ):
     """Drive every (scenario, condition, seed) and summarise the metrics per scenario and condition.
+
+    Besides the runs and summary.json, --out gets summary.csv (every metric per scenario and condition: runs,
+    mean, p95, worst), summary.md (safety counts, headline metrics, runs to look at with the command that
+    reproduces each) and plots/*.png.
 
     Each finished run is written at once (complete or absent), so an interrupted batch keeps its runs and the
     same command resumes it. A run is reused only if it was made with the same settings (slots, duration, percept
@@ -73,9 +80,23 @@ def eval_(
         err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
     summary = _run(plan, out, workers, eng, address, redo, files)
     console.print(summary_table(summary, TASKS))
-    console.print(f"all metrics per scenario and condition (mean / max / min): {out / 'summary.json'}")
+    console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
+                  f"{out / 'summary.md'}; plots in {out / 'plots'}")
     write_json(json_path, summary)
     _report_failures(summary, len(plan.jobs), out)
+    if strict:
+        _strict(summary)
+
+
+def _strict(summary: dict) -> None:
+    """--strict: list every run with a collision, a pedestrian collision or a lane departure and exit 1."""
+    for u in summary["unsafe"]:
+        console.print(f"[red]unsafe[/] {escape(u['scenario'])}/{u['condition']}/seed {u['seed']}: {u['what']}; "
+                      f"reproduce: {escape(u['reproduce'])}", soft_wrap=True)
+    if summary["unsafe"]:
+        err.print(f"[bold red]error:[/] --strict: {len(summary['unsafe'])} run(s) had a collision, a pedestrian "
+                  "collision or a lane departure (listed above)", highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
 
 
 def _report_failures(summary: dict, total: int, out: Path) -> None:
@@ -95,16 +116,17 @@ def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict
     """The batch under a progress bar; Ctrl-C says how many finished runs are kept."""
     from percept.drive.batch import evaluate
 
-    kept = [0]
+    kept, failed = [0], [0]
 
     def advance(r: dict) -> None:
         kept[0] += "error" not in r
-        bar.advance(task)
+        failed[0] += "error" in r
+        bar.update(task, advance=1, description=f"eval {len(plan.jobs)} runs, {failed[0]} failed")
 
     on_interrupt(lambda: f"{kept[0]} finished run{'' if kept[0] == 1 else 's'} kept in {out / 'runs'}; run the same "
                          "command to resume")
     with progress_bar() as bar:
-        task = bar.add_task(f"eval {len(plan.jobs)} runs", total=len(plan.jobs))
+        task = bar.add_task(f"eval {len(plan.jobs)} runs, 0 failed", total=len(plan.jobs))
         try:
             return evaluate(plan, out, workers, eng, address, progress=advance, redo=redo, files=files)
         except (RuntimeError, ValueError) as e:

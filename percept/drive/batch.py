@@ -1,4 +1,5 @@
-"""Batch evaluation: the closed loop over scenarios x conditions x seeds, one run JSON each, and a summary.
+"""Batch evaluation: the closed loop over scenarios x conditions x seeds, one run JSON each, and a summary
+(``summary.json``; ``summary.csv``, ``summary.md`` and ``plots/`` from ``percept.drive.report``).
 
 Runs go to worker processes (``workers``, one OpenCV thread each) or to a Ray cluster. Each finished run is
 written at once (atomically) to ``OUT/runs/<scenario>-<condition>-<seed>.json``, so an interrupted batch keeps
@@ -206,8 +207,14 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
             results.append(r)
             if progress:
                 progress(r)
-    summary = {"settings": settings, **summarize(plan, results)}
+    from .report import reproduce_command, unsafe_runs, write_reports
+    from .tasks import TASKS
+
+    summary = {"settings": settings, **summarize(plan, results),
+               "unsafe": [{"scenario": r["scenario"], "condition": r["condition"], "seed": r["seed"], "what": what,
+                           "reproduce": reproduce_command(r, settings)} for r, what in unsafe_runs(results)]}
     write_json_atomic(out_dir / "summary.json", summary)
+    write_reports(plan, results, settings, out_dir, TASKS)
     return summary
 
 

@@ -15,6 +15,8 @@ from percept.odometry.metrics import ate_rmse_m, final_position_error_m, kitti_d
 # P(chi2 with 2 dof <= 11.83) = 0.9973, the probability of a 1-D +-3 sigma interval
 NEES_3SIGMA_2DOF = 11.83
 TRAJECTORIES = ("vo", "dead_reckoning", "fused", "landmarks")
+TRAJECTORY_EVERY = 15
+"""The run JSON keeps one pose in this many frames of each trajectory (for plots), rounded to 1 cm."""
 
 
 def _pose(p) -> list[float]:
@@ -55,11 +57,19 @@ class OdometryScorer:
         self.sightings += len(debug.sightings)
         self.vo_failed += int(len(self.true) > 1 and not debug.vo_step.ok)
 
+    def _trajectory(self, true: np.ndarray) -> dict:
+        """x, y [m] of the truth and of each trajectory every TRAJECTORY_EVERY frames (and the last frame)."""
+        idx = sorted(set(range(0, len(true), TRAJECTORY_EVERY)) | {len(true) - 1})
+        paths = {"true": true, "estimate": np.asarray(self.paths["landmarks"]), "fused": np.asarray(self.paths["fused"]),
+                 "vo": np.asarray(self.paths["vo"]), "dead_reckoning": np.asarray(self.paths["dead_reckoning"])}
+        return {"every_frames": TRAJECTORY_EVERY,
+                **{k: np.round(p[idx, :2], 2).tolist() for k, p in paths.items()}}
+
     def result(self) -> dict:
         keys = [f"{m}_{k}" for k in TRAJECTORIES for m in ("drift_pct", "rot_drift_deg_per_100m")]
         keys += [f"{m}_{k}_m" for k in TRAJECTORIES for m in ("ate_rmse", "final_error")]
         keys += ["consistency_3sigma", "consistency_3sigma_fused", "path_length_m", "landmark_fixes",
-                 "landmark_sightings", "vo_failed_frames"]
+                 "landmark_sightings", "vo_failed_frames", "trajectory"]
         if len(self.true) < 2:
             return dict.fromkeys(keys)
         true = np.asarray(self.true)
@@ -74,5 +84,5 @@ class OdometryScorer:
         for key, k in (("consistency_3sigma", "landmarks"), ("consistency_3sigma_fused", "fused")):
             out[key] = inside_3sigma(np.asarray(self.paths[k])[:, :2] - true[:, :2], np.asarray(self.cov[k]))
         out.update(path_length_m=path_length_m(true), landmark_fixes=self.fixes, landmark_sightings=self.sightings,
-                   vo_failed_frames=self.vo_failed)
+                   vo_failed_frames=self.vo_failed, trajectory=self._trajectory(true))
         return {k: out[k] for k in keys}

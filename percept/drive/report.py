@@ -1,0 +1,169 @@
+"""Evaluation reports a person reads: ``summary.csv`` (every metric per scenario x condition: runs, mean, p95 and
+worst), ``summary.md`` (safety counts, the headline metrics, the runs that failed or were unsafe with the command
+that reproduces each) and the list ``--strict`` acts on.
+
+"Worst" is the maximum of a metric where lower is better (errors, counts, times) and the minimum where higher is
+better (``HIGHER_IS_BETTER``); p95 is the 95th percentile towards the worse side (the 5th where higher is better).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+import numpy as np
+
+from percept.outputs import write_text_atomic
+
+from .resume import COUNTS, GROUPS
+
+HIGHER_IS_BETTER = frozenset({
+    "realtime_factor", "pedestrians.recall", "pedestrians.precision", "pedestrians.first_detection_range_m",
+    "longitudinal.time_gap_mean_s", "longitudinal.time_gap_min_s", "longitudinal.time_gap_steady_s",
+    "odometry.consistency_3sigma", "odometry.consistency_3sigma_fused", "odometry.landmark_fixes",
+    "odometry.landmark_sightings", "odometry.path_length_m"})
+SAFETY = ("collisions", "pedestrian_collisions", "lane_departures", "phantom_brakes", "missed_stops")
+"""Counts summed per scenario x condition: the three of every run, the longitudinal phantom brakes and the
+crossing pedestrians the car did not stop for."""
+UNSAFE = ("collisions", "pedestrian_collisions", "lane_departures")
+"""What makes a run fail ``--strict``."""
+
+
+def run_metrics(run: dict) -> dict[str, float]:
+    """The numeric metrics of one run JSON, flat: the safety counts, ``<group>.<key>`` and ``realtime_factor``."""
+    out: dict[str, float] = {k: float(run[k]) for k in COUNTS}
+    stops = run.get("pedestrians", {}).get("stops")
+    out["phantom_brakes"] = float(run.get("longitudinal", {}).get("phantom_brakes") or 0)
+    out["missed_stops"] = float(sum(1 for s in stops if not s)) if stops else 0.0
+    for g in GROUPS:
+        for k, v in (run.get(g) or {}).items():
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                out[f"{g}.{k}"] = float(v)
+    if isinstance(run.get("realtime_factor"), (int, float)):
+        out["realtime_factor"] = float(run["realtime_factor"])
+    return out
+
+
+def _stat_row(name: str, values: list[float]) -> dict:
+    a = np.asarray(values, dtype=float)
+    up = name in HIGHER_IS_BETTER
+    return {"metric": name, "runs": len(a), "mean": float(a.mean()),
+            "p95": float(np.percentile(a, 5 if up else 95)), "worst": float(a.min() if up else a.max()),
+            "total": float(a.sum()) if name in SAFETY else None, "better": "higher" if up else "lower"}
+
+
+def metric_rows(plan, results: list[dict]) -> list[dict]:
+    """Long table: one row per scenario x condition x metric some run has (runs, mean, p95, worst, total)."""
+    rows = []
+    for sc in plan.scenarios:
+        for c in plan.conditions:
+            ok = [run_metrics(r) for r in results
+                  if r.get("scenario") == sc and r.get("condition") == c and "error" not in r]
+            names = sorted({k for m in ok for k in m}, key=lambda k: (k not in SAFETY, k))
+            for name in names:
+                vals = [m[name] for m in ok if name in m]
+                rows.append({"scenario": sc, "condition": c, **_stat_row(name, vals)})
+    return rows
+
+
+def reproduce_command(run: dict, settings: dict) -> str:
+    """The ``percept drive`` command that drives this run again with the batch's settings."""
+    cmd = ["percept drive", f"--scenario {run['scenario']}", f"--seed {run['seed']}",
+           f"--condition {run['condition']}"]
+    cmd += [f"--{task} {src}" for task, src in settings.get("slots", {}).items() if src != "privileged"]
+    if settings.get("duration_s") is not None:
+        cmd.append(f"--duration {settings['duration_s']:g}")
+    if settings.get("detector") not in (None, "sim"):
+        cmd.append(f"--detector {settings['detector']}")
+    return " ".join(cmd)
+
+
+def unsafe_runs(results: list[dict]) -> list[tuple[dict, str]]:
+    """Runs with a collision, a pedestrian collision or a lane departure: (run, what happened)."""
+    out = []
+    for r in sorted((r for r in results if "error" not in r), key=lambda r: (r["scenario"], r["condition"],
+                                                                              r["seed"])):
+        what = [f"{r[k]} {k.replace('_', ' ')}" for k in UNSAFE if r.get(k)]
+        if what:
+            out.append((r, ", ".join(what)))
+    return out
+
+
+def summary_csv(rows: list[dict]) -> str:
+    buf = io.StringIO()
+    fields = ["scenario", "condition", "metric", "runs", "mean", "p95", "worst", "total", "better"]
+    w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: ("" if r[k] is None else f"{r[k]:.6g}" if isinstance(r[k], float) else r[k]) for k in fields})
+    return buf.getvalue()
+
+
+def _fmt(v, spec: str = "{:.3g}") -> str:
+    return "—" if v is None else spec.format(v)
+
+
+def summary_md(plan, results: list[dict], settings: dict, tasks, plots: list[str]) -> str:
+    """The evaluation as Markdown: settings, safety, headline metrics, failures with reproduction commands."""
+    rows = {(r["scenario"], r["condition"], r["metric"]): r for r in metric_rows(plan, results)}
+    ok = [r for r in results if "error" not in r]
+    slots = ", ".join(f"{k} {v}" for k, v in settings.get("slots", {}).items())
+    lines = [f"# Evaluation: {len(ok)} runs", "",
+             f"Scenarios {', '.join(plan.scenarios)}; conditions {', '.join(plan.conditions)}; seeds "
+             f"{_seed_text(plan.seeds)}; slots: {slots}; percept {settings.get('percept')}.", "",
+             "## Safety (totals over the seeds)", "",
+             "| scenario | condition | runs | failed | collisions | pedestrian collisions | lane departures | "
+             "phantom brakes | missed stops |", "|---|---|---|---|---|---|---|---|---|"]
+    for sc in plan.scenarios:
+        for c in plan.conditions:
+            n = sum(1 for r in ok if r["scenario"] == sc and r["condition"] == c)
+            failed = sum(1 for r in results if "error" in r and r.get("scenario") == sc and r.get("condition") == c)
+            cells = [_fmt((rows.get((sc, c, k)) or {}).get("total"), "{:.0f}") for k in SAFETY]
+            lines.append(f"| {sc} | {c} | {n} | {failed} | " + " | ".join(cells) + " |")
+    lines += ["", "## Headline metrics (mean / p95 / worst over the seeds)", ""]
+    heads = [(f"{t.group}.{h.key}", f"{t.name}: {h.label}") for t in tasks for h in t.headline]
+    heads = [(k, label) for k, label in heads if any(key[2] == k for key in rows)]
+    if heads:
+        lines += ["| scenario | condition | " + " | ".join(label for _, label in heads) + " |",
+                  "|---|---|" + "---|" * len(heads)]
+        for sc in plan.scenarios:
+            for c in plan.conditions:
+                cells = [" / ".join(_fmt(rows[(sc, c, k)][s]) for s in ("mean", "p95", "worst"))
+                         if (sc, c, k) in rows else "—" for k, _ in heads]
+                lines.append(f"| {sc} | {c} | " + " | ".join(cells) + " |")
+    lines += ["", "Every metric, with p95 and worst: `summary.csv`.", ""]
+    lines += _problems_md(results, settings)
+    if plots:
+        lines += ["## Plots", ""] + [f"![{Path(p).stem}]({p})" for p in plots] + [""]
+    return "\n".join(lines)
+
+
+def _problems_md(results: list[dict], settings: dict) -> list[str]:
+    bad = unsafe_runs(results)
+    errors = [r for r in results if "error" in r]
+    if not bad and not errors:
+        return ["No run had a collision, a pedestrian collision or a lane departure, and none failed.", ""]
+    lines = ["## Runs to look at", ""]
+    lines += [f"- {r['scenario']} / {r['condition']} / seed {r['seed']}: {what} — `{reproduce_command(r, settings)}`"
+              for r, what in bad]
+    lines += [f"- {r['scenario']} / {r['condition']} / seed {r['seed']}: failed ({r['error']}) — "
+              f"`{reproduce_command(r, settings)}`" for r in errors]
+    return lines + [""]
+
+
+def _seed_text(seeds) -> str:
+    s = sorted(seeds)
+    return f"{s[0]}–{s[-1]}" if s == list(range(s[0], s[-1] + 1)) and len(s) > 1 else ", ".join(map(str, s))
+
+
+def write_reports(plan, results: list[dict], settings: dict, out_dir: Path, tasks) -> list[Path]:
+    """summary.csv, plots/*.png and summary.md in ``out_dir`` (each written atomically); the paths written."""
+    from .plots import write_plots
+
+    out_dir = Path(out_dir)
+    plots = write_plots(plan, results, out_dir / "plots", tasks)
+    write_text_atomic(out_dir / "summary.csv", summary_csv(metric_rows(plan, results)))
+    rel = [str(p.relative_to(out_dir)) for p in plots]
+    write_text_atomic(out_dir / "summary.md", summary_md(plan, results, settings, tasks, rel))
+    return [out_dir / "summary.csv", out_dir / "summary.md", *plots]
