@@ -12,6 +12,19 @@ import numpy as np
 
 # below this mean intensity (or standard deviation) a frame has nothing to track: dark or featureless
 MIN_CONTRAST_GREY = 2.0
+# FAST's threshold is at least this many times the image's noise sigma (a corner must stand out of the noise)
+NOISE_GAIN = 4.0
+# Immerkaer's noise-estimation kernel (the difference of two Laplacians: blind to planes and ramps)
+_NOISE_KERNEL = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
+
+
+def noise_sigma(gray: np.ndarray) -> float:
+    """The image noise's standard deviation [grey levels], robust to texture and edges: the median absolute
+    response to Immerkaer's kernel, on every other pixel (Immerkaer 1996, "Fast noise variance estimation", CVIU
+    64(2); the median in place of the mean keeps scene texture out)."""
+    r = cv2.filter2D(gray, cv2.CV_32F, _NOISE_KERNEL)[1:-1:2, 1:-1:2]
+    # the kernel's gain on white noise is sqrt(36) = 6; 1.4826 MAD = sigma for a normal distribution
+    return float(1.4826 * np.median(np.abs(r)) / 6.0)
 
 
 def to_gray(image: np.ndarray) -> np.ndarray:
@@ -26,9 +39,11 @@ def to_gray(image: np.ndarray) -> np.ndarray:
 
 def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], threshold: int,
                    mask: np.ndarray | None = None) -> np.ndarray:
-    """FAST corners, the strongest few per grid cell so that they cover the image: (N, 2) float32 [px]."""
+    """FAST corners, the strongest few per grid cell so that they cover the image: (N, 2) float32 [px]. The
+    threshold rises with the image noise (NOISE_GAIN sigma) so that noise makes no corners."""
     if float(gray.std()) < MIN_CONTRAST_GREY:
         return np.zeros((0, 2), np.float32)
+    threshold = max(int(threshold), int(round(NOISE_GAIN * noise_sigma(gray))))
     kps = cv2.FastFeatureDetector_create(threshold, True).detect(gray, mask)
     if not kps:
         return np.zeros((0, 2), np.float32)

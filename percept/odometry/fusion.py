@@ -119,6 +119,10 @@ class PoseFilter:
         return float(self.kf.x[V, 0])
 
     @property
+    def gyro_bias_rps(self) -> float:
+        return float(self.kf.x[BG, 0])
+
+    @property
     def pose_covariance(self) -> np.ndarray:
         """(3, 3) covariance of (x_m, y_m, yaw_rad)."""
         return self.kf.P[:3, :3].copy()

@@ -20,6 +20,12 @@ from .stereo_vo import StereoVO
 from .types import VOStep
 
 
+FEW_INLIERS = 40
+GOOD_SHARE = 0.5
+"""A keyframe pose measured from n < FEW_INLIERS PnP inliers, or whose inliers are a share q < GOOD_SHARE of the
+points tracked, has its standard deviations widened by FEW_INLIERS / n and by GOOD_SHARE / q."""
+
+
 @dataclass(frozen=True)
 class OdometryDebug:
     """vo_pose: visual odometry alone, chained from the start pose; dead_reckoning_pose: IMU + wheel speed;
@@ -69,6 +75,7 @@ class OdometrySlot:
         self._vo_T = self.start.world_from_vehicle().matrix()
         self._last_motion = np.eye(4)
         self._frames = 0
+        self._since_image = 1  # frames since the last image VO saw
 
     @property
     def filters(self) -> tuple[PoseFilter, ...]:
@@ -98,9 +105,11 @@ class OdometrySlot:
     def _visual_odometry(self, frame: Frame) -> VOStep:
         """VO on this frame's pair; the VO-only chain takes every step, the filters the pose against the last
         keyframe when the keyframe changes (one independent measurement per keyframe span)."""
-        step = self.vo.process(frame.left, frame.right)
+        step = self.vo.process(frame.left, frame.right, self._prior(frame))
         if frame.left is None or frame.right is None:
+            self._since_image += 1
             return step  # dropped: the next image's motion is measured from the last image
+        self._since_image = 1
         if step.ok:
             self._last_motion = self._vehicle(step.T_prev_cur)
         # VO alone: a lost step is bridged with the last measured motion (constant velocity)
@@ -108,12 +117,29 @@ class OdometrySlot:
         if step.keyframe:
             if step.ok and step.T_key_cur is not None:
                 dx, dy, dyaw = _planar(self._vehicle(step.T_key_cur))
-                cov = self._J @ step.key_covariance @ self._J.T
+                # a pose from few inliers, or from a small share of the tracked points (night, rain), is biased
+                # beyond what its residuals say: widen it
+                widen = max(1.0, FEW_INLIERS / max(step.inliers, 1)) * max(1.0, GOOD_SHARE / max(step.quality, 0.01))
+                cov = self._J @ step.key_covariance @ self._J.T * widen ** 2
                 for f in (self.fused, self.estimate):
                     f.update_relative(dx, dy, dyaw, cov)
             for f in (self.fused, self.estimate):
                 f.clone()
         return step
+
+    def _prior(self, frame: Frame) -> np.ndarray | None:
+        """The camera motion since the last image that the wheel speed and the gyro alone predict (None before the
+        first image or without a finite sample): independent of the visual odometry it guides, so that a biased
+        VO cannot select the points that confirm its bias."""
+        w, v = float(frame.imu.gyro_rps[2]), float(frame.wheel_speed_mps)
+        if self._frames <= 1 or not (math.isfinite(w) and math.isfinite(v)):
+            return None
+        dt = self._since_image * self.dt_s
+        # planar motion at constant speed and yaw rate: the heading turns by w dt, the chord lies at half of it
+        T = np.eye(4)
+        T[:2, :2] = [[math.cos(w * dt), -math.sin(w * dt)], [math.sin(w * dt), math.cos(w * dt)]]
+        T[:2, 3] = v * dt * math.cos(w * dt / 2), v * dt * math.sin(w * dt / 2)
+        return self._T_cv @ T @ self._T_vc
 
     def _vehicle(self, T_cam: np.ndarray) -> np.ndarray:
         """Camera motion -> the vehicle's: T_v = T_vc T_c T_cv."""

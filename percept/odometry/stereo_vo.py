@@ -25,7 +25,9 @@ class StereoVOConfig:
     fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels;
     max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
     point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
-    ransac_px: PnP RANSAC reprojection threshold."""
+    ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
+    image lies further than prior_gate_px + prior_gate_frac x (its image motion since the keyframe) from where the
+    prior puts it is left out of PnP (it moves: a vehicle, a pedestrian; or it was tracked wrongly)."""
 
     max_features: int = 400
     grid: tuple[int, int] = (10, 6)
@@ -37,6 +39,8 @@ class StereoVOConfig:
     min_inliers: int = 12
     keyframe_inliers: int = 60
     ransac_px: float = 0.7
+    prior_gate_px: float = 3.0
+    prior_gate_frac: float = 0.15
 
     def __post_init__(self) -> None:
         if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:
@@ -90,9 +94,14 @@ class StereoVO:
         self._T_kf_prev = np.eye(4)  # previous camera in the keyframe's frame
         self._cov_prev = np.zeros((6, 6))
 
-    def process(self, left: np.ndarray | None, right: np.ndarray | None) -> VOStep:
+    def process(self, left: np.ndarray | None, right: np.ndarray | None, prior: np.ndarray | None = None,
+                movers: list | tuple = ()) -> VOStep:
         """Motion from the previous processed frame to this one. A missing image (dropped frame) returns a failed
-        step and keeps the keyframe, so tracking resumes on the next frame."""
+        step and keeps the keyframe, so tracking resumes on the next frame. ``prior``: (4, 4) the expected camera
+        motion since the previous processed frame (from wheel speed and gyro, as T_prev_cur): it starts KLT where
+        each point should be and keeps points that move on their own out of PnP. ``movers``: boxes (u0, v0, u1, v1)
+        in the left image of things known to move (vehicles, people): no point inside one is used."""
+        self._movers = [tuple(map(float, b)) for b in movers if b is not None]
         if left is None or right is None:
             return VOStep.failed("dropped frame")
         if np.shape(left)[:2] != np.shape(right)[:2]:
@@ -100,7 +109,7 @@ class StereoVO:
         gl = to_gray(left)
         if self._kf_points is None or self._prev is None or self._prev.shape != gl.shape:
             return self._start_keyframe(gl, right, "first frame")
-        step = self._track(gl)
+        step = self._track(gl, None if prior is None else self._T_kf_prev @ np.asarray(prior, float))
         if step.ok and step.inliers >= self.config.keyframe_inliers:
             self._prev = gl
             return step
@@ -113,6 +122,7 @@ class StereoVO:
         here)."""
         c = self.config
         corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold)
+        corners = corners[self._static(corners)]
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
         self._kf_points = self._pixels = None
         if len(corners) < c.min_inliers:
@@ -141,20 +151,45 @@ class StereoVO:
             self.K[1, 1] * self.camera_height_m)
         return np.column_stack([px[:, 0] - d, px[:, 1]])
 
-    def _track(self, gl: np.ndarray) -> VOStep:
+    def _static(self, px: np.ndarray) -> np.ndarray:
+        """(N,) bool: the pixel lies outside every box of a mover."""
+        keep = np.ones(len(px), bool)
+        for u0, v0, u1, v1 in getattr(self, "_movers", ()):
+            keep &= ~((px[:, 0] >= u0) & (px[:, 0] <= u1) & (px[:, 1] >= v0) & (px[:, 1] <= v1))
+        return keep
+
+    def _project(self, T_kf_cur: np.ndarray) -> np.ndarray:
+        """Where the keyframe's points are seen from a camera at ``T_kf_cur``: (N, 2) [px]."""
+        T = _inverse(T_kf_cur)
+        p = self._kf_points @ T[:3, :3].T + T[:3, 3]
+        z = np.maximum(p[:, 2], 1e-3)
+        # u = fx X / Z + cx, v = fy Y / Z + cy
+        return np.column_stack([self.K[0, 0] * p[:, 0] / z + self.K[0, 2], self.K[1, 1] * p[:, 1] / z + self.K[1, 2]])
+
+    def _track(self, gl: np.ndarray, T_kf_pred: np.ndarray | None) -> VOStep:
         c = self.config
-        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels)
+        expected = None if T_kf_pred is None else self._project(T_kf_pred)
+        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels, expected)
+        ok &= self._static(moved)
         self._kf_points, self._pixels = self._kf_points[ok], moved[ok]
         n = len(self._pixels)
         if n < c.min_inliers:
             return VOStep.failed(f"only {n} points tracked", tracked=n)
+        use = np.arange(n)
+        if expected is not None:
+            # |seen - expected| against the gate, which widens with the point's motion since the keyframe
+            off = np.linalg.norm(self._pixels - expected[ok], axis=1)
+            flow = np.linalg.norm(self._pixels - self._project(np.eye(4)), axis=1)
+            agree = np.flatnonzero(off < c.prior_gate_px + c.prior_gate_frac * flow)
+            if len(agree) >= max(c.min_inliers, n // 3):
+                use = agree
         # minimal solutions by EPnP inside RANSAC (no initial guess to lead it astray), then LM on the inliers
-        found, rvec, tvec, inl = cv2.solvePnPRansac(self._kf_points, self._pixels, self.K, None,
+        found, rvec, tvec, inl = cv2.solvePnPRansac(self._kf_points[use], self._pixels[use], self.K, None,
                                                     iterationsCount=100, reprojectionError=c.ransac_px,
                                                     confidence=0.999, flags=cv2.SOLVEPNP_EPNP)
         if not found or inl is None or len(inl) < c.min_inliers:
             return VOStep.failed(f"PnP found {0 if inl is None else len(inl)} inliers of {n}", tracked=n)
-        idx = inl.ravel()
+        idx = use[inl.ravel()]
         rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
         if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
             return VOStep.failed("PnP diverged", tracked=n)

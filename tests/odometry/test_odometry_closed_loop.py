@@ -31,7 +31,9 @@ def test_dropped_frames_widen_the_bounds_and_break_nothing():
     r = run_drive(DriveConfig(WorldConfig("loop", 2, "dropout"), 20.0, {"odometry": "vision"}))
     o = r["odometry"]
     assert o["vo_failed_frames"] > 10  # 10 % of 300 frames are dropped
+    traj = o.pop("trajectory")
     assert all(v is not None and math.isfinite(v) for v in o.values())
+    assert len(traj["true"]) == len(traj["estimate"]) == len(range(0, 300, 15)) + 1
     assert o["consistency_3sigma"] >= 0.95 and o["ate_rmse_landmarks_m"] < 0.5
 
 

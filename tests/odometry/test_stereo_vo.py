@@ -74,3 +74,20 @@ def test_bad_input_is_refused_with_a_clear_message():
     vo = vo_for(rig)
     with pytest.raises(ValueError, match="differ in size"):
         vo.process(np.zeros((480, 640), np.uint8), np.zeros((240, 320), np.uint8))
+
+
+def test_a_motion_prior_and_mover_boxes_are_used(loop_run):
+    world, shots = loop_run
+    rig = world.cfg.rig
+    T_cv = rig.cam_from_vehicle().matrix()
+    vo = vo_for(rig)
+    vo.process(shots[0][0].left, shots[0][0].right)
+    for k in range(1, 6):
+        a, b = shots[k - 1][1].ego.world_from_vehicle().matrix(), shots[k][1].ego.world_from_vehicle().matrix()
+        prior = T_cv @ np.linalg.inv(a) @ b @ np.linalg.inv(T_cv)
+        step = vo.process(shots[k][0].left, shots[k][0].right, prior)
+        assert step.ok and step.T_prev_cur[2, 3] == pytest.approx(travelled(shots[k - 1][1], shots[k][1]), rel=0.03)
+    # a mover box over the whole image leaves nothing to use
+    vo.reset()
+    step = vo.process(shots[0][0].left, shots[0][0].right, movers=[(0, 0, 640, 480)])
+    assert not step.ok and "only 0 corners" in step.reason
