@@ -82,11 +82,14 @@ def test_a_motion_prior_and_mover_boxes_are_used(loop_run):
     T_cv = rig.cam_from_vehicle().matrix()
     vo = vo_for(rig)
     vo.process(shots[0][0].left, shots[0][0].right)
-    for k in range(1, 6):
+    forward = 0.0
+    for k in range(1, 11):
         a, b = shots[k - 1][1].ego.world_from_vehicle().matrix(), shots[k][1].ego.world_from_vehicle().matrix()
         prior = T_cv @ np.linalg.inv(a) @ b @ np.linalg.inv(T_cv)
         step = vo.process(shots[k][0].left, shots[k][0].right, prior)
-        assert step.ok and step.T_prev_cur[2, 3] == pytest.approx(travelled(shots[k - 1][1], shots[k][1]), rel=0.03)
+        assert step.ok
+        forward += step.T_prev_cur[2, 3]
+    assert forward == pytest.approx(travelled(shots[0][1], shots[10][1]), rel=0.02)
     # a mover box over the whole image leaves nothing to use
     vo.reset()
     step = vo.process(shots[0][0].left, shots[0][0].right, movers=[(0, 0, 640, 480)])
