@@ -131,7 +131,7 @@ TASKS: tuple[Task, ...] = (
          help="people in or stepping into the path (braking requests)", bench_scenario="crossing",
          bench_peer=_people_peer),
     Task("odometry", "odometry", "odometry", priv.PrivilegedOdometry, OdometryScorer, vision=_odometry_slot,
-         recorder="percept.review.parts:odometry",
+         recorder="percept.review.parts:odometry", upstream=("longitudinal",),
          headline=(Headline("drift VO [%]", "drift_pct_vo", "{:.2f}"),
                    Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),
                    Headline("ATE with landmarks [m]", "ate_rmse_landmarks_m", "{:.2f}"),

@@ -88,7 +88,7 @@ class OdometrySlot:
                 f.predict(float(imu.gyro_rps[2]), float(imu.accel_mps2[0]), self.dt_s)
             f.update_wheel(float(frame.wheel_speed_mps))
         self._frames += 1
-        vo = self._visual_odometry(frame)
+        vo = self._visual_odometry(frame, upstream)
         sightings: list[LandmarkSighting] = []
         fixes = 0
         if self.finder is not None and frame.left is not None and frame.right is not None:
@@ -102,10 +102,12 @@ class OdometrySlot:
                               sum(f.rejected for f in self.filters))
         return PoseEstimate(est.pose, est.speed_mps, est.pose_covariance, True), debug
 
-    def _visual_odometry(self, frame: Frame) -> VOStep:
-        """VO on this frame's pair; the VO-only chain takes every step, the filters the pose against the last
-        keyframe when the keyframe changes (one independent measurement per keyframe span)."""
-        step = self.vo.process(frame.left, frame.right, self._prior(frame))
+    def _visual_odometry(self, frame: Frame, upstream: dict) -> VOStep:
+        """VO on this frame's pair (the lead's box, from the longitudinal slot, left out: it moves); the VO-only
+        chain takes every step, the filters the pose against the last keyframe when the keyframe changes (one
+        independent measurement per keyframe span)."""
+        lead = upstream.get("longitudinal")
+        step = self.vo.process(frame.left, frame.right, self._prior(frame), [getattr(lead, "box_px", None)])
         if frame.left is None or frame.right is None:
             self._since_image += 1
             return step  # dropped: the next image's motion is measured from the last image
