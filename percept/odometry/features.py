@@ -38,12 +38,13 @@ def to_gray(image: np.ndarray) -> np.ndarray:
 
 
 def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], threshold: int,
-                   mask: np.ndarray | None = None) -> np.ndarray:
+                   mask: np.ndarray | None = None, noise: float | None = None) -> np.ndarray:
     """FAST corners, the strongest few per grid cell so that they cover the image: (N, 2) float32 [px]. The
-    threshold rises with the image noise (NOISE_GAIN sigma) so that noise makes no corners."""
+    threshold rises with the image noise (NOISE_GAIN sigma; ``noise``: sigma when already measured) so that noise
+    makes no corners."""
     if float(gray.std()) < MIN_CONTRAST_GREY:
         return np.zeros((0, 2), np.float32)
-    threshold = max(int(threshold), int(round(NOISE_GAIN * noise_sigma(gray))))
+    threshold = max(int(threshold), int(round(NOISE_GAIN * (noise_sigma(gray) if noise is None else noise))))
     kps = cv2.FastFeatureDetector_create(threshold, True).detect(gray, mask)
     if not kps:
         return np.zeros((0, 2), np.float32)

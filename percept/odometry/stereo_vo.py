@@ -15,14 +15,15 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from .features import detect_corners, pose_covariance, to_gray, track
+from .features import detect_corners, noise_sigma, pose_covariance, to_gray, track
 from .types import VOStep
 
 
 @dataclass(frozen=True)
 class StereoVOConfig:
     """max_features: corners per keyframe; grid: cells (columns, rows) the corners are spread over;
-    fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels;
+    fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels (prior_levels when
+    a motion prior says where to start: a shallow pyramid suffices and costs less);
     max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
     point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
     ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
@@ -34,6 +35,7 @@ class StereoVOConfig:
     fast_threshold: int = 5
     win_px: int = 15
     levels: int = 3
+    prior_levels: int = 1
     max_row_err_px: float = 0.7
     min_disparity_px: float = 0.5
     min_inliers: int = 12
@@ -121,7 +123,8 @@ class StereoVO:
         """Corners of the left image with their stereo depth become the keyframe (the right image is only read
         here)."""
         c = self.config
-        corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold)
+        self._noise = noise_sigma(gl)
+        corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise)
         corners = corners[self._static(corners)]
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
         self._kf_points = self._pixels = None
@@ -169,7 +172,8 @@ class StereoVO:
     def _track(self, gl: np.ndarray, T_kf_pred: np.ndarray | None) -> VOStep:
         c = self.config
         expected = None if T_kf_pred is None else self._project(T_kf_pred)
-        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels, expected)
+        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels if expected is None else c.prior_levels,
+                          expected)
         ok &= self._static(moved)
         self._kf_points, self._pixels = self._kf_points[ok], moved[ok]
         n = len(self._pixels)
@@ -202,4 +206,5 @@ class StereoVO:
         T_prev_cur = _inverse(self._T_kf_prev) @ T_kf_cur
         step_cov = cov + self._cov_prev
         self._T_kf_prev, self._cov_prev = T_kf_cur, cov
-        return VOStep(T_prev_cur, step_cov, True, n, len(idx), len(idx) / n, T_key_cur=T_kf_cur, key_covariance=cov)
+        return VOStep(T_prev_cur, step_cov, True, n, len(idx), len(idx) / n, T_key_cur=T_kf_cur, key_covariance=cov,
+                      noise_grey=self._noise)

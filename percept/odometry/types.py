@@ -22,7 +22,8 @@ class VOStep:
     T_key_cur, key_covariance: (4, 4) pose of the current camera in the frame of the keyframe it was measured
     against, and its (6, 6) covariance (None when not measured, or when the estimator has no keyframes). Steps
     chained from one keyframe share its errors; poses against successive keyframes do not, which is what a filter
-    should be given.
+    should be given. noise_grey: the image noise's sigma measured at the keyframe [grey levels] (None: not
+    measured).
     """
 
     T_prev_cur: np.ndarray
@@ -35,6 +36,7 @@ class VOStep:
     reason: str = ""
     T_key_cur: np.ndarray | None = None
     key_covariance: np.ndarray | None = None
+    noise_grey: float | None = None
 
     @classmethod
     def failed(cls, reason: str, tracked: int = 0, keyframe: bool = False) -> "VOStep":
