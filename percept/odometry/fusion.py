@@ -22,10 +22,10 @@ from filterpy.kalman import ExtendedKalmanFilter
 from percept.sensors import Pose2D, wrap_angle
 from percept.sensors.vehicle import WHEELBASE_M
 
-# state: pose (x, y, yaw), speed, gyro bias, wheel scale, accelerometer bias, then the clone of the pose at the
-# last image
-X, Y, YAW, V, BG, KW, BA, XC, YC, YAWC = range(10)
-N_STATE = 10
+# state: pose (x, y, yaw), speed, gyro bias, wheel scale, accelerometer bias, visual odometry's scale error and
+# yaw drift per metre, then the clone of the pose at the last keyframe
+X, Y, YAW, V, BG, KW, BA, SV, BV, XC, YC, YAWC = range(12)
+N_STATE = 12
 # 99 % gates of the normalised innovation squared: chi2 with 2 and 3 degrees of freedom
 GATE_CHI2 = {2: 9.21, 3: 11.34}
 
@@ -35,7 +35,10 @@ class FusionNoise:
     """gyro_sigma_rps, accel_sigma_mps2: white noise of one IMU sample; gyro_bias_walk [rad/s/sqrt(s)];
     wheel_sigma_mps: of one wheel-speed sample; wheel_scale_sigma: prior std of the wheel scale error;
     init_bias_sigma_rps: prior std of the gyro bias; accel_bias_walk [m/s²/sqrt(s)], init_accel_bias_mps2: the
-    accelerometer bias's random walk and prior std; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
+    accelerometer bias's random walk and prior std; vo_scale_sigma, vo_yaw_drift_sigma_rad_per_m: prior std of
+    visual odometry's systematic errors (translation scale, yaw per metre travelled), with vo_bias_walk their
+    relative random walk per sqrt(s): without landmarks they are unobservable and the estimate's covariance grows
+    with the distance as it should; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
     beyond these is absurd and rejected; vo_scale_translation, vo_scale_rotation: multiply the visual odometry's
     own variances of translation and of yaw (its covariance comes from the reprojection residuals alone and leaves
     out the keyframe points' depth error; these factors were measured from its innovations on `loop`);
@@ -50,6 +53,9 @@ class FusionNoise:
     init_bias_sigma_rps: float = 0.002
     accel_bias_walk: float = 0.003
     init_accel_bias_mps2: float = 0.02
+    vo_scale_sigma: float = 0.003
+    vo_yaw_drift_sigma_rad_per_m: float = 2e-5
+    vo_bias_walk: float = 0.02
     max_yaw_rate_rps: float = 3.0
     max_accel_mps2: float = 20.0
     max_speed_mps: float = 90.0
@@ -102,7 +108,8 @@ class PoseFilter:
         self.kf.x[[X, Y, YAW], 0] = (start.x_m, start.y_m, start.yaw_rad)
         self.kf.x[KW, 0] = 1.0
         self.kf.P = np.diag([1e-6, 1e-6, 1e-8, 1.0, noise.init_bias_sigma_rps ** 2, noise.wheel_scale_sigma ** 2,
-                             noise.init_accel_bias_mps2 ** 2, 1e-6, 1e-6, 1e-8])
+                             noise.init_accel_bias_mps2 ** 2, noise.vo_scale_sigma ** 2,
+                             noise.vo_yaw_drift_sigma_rad_per_m ** 2, 1e-6, 1e-6, 1e-8])
         self._last_input = (0.0, 0.0)
         self._started = False
         self.rejected = 0  # sensor samples rejected as NaN or absurd
@@ -157,6 +164,8 @@ class PoseFilter:
         Q[BG, BG] = n.gyro_bias_walk ** 2 * dt
         Q[KW, KW] = 1e-10 * dt
         Q[BA, BA] = n.accel_bias_walk ** 2 * dt
+        Q[SV, SV] = (n.vo_bias_walk * n.vo_scale_sigma) ** 2 * dt
+        Q[BV, BV] = (n.vo_bias_walk * n.vo_yaw_drift_sigma_rad_per_m) ** 2 * dt
         self.kf.Q = Q
         self.kf.predict(u=(w, a, dt))
         return good
@@ -194,15 +203,20 @@ class PoseFilter:
         def hx(s):
             c, sn = math.cos(s[YAWC, 0]), math.sin(s[YAWC, 0])
             d = s[[X, Y], 0] - s[[XC, YC], 0]
-            # [dx, dy] = R(-psi_c) (p - p_c); dyaw = psi - psi_c
-            return np.array([[c * d[0] + sn * d[1]], [-sn * d[0] + c * d[1]], [wrap_angle(s[YAW, 0] - s[YAWC, 0])]])
+            k = 1.0 + s[SV, 0]
+            # [dx, dy] = (1 + s_vo) R(-psi_c) (p - p_c); dyaw = psi - psi_c + b_vo |p - p_c|
+            return np.array([[k * (c * d[0] + sn * d[1])], [k * (-sn * d[0] + c * d[1])],
+                             [wrap_angle(s[YAW, 0] - s[YAWC, 0]) + s[BV, 0] * math.hypot(d[0], d[1])]])
 
-        h = hx(self.kf.x)
         c, sn = math.cos(x[YAWC]), math.sin(x[YAWC])
+        d = x[[X, Y]] - x[[XC, YC]]
+        base = np.array([c * d[0] + sn * d[1], -sn * d[0] + c * d[1]])
+        k = 1.0 + x[SV]
         Hm = np.zeros((3, N_STATE))
-        Hm[0, [X, Y, XC, YC, YAWC]] = c, sn, -c, -sn, h[1, 0]
-        Hm[1, [X, Y, XC, YC, YAWC]] = -sn, c, sn, -c, -h[0, 0]
-        Hm[2, [YAW, YAWC]] = 1.0, -1.0
+        Hm[0, [X, Y, XC, YC, YAWC, SV]] = k * c, k * sn, -k * c, -k * sn, k * base[1], base[0]
+        Hm[1, [X, Y, XC, YC, YAWC, SV]] = -k * sn, k * c, k * sn, -k * c, -k * base[0], base[1]
+        # d dyaw / d b_vo = |p - p_c| (its dependence on the positions, b_vo d|d|/dp, is negligible)
+        Hm[2, [YAW, YAWC, BV]] = 1.0, -1.0, math.hypot(d[0], d[1])
         n = self.noise
         # Sigma = D Sigma_vo D, D = diag(sqrt(k_t), sqrt(k_t), sqrt(k_r))
         d = np.sqrt([n.vo_scale_translation, n.vo_scale_translation, n.vo_scale_rotation])
