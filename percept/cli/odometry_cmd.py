@@ -34,7 +34,8 @@ def odometry(
     out: Annotated[Optional[Path], typer.Option("--out", help=f"Folder for {PLOT_NAME}: the path seen from above "
                                                 "(estimated and true).")] = None,
     camera_height: Annotated[float, typer.Option("--camera-height", help="Height of the left camera above the "
-                                                 "road in metres, 0.1 to 10; gives the monocular scale.")] = 1.65,
+                                                 "road in metres, 0.1 to 10; gives the monocular scale (stereo: where the near "
+                                                 "road's disparity search starts).")] = 1.65,
 ):
     """Visual odometry on a recorded sequence: stereo (PnP on stereo depth) when the folder has right images,
     else monocular (essential matrix, scale from the road plane and --camera-height).
@@ -63,7 +64,7 @@ def odometry(
         est = seq.poses[0] @ est  # the estimate starts from the known first pose
     data = {"folder": str(folder), "mode": "stereo" if seq.stereo else "mono", "frames": len(seq),
             "steps_failed": failed, "failure_reasons": reasons, "ms_per_frame": ms,
-            "camera_height_m": None if seq.stereo else camera_height,
+            "camera_height_m": camera_height,
             "baseline_m": seq.baseline_m if seq.stereo else None,
             **_scores(est, seq.poses), "outputs": [str(p) for p in (json_path, poses_out, plot) if p is not None]}
     _print_summary(data)
@@ -78,7 +79,7 @@ def _run(seq, camera_height: float) -> tuple[np.ndarray, int, dict, float]:
     if seq.stereo:
         from percept.odometry.stereo_vo import StereoVO
 
-        vo, label = StereoVO(seq.K, seq.baseline_m), "stereo odometry"
+        vo, label = StereoVO(seq.K, seq.baseline_m, camera_height), "stereo odometry"
     else:
         from percept.odometry.mono_vo import MonoVO
 
