@@ -15,7 +15,7 @@ from .report import run_metrics
 
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 INK, GRID, DOT, MEAN = (40, 40, 40), (225, 225, 225), (200, 120, 30), (30, 30, 220)
-PALETTE = [(200, 120, 30), (40, 160, 40), (30, 30, 220), (160, 60, 160), (20, 170, 200), (120, 120, 120)]
+PALETTE = [(170, 170, 170), (200, 120, 30), (40, 160, 40), (30, 30, 220), (160, 60, 160), (20, 170, 200)]
 LEFT, RIGHT, TOP, BOTTOM = 190, 30, 64, 50
 LEGEND_W = 170
 
@@ -98,8 +98,10 @@ def lines_png(title: str, xlabel: str, ylabel: str, series: list[tuple[str, np.n
     c.x_axis(xlabel)
     c.y_axis(ylabel)
     for i, (label, p) in enumerate(series):
+        # the first series (the truth, where there is one) is drawn wide, so that the others show on it
         rgb = PALETTE[i % len(PALETTE)]
-        cv2.polylines(c.img, [np.array([c.px(x, y) for x, y in p], np.int32)], False, rgb, 2, cv2.LINE_AA)
+        cv2.polylines(c.img, [np.array([c.px(x, y) for x, y in p], np.int32)], False, rgb, 6 if i == 0 else 2,
+                      cv2.LINE_AA)
     for i, (label, _) in enumerate(series):  # the legend, right of the plot area
         cv2.putText(c.img, label, (c.x1 + 14, c.y0 + 14 + 20 * i), FONT, 0.45, PALETTE[i % len(PALETTE)], 1,
                     cv2.LINE_AA)
