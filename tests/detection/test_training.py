@@ -61,6 +61,7 @@ def test_train_detector_writes_a_model_that_detect_loads(tmp_path):
     (["--every", "0"], "--every"),
     (["--c", "-1"], "--c"),
     (["--seeds", "x"], "--seeds must look like"),
+    (["--condition", "fog"], "unknown condition 'fog'"),
 ])
 def test_train_detector_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
     r = runner.invoke(app, ["train-detector", *args, "--out", str(tmp_path / "m.npz")])
