@@ -53,6 +53,24 @@ def eval_(
     go on, and the exit code is 1.
     """
     from percept.drive import TASKS
+
+    plan, eng, files = _plan(scenario, condition, seeds, workers, engine, duration, detector, out, redo,
+                             opt.slot_sources(lateral, longitudinal, pedestrians, odometry))
+    check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
+    for path, why in files.damaged:
+        err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
+    summary = _run(plan, out, workers, eng, address, redo, files)
+    console.print(summary_table(summary, TASKS))
+    console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
+                  f"{out / 'summary.md'}; plots in {out / 'plots'}")
+    write_json(json_path, summary)
+    _report_failures(summary, len(plan.jobs), out)
+    if strict:
+        _strict(summary)
+
+
+def _plan(scenario, condition, seeds, workers, engine, duration, detector, out: Path, redo: bool, sources):
+    """The checked options as (EvalPlan, Engine, the run files already in --out); one-line exit 2 otherwise."""
     from percept.drive.batch import Engine, EvalPlan, parse_seeds
     from percept.drive.config import MAX_DURATION_S
     from percept.drive.resume import refuse_other_settings, scan_runs
@@ -69,23 +87,13 @@ def eval_(
         fail(f"--engine must be local or ray, got '{engine}'")
     try:
         plan = EvalPlan(tuple(dict.fromkeys(names)), tuple(dict.fromkeys(condition)), tuple(parse_seeds(seeds)),
-                        opt.slot_sources(lateral, longitudinal, pedestrians, odometry), duration, detector)
+                        sources, duration, detector)
         files = scan_runs(plan, out)
         if not redo:
             refuse_other_settings(files, out)
     except ValueError as e:
         fail(str(e))
-    check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
-    for path, why in files.damaged:
-        err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
-    summary = _run(plan, out, workers, eng, address, redo, files)
-    console.print(summary_table(summary, TASKS))
-    console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
-                  f"{out / 'summary.md'}; plots in {out / 'plots'}")
-    write_json(json_path, summary)
-    _report_failures(summary, len(plan.jobs), out)
-    if strict:
-        _strict(summary)
+    return plan, eng, files
 
 
 def _strict(summary: dict) -> None:
