@@ -124,15 +124,20 @@ def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict
     """The batch under a progress bar; Ctrl-C says how many finished runs are kept."""
     from percept.drive.batch import evaluate
 
-    kept, failed = [0], [0]
+    from percept.drive.resume import run_path
+
+    failed = [0]
 
     def advance(r: dict) -> None:
-        kept[0] += "error" not in r
         failed[0] += "error" in r
         bar.update(task, advance=1, description=f"eval {len(plan.jobs)} runs, {failed[0]} failed")
 
-    on_interrupt(lambda: f"{kept[0]} finished run{'' if kept[0] == 1 else 's'} kept in {out / 'runs'}; run the same "
-                         "command to resume")
+    def kept() -> str:
+        # counted on disk: a run is kept once its file is there, whether or not the bar has caught up with it
+        n = sum(run_path(out, job).is_file() for job in plan.jobs)
+        return f"{n} finished run{'' if n == 1 else 's'} kept in {out / 'runs'}; run the same command to resume"
+
+    on_interrupt(kept)
     with progress_bar() as bar:
         task = bar.add_task(f"eval {len(plan.jobs)} runs, 0 failed", total=len(plan.jobs))
         try:
