@@ -55,7 +55,7 @@ class FusionNoise:
     init_accel_bias_mps2: float = 0.02
     vo_scale_sigma: float = 0.003
     vo_yaw_drift_sigma_rad_per_m: float = 2e-5
-    vo_bias_walk: float = 0.02
+    vo_bias_walk: float = 0.2
     max_yaw_rate_rps: float = 3.0
     max_accel_mps2: float = 20.0
     max_speed_mps: float = 90.0
