@@ -34,8 +34,8 @@ def odometry(
     out: Annotated[Optional[Path], typer.Option("--out", help=f"Folder for {PLOT_NAME}: the path seen from above "
                                                 "(estimated and true).")] = None,
     camera_height: Annotated[float, typer.Option("--camera-height", help="Height of the left camera above the "
-                                                 "road in metres, 0.1 to 10; gives the monocular scale (stereo: where the near "
-                                                 "road's disparity search starts).")] = 1.65,
+                                                 "road in metres, 0.1 to 10; gives the monocular scale (stereo: "
+                                                 "where the near road's disparity search starts).")] = 1.65,
 ):
     """Visual odometry on a recorded sequence: stereo (PnP on stereo depth) when the folder has right images,
     else monocular (essential matrix, scale from the road plane and --camera-height).

@@ -60,8 +60,8 @@ class OdometryScorer:
     def _trajectory(self, true: np.ndarray) -> dict:
         """x, y [m] of the truth and of each trajectory every TRAJECTORY_EVERY frames (and the last frame)."""
         idx = sorted(set(range(0, len(true), TRAJECTORY_EVERY)) | {len(true) - 1})
-        paths = {"true": true, "estimate": np.asarray(self.paths["landmarks"]), "fused": np.asarray(self.paths["fused"]),
-                 "vo": np.asarray(self.paths["vo"]), "dead_reckoning": np.asarray(self.paths["dead_reckoning"])}
+        paths = {"true": true, "estimate": np.asarray(self.paths["landmarks"]),
+                 **{k: np.asarray(self.paths[k]) for k in ("fused", "vo", "dead_reckoning")}}
         return {"every_frames": TRAJECTORY_EVERY,
                 **{k: np.round(p[idx, :2], 2).tolist() for k, p in paths.items()}}
 

@@ -16,6 +16,8 @@ from .report import run_metrics
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 INK, GRID, DOT, MEAN = (40, 40, 40), (225, 225, 225), (200, 120, 30), (30, 30, 220)
 PALETTE = [(170, 170, 170), (200, 120, 30), (40, 160, 40), (30, 30, 220), (160, 60, 160), (20, 170, 200)]
+TRAJECTORY_SERIES = ("true", "estimate", "fused", "vo", "dead_reckoning")
+"""The odometry trajectories of a run JSON (``odometry.trajectory``), the truth first."""
 LEFT, RIGHT, TOP, BOTTOM = 190, 30, 64, 50
 LEGEND_W = 170
 
@@ -117,11 +119,11 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
     """Every plot the results allow, into ``folder``; the paths written."""
     images: dict[str, np.ndarray] = {}
     cells = [(sc, c) for sc in plan.scenarios for c in plan.conditions]
+    metrics = {(sc, c): [run_metrics(r) for r in _runs(results, sc, c)] for sc, c in cells}
     for t in tasks:
         for h in t.headline:
             key = f"{t.group}.{h.key}"
-            groups = [(f"{sc} / {c}", [run_metrics(r)[key] for r in _runs(results, sc, c) if key in run_metrics(r)])
-                      for sc, c in cells]
+            groups = [(f"{sc} / {c}", [m[key] for m in metrics[(sc, c)] if key in m]) for sc, c in cells]
             groups = [g for g in groups if g[1]]
             if groups:
                 images[f"{key}.png"] = distribution_png(f"{t.name}: {h.label}", groups)
@@ -142,8 +144,7 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
         for r in _runs(results, sc, c):
             traj = (r.get("odometry") or {}).get("trajectory")
             if traj:
-                series = [(name, np.asarray(traj[name], float)) for name in ("true", "estimate", "fused", "vo", "dead_reckoning")
-                          if traj.get(name)]
+                series = [(name, np.asarray(traj[name], float)) for name in TRAJECTORY_SERIES if traj.get(name)]
                 images[f"odometry.trajectory.{sc}-{c}-{r['seed']}.png"] = lines_png(
                     f"odometry {sc} / {c} / seed {r['seed']}", "x [m]", "y [m]", series, equal=True)
     folder.mkdir(parents=True, exist_ok=True)

@@ -104,9 +104,10 @@ def _fmt(v, spec: str = "{:.3g}") -> str:
     return "—" if v is None else spec.format(v)
 
 
-def summary_md(plan, results: list[dict], settings: dict, tasks, plots: list[str]) -> str:
-    """The evaluation as Markdown: settings, safety, headline metrics, failures with reproduction commands."""
-    rows = {(r["scenario"], r["condition"], r["metric"]): r for r in metric_rows(plan, results)}
+def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, tasks, plots: list[str]) -> str:
+    """The evaluation as Markdown: settings, safety, headline metrics (``rows`` from ``metric_rows``), failures
+    with reproduction commands."""
+    rows = {(r["scenario"], r["condition"], r["metric"]): r for r in rows}
     ok = [r for r in results if "error" not in r]
     slots = ", ".join(f"{k} {v}" for k, v in settings.get("slots", {}).items())
     lines = [f"# Evaluation: {len(ok)} runs", "",
@@ -163,7 +164,8 @@ def write_reports(plan, results: list[dict], settings: dict, out_dir: Path, task
 
     out_dir = Path(out_dir)
     plots = write_plots(plan, results, out_dir / "plots", tasks)
-    write_text_atomic(out_dir / "summary.csv", summary_csv(metric_rows(plan, results)))
+    rows = metric_rows(plan, results)
+    write_text_atomic(out_dir / "summary.csv", summary_csv(rows))
     rel = [str(p.relative_to(out_dir)) for p in plots]
-    write_text_atomic(out_dir / "summary.md", summary_md(plan, results, settings, tasks, rel))
+    write_text_atomic(out_dir / "summary.md", summary_md(plan, results, rows, settings, tasks, rel))
     return [out_dir / "summary.csv", out_dir / "summary.md", *plots]

@@ -27,6 +27,14 @@ def noise_sigma(gray: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(r)) / 6.0)
 
 
+def check_intrinsics(K) -> np.ndarray:
+    """K as a (3, 3) float array; ValueError unless it is finite with positive focal lengths."""
+    K = np.asarray(K, dtype=np.float64)
+    if K.shape != (3, 3) or not np.all(np.isfinite(K)) or K[0, 0] <= 0 or K[1, 1] <= 0:
+        raise ValueError(f"K must be a finite (3, 3) intrinsic matrix with fx, fy > 0, got {K.tolist()}")
+    return K
+
+
 def to_gray(image: np.ndarray) -> np.ndarray:
     """(H, W, 3) BGR or (H, W) grey uint8 -> (H, W) grey uint8."""
     img = np.asarray(image)
@@ -48,7 +56,7 @@ def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], th
     kps = cv2.FastFeatureDetector_create(threshold, True).detect(gray, mask)
     if not kps:
         return np.zeros((0, 2), np.float32)
-    pts = np.float32([k.pt for k in kps])
+    pts = cv2.KeyPoint_convert(kps).astype(np.float32).reshape(-1, 2)
     resp = np.float32([k.response for k in kps])
     h, w = gray.shape
     gx, gy = grid

@@ -2,9 +2,9 @@
 the wheel-speed scale.
 
 The IMU (yaw rate, forward acceleration) predicts through the kinematic bicycle model (the vehicle centre's
-velocity leans from the heading by the slip angle in a turn; Rajamani, *Vehicle Dynamics and Control*, sec. 2.2); the wheel speed, visual odometry and landmark fixes update.
-Visual odometry measures the motion between two images, so the filter keeps a copy of the pose at the last
-processed image (stochastic cloning: Roumeliotis & Burdick 2002, "Stochastic cloning: a generalized framework
+velocity leans from the heading by the slip angle in a turn; Rajamani, *Vehicle Dynamics and Control*, sec. 2.2);
+the wheel speed, visual odometry and landmark fixes update. Visual odometry measures the motion between two
+images, so the filter keeps a copy of the pose at the last keyframe (stochastic cloning: Roumeliotis & Burdick 2002, "Stochastic cloning: a generalized framework
 for processing relative state measurements", ICRA) and updates with the relative pose between the copy and now.
 A NaN or absurd sensor sample is rejected, never propagated: the prediction then uses the last good reading with
 its uncertainty widened. References: Thrun, Burgard & Fox, *Probabilistic Robotics*, ch. 3 and 7 (EKF, landmark
@@ -98,8 +98,8 @@ def _angle_residual(index: int):
 
 
 class PoseFilter:
-    """Planar pose, speed, gyro and accelerometer biases and wheel scale from IMU + wheel speed, updated by visual odometry's relative
-    motion and by landmark positions. ``start``: the known start pose; speed starts from the first wheel reading."""
+    """Planar pose, speed, gyro and accelerometer biases and wheel scale from IMU + wheel speed, updated by visual
+    odometry's relative motion and by landmark positions. ``start``: the known start pose; speed starts from the first wheel reading."""
 
     def __init__(self, start: Pose2D, noise: FusionNoise = FusionNoise()):
         self.noise = noise

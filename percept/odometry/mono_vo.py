@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .features import check_intrinsics
 from .road_plane import RoadRegion, plane_from_homography, plane_homography
 from .types import VOStep
 
@@ -101,9 +102,7 @@ class MonoVO:
     """
 
     def __init__(self, K: np.ndarray, camera_height_m: float, config: MonoVOConfig = MonoVOConfig()):
-        K = np.asarray(K, dtype=np.float64)
-        if K.shape != (3, 3) or not np.all(np.isfinite(K)) or K[0, 0] <= 0 or K[1, 1] <= 0:
-            raise ValueError(f"K must be a finite (3, 3) intrinsic matrix with fx, fy > 0, got {K.tolist()}")
+        K = check_intrinsics(K)
         if not np.isfinite(camera_height_m) or camera_height_m <= 0:
             raise ValueError(f"camera_height_m must be a finite number > 0, got {camera_height_m}")
         self.K, self.height_m, self.cfg = K, float(camera_height_m), config

@@ -14,6 +14,7 @@ import numpy as np
 
 from percept.sensors import Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig
 
+from .features import to_gray
 from .fusion import FusionNoise, PoseFilter
 from .landmarks import LandmarkFinder, LandmarkSighting
 from .stereo_vo import StereoVO
@@ -95,11 +96,13 @@ class OdometrySlot:
                 f.predict(float(imu.gyro_rps[2]), float(imu.accel_mps2[0]), self.dt_s)
             f.update_wheel(float(frame.wheel_speed_mps))
         self._frames += 1
-        vo = self._visual_odometry(frame, upstream)
+        # the left image in grey once, for VO and the sign search
+        left = None if frame.left is None else to_gray(frame.left)
+        vo = self._visual_odometry(frame, left, upstream)
         sightings: list[LandmarkSighting] = []
         fixes = 0
-        if self.finder is not None and frame.left is not None and frame.right is not None:
-            sightings = self.finder.sight(frame.left, frame.right, self.estimate.pose, self.estimate.pose_covariance)
+        if self.finder is not None and left is not None and frame.right is not None:
+            sightings = self.finder.sight(left, frame.right, self.estimate.pose, self.estimate.pose_covariance)
             for s in sightings:
                 fixes += self.estimate.update_landmark(self.finder.map.position(s.marker_id)[:2], s.position_v_m[:2],
                                                        s.covariance_xy)
@@ -109,13 +112,13 @@ class OdometrySlot:
                               sum(f.rejected for f in self.filters))
         return PoseEstimate(est.pose, est.speed_mps, est.pose_covariance, True), debug
 
-    def _visual_odometry(self, frame: Frame, upstream: dict) -> VOStep:
+    def _visual_odometry(self, frame: Frame, left: np.ndarray | None, upstream: dict) -> VOStep:
         """VO on this frame's pair (the lead's box, from the longitudinal slot, left out: it moves); the VO-only
         chain takes every step, the filters the pose against the last keyframe when the keyframe changes (one
         independent measurement per keyframe span)."""
         lead = upstream.get("longitudinal")
-        step = self.vo.process(frame.left, frame.right, self._prior(frame), [getattr(lead, "box_px", None)])
-        if frame.left is None or frame.right is None:
+        step = self.vo.process(left, frame.right, self._prior(frame), [getattr(lead, "box_px", None)])
+        if left is None or frame.right is None:
             self._since_image += 1
             return step  # dropped: the next image's motion is measured from the last image
         self._since_image = 1

@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from .features import detect_corners, noise_sigma, pose_covariance, to_gray, track
+from .features import check_intrinsics, detect_corners, noise_sigma, pose_covariance, to_gray, track
 from .types import VOStep
 
 
@@ -75,9 +75,7 @@ class StereoVO:
 
     def __init__(self, K: np.ndarray, baseline_m: float, camera_height_m: float | None = None,
                  config: StereoVOConfig = StereoVOConfig()):
-        K = np.asarray(K, dtype=np.float64)
-        if K.shape != (3, 3) or not np.all(np.isfinite(K)) or K[0, 0] <= 0:
-            raise ValueError(f"K must be a finite (3, 3) intrinsic matrix, got {K.tolist()}")
+        K = check_intrinsics(K)
         if not (np.isfinite(baseline_m) and baseline_m > 0):
             raise ValueError(f"baseline_m must be positive, got {baseline_m}")
         if camera_height_m is not None and not (np.isfinite(camera_height_m) and camera_height_m > 0):
@@ -92,6 +90,9 @@ class StereoVO:
         cv2.setRNGSeed(RANSAC_SEED)
         self._kf_points: np.ndarray | None = None  # (N, 3) keyframe camera frame [m]
         self._pixels: np.ndarray | None = None  # (N, 2) where they are in the previous left image
+        self._kf_pixels: np.ndarray | None = None  # (N, 2) where they were in the keyframe's left image
+        self._movers: list[tuple] = []  # this frame's boxes of things that move
+        self._noise: float | None = None  # the keyframe image's noise sigma [grey levels]
         self._prev: np.ndarray | None = None  # previous left image (grey)
         self._T_kf_prev = np.eye(4)  # previous camera in the keyframe's frame
         self._cov_prev = np.zeros((6, 6))
@@ -127,7 +128,7 @@ class StereoVO:
         corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise)
         corners = corners[self._static(corners)]
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
-        self._kf_points = self._pixels = None
+        self._kf_points = self._pixels = self._kf_pixels = None
         if len(corners) < c.min_inliers:
             return VOStep.failed(f"{reason}: only {len(corners)} corners (dark or featureless)", keyframe=True)
         matched, ok = track(gl, to_gray(right), corners, c.win_px, c.levels, self._disparity_guess(corners))
@@ -140,7 +141,7 @@ class StereoVO:
         # Z = f b / d; X = (u - cx) Z / fx; Y = (v - cy) Z / fy
         z = fx * self.baseline_m / d
         self._kf_points = np.column_stack([(px[:, 0] - cx) * z / fx, (px[:, 1] - cy) * z / fy, z])
-        self._pixels = px
+        self._pixels = self._kf_pixels = px
         return VOStep.failed(reason, tracked=len(px), keyframe=True)
 
     def _disparity_guess(self, px: np.ndarray) -> np.ndarray | None:
@@ -157,7 +158,7 @@ class StereoVO:
     def _static(self, px: np.ndarray) -> np.ndarray:
         """(N,) bool: the pixel lies outside every box of a mover."""
         keep = np.ones(len(px), bool)
-        for u0, v0, u1, v1 in getattr(self, "_movers", ()):
+        for u0, v0, u1, v1 in self._movers:
             keep &= ~((px[:, 0] >= u0) & (px[:, 0] <= u1) & (px[:, 1] >= v0) & (px[:, 1] <= v1))
         return keep
 
@@ -175,7 +176,7 @@ class StereoVO:
         moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels if expected is None else c.prior_levels,
                           expected)
         ok &= self._static(moved)
-        self._kf_points, self._pixels = self._kf_points[ok], moved[ok]
+        self._kf_points, self._pixels, self._kf_pixels = self._kf_points[ok], moved[ok], self._kf_pixels[ok]
         n = len(self._pixels)
         if n < c.min_inliers:
             return VOStep.failed(f"only {n} points tracked", tracked=n)
@@ -183,7 +184,7 @@ class StereoVO:
         if expected is not None:
             # |seen - expected| against the gate, which widens with the point's motion since the keyframe
             off = np.linalg.norm(self._pixels - expected[ok], axis=1)
-            flow = np.linalg.norm(self._pixels - self._project(np.eye(4)), axis=1)
+            flow = np.linalg.norm(self._pixels - self._kf_pixels, axis=1)
             agree = np.flatnonzero(off < c.prior_gate_px + c.prior_gate_frac * flow)
             if len(agree) >= max(c.min_inliers, n // 3):
                 use = agree
@@ -199,6 +200,7 @@ class StereoVO:
             return VOStep.failed("PnP diverged", tracked=n)
         # keep the inliers only: outliers (moving objects, bad tracks) would pull later frames too
         self._kf_points, self._pixels = self._kf_points[idx], self._pixels[idx]
+        self._kf_pixels = self._kf_pixels[idx]
         cov = pose_covariance(self._kf_points, self._pixels, self.K, rvec, tvec)
         # T_kf_cur = (T_cur_kf)^-1, where PnP gives p_cur = R p_kf + t
         T_kf_cur = _inverse(_matrix(rvec, tvec))

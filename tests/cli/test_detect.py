@@ -15,10 +15,6 @@ VTEST = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "opencv
 needs_vtest = pytest.mark.skipif(not VTEST.is_file(), reason=f"{VTEST} is absent (real data in ../shared/data)")
 
 
-def one_line_error(r, message):
-    assert r.exit_code == 2, r.output
-    assert message in r.output and len(r.output.strip().splitlines()) == 1, r.output
-
 
 @pytest.fixture(scope="module")
 def frame(tmp_path_factory):
@@ -56,7 +52,7 @@ def test_detect_on_a_video_writes_every_frame_and_an_overlay_video(tmp_path):
     assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == 3
 
 
-def test_bad_input_is_one_line_and_exit_2(tmp_path):
+def test_bad_input_is_one_line_and_exit_2(tmp_path, one_line_error):
     one_line_error(runner.invoke(app, ["detect", str(tmp_path / "none.png")]), "does not exist")
     (tmp_path / "broken.png").write_bytes(b"\x89PNG\r\n\x1a\n not really")
     one_line_error(runner.invoke(app, ["detect", str(tmp_path / "broken.png")]), "broken.png")

@@ -19,10 +19,6 @@ SCORES = ("true_path_length_m", "ate_rmse_m", "drift_pct", "rot_drift_deg_per_10
 P0 = "300 0 160 0 0 300 120 0 0 0 1 0"
 
 
-def one_line_error(r, message):
-    assert r.exit_code == 2, r.output
-    assert message in r.output and len(r.output.strip().splitlines()) == 1, r.output
-
 
 @pytest.fixture(scope="module")
 def kitti(tmp_path_factory):
@@ -130,13 +126,13 @@ def bad_folder(root: Path, kind: str) -> Path:
 @pytest.mark.parametrize("kind, message", [("no images", "holds no images"), ("no P0", "has no P0 line"),
                                            ("mixed sizes", "image_0/000001.png is 320x200 px but"),
                                            ("poses length", "has 5 poses but there are 3 images")])
-def test_bad_folders_are_one_line_and_exit_2(tmp_path, kind, message):
+def test_bad_folders_are_one_line_and_exit_2(tmp_path, kind, message, one_line_error):
     folder = bad_folder(tmp_path / "seq", kind)
     one_line_error(runner.invoke(app, ["odometry", str(folder), "--json", str(tmp_path / "o.json")]), message)
     assert not (tmp_path / "o.json").exists()
 
 
-def test_bad_options_are_one_line_and_exit_2(tmp_path):
+def test_bad_options_are_one_line_and_exit_2(tmp_path, one_line_error):
     one_line_error(runner.invoke(app, ["odometry", str(tmp_path / "none")]), "is not a folder")
     folder = make_stereo(tmp_path / "seq", n=2)
     one_line_error(runner.invoke(app, ["odometry", str(folder), "--camera-height", "0"]), "--camera-height")
