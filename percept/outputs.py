@@ -20,7 +20,9 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import signal
 import tempfile
+import threading
 from pathlib import Path
 from typing import Any, Iterator, Mapping
 
@@ -99,12 +101,34 @@ def write_json_atomic(path: Path | str, data: Any, indent: int | None = 2) -> No
     write_text_atomic(path, json.dumps(data, indent=indent))
 
 
+@contextlib.contextmanager
+def _stop_signals_held() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM (main thread, POSIX) until the block is done: a stop that lands between creating a
+    temporary and noting it down would leave the temporary behind. The stop is delivered right after (a write
+    takes milliseconds), so the command still stops at once and counts what was just written."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    stops = {signal.SIGINT, signal.SIGTERM}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, stops)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def write_files_atomic(files: Mapping[Path | str, bytes]) -> None:
     """Write several files as one unit: every file goes to a fsynced temporary first, then all are renamed.
 
     A failure while writing leaves every target as it was; a failure (or Ctrl-C) while renaming removes the
-    targets already renamed, so that a set of new files is complete or absent.
+    targets already renamed, so that a set of new files is complete or absent. Ctrl-C and SIGTERM are held while
+    the files are written and take effect when they are in place.
     """
+    with _stop_signals_held():
+        _write_files(files)
+
+
+def _write_files(files: Mapping[Path | str, bytes]) -> None:
     staged: list[tuple[Path, Path]] = []
     renamed: list[Path] = []
     try:
