@@ -39,7 +39,7 @@ class LandmarkSighting:
 @dataclass(frozen=True)
 class SightingConfig:
     """min_range_m, max_range_m: camera depths at which a sign is looked for; corner_sigma_px: a refined marker
-    corner's error; face_sigma_m: how far the face centre may lie from the mapped point (face offset, survey);
+    corner's error at the least (a sighting whose corners disagree between the images gets more); face_sigma_m: how far the face centre may lie from the mapped point (face offset, survey);
     margin_px: added around a predicted window; sigma_window: pose-uncertainty sigmas the window covers."""
 
     min_range_m: float = 4.0
@@ -132,14 +132,18 @@ class LandmarkFinder:
         if not (c.min_range_m * 0.5 <= pc[2] <= c.max_range_m * 1.5):
             return None
         zc = float(pc[2])
+        # this sighting's corner error: in a rectified pair the rows of a corner in the two images differ only by
+        # their errors, var(v_l - v_r) = 2 sigma^2; blur and rain streaks show there. Added to the floor:
+        # sigma^2 = sigma_0^2 + mean((v_l - v_r)^2) / 2
+        sigma_px = float(np.sqrt(c.corner_sigma_px ** 2 + np.mean((cl[:, 1] - cr[:, 1]) ** 2) / 2.0))
         # stereo depth error sigma_Z = Z^2 sigma_d / (f b) (sigma_d = sqrt(2) corner sigmas; four corners averaged
         # but correlated: halved, not quartered); X = (u - cx) Z / f carries Z's error along the ray:
         # Sigma_cam = J diag(sigma_u^2, sigma_v^2, sigma_Z^2) J^T, J = d(X, Y, Z) / d(u, v, Z)
-        sig_z = zc ** 2 * np.sqrt(2.0) * c.corner_sigma_px / (cam.fx * self.rig.baseline_m) / 2.0
+        sig_z = zc ** 2 * np.sqrt(2.0) * sigma_px / (cam.fx * self.rig.baseline_m) / 2.0
         u, v = cl.mean(axis=0)
         J = np.array([[zc / cam.fx, 0.0, (u - cam.cx) / cam.fx], [0.0, zc / cam.fy, (v - cam.cy) / cam.fy],
                       [0.0, 0.0, 1.0]])
-        cov_cam = J @ np.diag([c.corner_sigma_px ** 2, c.corner_sigma_px ** 2, sig_z ** 2]) @ J.T
+        cov_cam = J @ np.diag([sigma_px ** 2, sigma_px ** 2, sig_z ** 2]) @ J.T
         R = self._v_from_c.R
         cov_v = (R @ cov_cam @ R.T)[:2, :2] + np.eye(2) * c.face_sigma_m ** 2
         return LandmarkSighting(marker_id, self._v_from_c.apply(pc), cov_v, cl, zc)

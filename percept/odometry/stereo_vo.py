@@ -3,7 +3,9 @@
 At a keyframe, corners (FAST, strongest per grid cell) in the left image get their depth from the right image
 (KLT along the row of a rectified pair, Z = f b / d); in later frames they are tracked with KLT and the camera
 pose relative to the keyframe comes from PnP with RANSAC (points on moving vehicles and pedestrians disagree
-with the static world's motion and fall out as outliers) refined by Levenberg-Marquardt on the inliers. A new
+with the static world's motion and fall out as outliers) refined by Levenberg-Marquardt on the inliers; with a
+motion prior (wheel speed and gyro) that most points agree with, Levenberg-Marquardt starts from the prior and
+drops the points it cannot fit, without RANSAC. A new
 keyframe starts when too few inliers are left. References: Nistér, Naroditsky & Bergen 2004, "Visual
 odometry" (CVPR); Geiger, Ziegler & Stiller 2011, "StereoScan" (IV); Hartley & Zisserman, ch. 6-7 (PnP).
 """
@@ -188,6 +190,10 @@ class StereoVO:
             agree = np.flatnonzero(off < c.prior_gate_px + c.prior_gate_frac * flow)
             if len(agree) >= max(c.min_inliers, n // 3):
                 use = agree
+                # the prior agrees with most points: start from it instead of sampling minimal solutions
+                found = self._refine_from(use, T_kf_pred)
+                if found is not None:
+                    return self._solved(n, *found)
         # minimal solutions by EPnP inside RANSAC (no initial guess to lead it astray), then LM on the inliers
         found, rvec, tvec, inl = cv2.solvePnPRansac(self._kf_points[use], self._pixels[use], self.K, None,
                                                     iterationsCount=100, reprojectionError=c.ransac_px,
@@ -196,6 +202,28 @@ class StereoVO:
             return VOStep.failed(f"PnP found {0 if inl is None else len(inl)} inliers of {n}", tracked=n)
         idx = use[inl.ravel()]
         rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
+        return self._solved(n, idx, rvec, tvec)
+
+    def _refine_from(self, use: np.ndarray, T_kf_pred: np.ndarray) -> tuple | None:
+        """PnP by Levenberg-Marquardt from the prior's pose on the points ``use``, cutting the points whose
+        reprojection error exceeds 3 x, then 1 x, ransac_px and refining again: (inlier indices, rvec, tvec), or
+        None when fewer than half the points survive (the prior was off: RANSAC decides)."""
+        c = self.config
+        T = _inverse(T_kf_pred)
+        rvec, tvec = cv2.Rodrigues(T[:3, :3])[0], T[:3, 3].reshape(3, 1).copy()
+        idx = use
+        for cut_px in (3.0 * c.ransac_px, c.ransac_px):
+            rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
+            seen = cv2.projectPoints(self._kf_points[use], rvec, tvec, self.K, None)[0].reshape(-1, 2)
+            idx = use[np.linalg.norm(seen - self._pixels[use], axis=1) < cut_px]
+            if len(idx) < max(c.min_inliers, len(use) // 2):
+                return None
+        rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
+        return idx, rvec, tvec
+
+    def _solved(self, n: int, idx: np.ndarray, rvec: np.ndarray, tvec: np.ndarray) -> VOStep:
+        """The step from the pose (rvec, tvec: keyframe -> current camera) found on the inliers ``idx`` of the
+        ``n`` tracked points."""
         if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
             return VOStep.failed("PnP diverged", tracked=n)
         # keep the inliers only: outliers (moving objects, bad tracks) would pull later frames too
