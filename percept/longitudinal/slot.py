@@ -146,8 +146,13 @@ class LongitudinalSlot:
         cols = np.flatnonzero(m.mean(axis=0) >= self.cfg.column_fill)
         if len(cols) == 0 or cols[-1] - cols[0] < 2:
             return None
-        m[:, :cols[0]] = False
-        m[:, cols[-1] + 1:] = False
+        # and not their outline: a 5x5 block straddling it matches at the obstacle's disparity with half of it on
+        # what lies behind (foreground fattening), and the outline's strong gradients would dominate the fit
+        k = 2
+        if cols[-1] - cols[0] < 2 * k + 2:
+            return None
+        m[:, :cols[0] + k] = False
+        m[:, cols[-1] + 1 - k:] = False
         if m.sum() < 12:
             return None
         return refine_disparity(L, R, box, m, d0, huber=self.cfg.huber)
