@@ -1,11 +1,11 @@
-"""The lane module on recorded dash-camera footage: self-calibrated extrinsics, then the same LaneDetector.
+"""The lane module on recorded dash-camera footage: a self-calibrated geometry, then the same LaneDetector.
 
-Recorded footage comes without extrinsics. The horizon, hence the pitch, comes from the lane lines' vanishing
-point (``calibration.estimate_vanishing_point``: Hough segments, Hartley & Zisserman sec. 8.6), refined once
-from the marking evidence the detector labels (``calibration.marking_vanishing_point``). Intrinsics come from a
-calibration file (Zhang 2000) or an assumed horizontal field of view; the mount height [m] only scales the
-metric values (offset, width and 1/curvature are proportional to it). A still gets a fresh detector and its own
-horizon; a video gets one rig (median horizon of its first frames) and Kalman tracking at an assumed speed.
+Recorded footage comes without extrinsics: ``footage_geometry`` finds the lowest road row (above the hood, when
+one is seen), the horizon (pitch) from the lane lines' vanishing point, and, without a given height, the camera
+height from a lane-width prior. Intrinsics come from a calibration file (Zhang 2000) or an assumed horizontal
+field of view. A still gets a fresh detector and its own horizon (the height measured over a folder of one
+camera's stills by ``FootageLanes.calibrate``); a video gets one geometry (from its first frames) and Kalman
+tracking at an assumed speed. Each boundary is reported from the bottom row to the far end of its own evidence.
 """
 
 from __future__ import annotations
@@ -17,8 +17,9 @@ import numpy as np
 
 from percept.sensors import CameraCalibration, PinholeCamera, StereoRig
 
-from .horizon import VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
 from .detector import LaneConfig, LaneDebug, LaneDetector
+from .footage_geometry import FootageGeometry, footage_geometry, ground_range_at_row, make_detector
+from .horizon import VanishingPoint
 from .evidence import Brightness, EvidenceConfig
 from .fit import FitConfig
 from .types import LaneEstimate
@@ -35,18 +36,22 @@ def _real_lane_config() -> LaneConfig:
 @dataclass(frozen=True)
 class RealLaneConfig:
     """hfov_rad: assumed horizontal field of view without calibration [rad]; mount_height_m: camera height above
-    the road [m]; horizon_frac: horizon row as a fraction of the image height when no vanishing point is found;
-    roi_top_frac, bottom_margin_frac: rows searched for lane segments, and rows left out at the bottom (a car's
-    hood), as fractions of the height; x_far_m: farthest ground range used [m]; speed_mps: assumed speed for
-    tracking through a video (no odometry) [m/s]; horizon_frames: video frames whose median horizon is used;
-    lane: the detector's configuration (x_near_m is set from the lowest usable row)."""
+    the road [m], None = estimated from the lane-width prior; lane_width_m: the width of the lanes filmed (US
+    freeways 3.6-3.7 m), which sets the height when it is not given; horizon_frac: horizon row as a fraction of the
+    image height when no vanishing point is found; roi_top_frac: top of the rows searched for lane segments, as a
+    fraction of the height; bottom_margin_frac: rows left out at the bottom, as a fraction of the height, None =
+    down to the car's hood when one is seen (``hood.py``), else to the last row; x_far_m: farthest ground range
+    used [m]; speed_mps: assumed speed for tracking through a video (no odometry) [m/s]; horizon_frames: video
+    frames whose median horizon (and height) is used; lane: the detector's configuration (x_near_m is set from the
+    lowest usable row)."""
 
     hfov_rad: float = math.radians(60.0)
-    mount_height_m: float = 1.2
+    mount_height_m: float | None = None
+    lane_width_m: float = 3.65
     horizon_frac: float = 0.58
     roi_top_frac: float = 0.5
-    bottom_margin_frac: float = 0.07
-    x_far_m: float = 40.0
+    bottom_margin_frac: float | None = None
+    x_far_m: float = 60.0
     speed_mps: float = 0.0
     horizon_frames: int = 15
     lane: LaneConfig = field(default_factory=_real_lane_config)
@@ -54,31 +59,17 @@ class RealLaneConfig:
     def __post_init__(self) -> None:
         if not 0.05 < self.hfov_rad < math.pi - 0.05:
             raise ValueError(f"field of view {math.degrees(self.hfov_rad):.1f} deg is outside (3, 177) deg")
-        if not 0.2 <= self.mount_height_m <= 10.0:
+        if self.mount_height_m is not None and not 0.2 <= self.mount_height_m <= 10.0:
             raise ValueError(f"mount height {self.mount_height_m} m is outside [0.2, 10] m")
-        if not 0.0 <= self.bottom_margin_frac < 0.4 or not 0.0 <= self.roi_top_frac < 1 - self.bottom_margin_frac:
-            raise ValueError(f"rows {self.roi_top_frac}..{1 - self.bottom_margin_frac} of the height are not a band")
+        if not 2.0 <= self.lane_width_m <= 6.0:
+            raise ValueError(f"lane width {self.lane_width_m} m is outside [2, 6] m")
+        margin = 0.0 if self.bottom_margin_frac is None else self.bottom_margin_frac
+        if not 0.0 <= margin < 0.4 or not 0.0 <= self.roi_top_frac < 1 - margin:
+            raise ValueError(f"rows {self.roi_top_frac}..{1 - margin} of the height are not a band")
         if not math.isfinite(self.speed_mps) or self.speed_mps < 0:
             raise ValueError(f"assumed speed {self.speed_mps} m/s must be finite and >= 0")
         if self.horizon_frames < 1:
             raise ValueError(f"horizon_frames must be at least 1, got {self.horizon_frames}")
-
-
-def ground_range_at_row(rig: StereoRig, row_px: float) -> float:
-    """Ground distance ahead [m] seen at image row ``row_px`` (below the horizon):
-    x = h / tan(pitch + atan((v - cy) / fy))."""
-    cam = rig.camera
-    a = rig.pitch_rad + math.atan((row_px - cam.cy) / cam.fy)
-    return rig.mount_height_m / math.tan(a) if a > 1e-4 else float("inf")
-
-
-def make_detector(rig: StereoRig, cfg: RealLaneConfig) -> LaneDetector:
-    """LaneDetector for a recorded camera: the near range starts at the lowest usable row (above the hood)."""
-    bottom = (1 - cfg.bottom_margin_frac) * (rig.camera.height - 1)
-    x_near = max(ground_range_at_row(rig, bottom) + 0.5, 3.0)
-    x_far = max(cfg.x_far_m, x_near + 10.0)
-    ev_cfg = replace(cfg.lane.evidence, x_near_m=x_near, x_far_m=x_far, max_row_px=bottom)
-    return LaneDetector(rig, replace(cfg.lane, evidence=ev_cfg))
 
 
 def boundary_points_px(rig: StereoRig, est: LaneEstimate, x_near_m: float, x_far_m: float,
@@ -92,27 +83,65 @@ def boundary_points_px(rig: StereoRig, est: LaneEstimate, x_near_m: float, x_far
     return out
 
 
+def boundary_u_at_rows(rig: StereoRig, est: LaneEstimate, side: int, rows_px: np.ndarray,
+                       x_range_m: tuple[float, float]) -> np.ndarray:
+    """Column [px] of a boundary (``side`` +1 left, -1 right) at each image row of ``rows_px``, NaN where the row
+    sees the road outside ``x_range_m`` (near, far) [m] or lies above the horizon: the row's ground range x, the
+    boundary's y there, projected."""
+    rows = np.asarray(rows_px, dtype=float)
+    x = np.array([ground_range_at_row(rig, v) for v in rows])
+    inside = np.isfinite(x) & (x >= x_range_m[0] - 1e-6) & (x <= x_range_m[1] + 1e-6)
+    u = np.full(len(rows), np.nan)
+    if inside.any():
+        xs = x[inside]
+        uv, z = rig.project_vehicle_points(np.column_stack([xs, est.boundary_y(xs, side), np.zeros_like(xs)]))
+        u[inside] = np.where(z > 0.1, uv[:, 0], np.nan)
+    return u
+
+
+def boundaries_over_ranges(rig: StereoRig, est: LaneEstimate, ranges: dict[str, tuple[float, float]],
+                           n: int = 40) -> dict[str, np.ndarray]:
+    """Each boundary in the image over its own ground range: {"left"|"right": (m <= n, 2) (u, v) [px]}, ``n``
+    points evenly spaced on the ground from the near end (the bottom row) to the far end."""
+    return {name: boundary_points_px(rig, est, *ranges[name], n=n)[name] for name in ("left", "right")}
+
+
 @dataclass(frozen=True)
 class LaneResult:
-    """One image's outcome: the estimate (invalid when no lane was found), the detector's debug data, the rig
-    used, the vanishing point (None when the fallback horizon was used), both boundaries in the image
-    {"left"|"right": (N, 2) (u, v) [px]} and the ground range they span, x_range_m (near, far) [m]."""
+    """One image's outcome: the estimate (invalid when no lane was found), the detector's debug data, the
+    camera's geometry, both boundaries in the image {"left"|"right": (N, 2) (u, v) [px]} from the bottom row to
+    the far end of each one's evidence, and the ground ranges they span, x_ranges_m {"left"|"right": (near, far)}
+    [m]."""
 
     estimate: LaneEstimate
     debug: LaneDebug
-    rig: StereoRig
-    vanishing_point: VanishingPoint | None
+    geometry: FootageGeometry
     boundaries_px: dict[str, np.ndarray]
-    x_range_m: tuple[float, float]
+    x_ranges_m: dict[str, tuple[float, float]]
+
+    @property
+    def rig(self) -> StereoRig:
+        return self.geometry.rig
+
+    @property
+    def vanishing_point(self) -> VanishingPoint | None:
+        return self.geometry.vanishing_point
 
     @property
     def both_found(self) -> bool:
         f = self.debug.fit
         return bool(self.estimate.valid and f is not None and f.inliers_left >= 5 and f.inliers_right >= 5)
 
+    def u_at_rows(self, rows_px: np.ndarray) -> dict[str, np.ndarray]:
+        """Each boundary's column [px] at ``rows_px``, NaN outside its drawn range (or without a lane)."""
+        if not self.estimate.valid:
+            return {k: np.full(len(rows_px), np.nan) for k in ("left", "right")}
+        return {name: boundary_u_at_rows(self.rig, self.estimate, side, rows_px, self.x_ranges_m[name])
+                for name, side in (("left", 1), ("right", -1))}
+
     def to_dict(self) -> dict:
-        e = self.estimate
-        vp = self.vanishing_point
+        e, g = self.estimate, self.geometry
+        vp = g.vanishing_point
         num = (lambda v: float(v) if e.valid else None)
         return {"lanes": [{"side": k, "points_px": np.round(v, 1).tolist()} for k, v in self.boundaries_px.items()],
                 "offset_m": num(e.offset_m), "heading_rad": num(e.heading_rad), "curvature_1pm": num(e.curvature_1pm),
@@ -120,35 +149,37 @@ class LaneResult:
                 "both_boundaries": self.both_found, "pitch_rad": self.rig.pitch_rad,
                 "horizon_row_px": self.rig.horizon_row,
                 "vanishing_point_px": None if vp is None else [round(vp.u, 1), round(vp.v, 1)],
-                "horizon_source": "assumed" if vp is None else vp.source}
+                "horizon_source": "assumed" if vp is None else vp.source,
+                "mount_height_m": round(self.rig.mount_height_m, 3), "mount_height_source": g.height_source,
+                "hood_row_px": g.hood_row_px, "bottom_row_px": g.bottom_row_px}
 
 
-def _drawn_range(det: LaneDetector, dbg: LaneDebug) -> tuple[float, float]:
-    """Ground range [m] to draw: from the near limit to the farthest inlier marking (the full range without a fit)."""
+def _drawn_ranges(det: LaneDetector, dbg: LaneDebug) -> dict[str, tuple[float, float]]:
+    """Ground range [m] to draw each boundary over: from the lowest road row (the fit carried the few tenths of a
+    metre below the evidence grid's first row) to its farthest inlier marking (the full range for a side without
+    one)."""
     ev = det.cfg.evidence
+    near = ev.x_near_m if ev.max_row_px is None else min(ground_range_at_row(det.rig, ev.max_row_px), ev.x_near_m)
     fit = dbg.fit
-    if fit is None or dbg.evidence is None or not (fit.side != 0).any():
-        return ev.x_near_m, ev.x_far_m
-    x_max = float(dbg.evidence.points_m[fit.side != 0, 0].max())
-    return ev.x_near_m, float(np.clip(x_max, ev.x_near_m + 5.0, ev.x_far_m))
-
-
-def _median_vp(vps: list[VanishingPoint | None]) -> VanishingPoint | None:
-    vps = [v for v in vps if v is not None]
-    if not vps:
-        return None
-    return VanishingPoint(float(np.median([p.u for p in vps])), float(np.median([p.v for p in vps])),
-                          int(np.median([p.segments for p in vps])), float(np.median([p.support_px for p in vps])),
-                          vps[0].source)
+    out = {}
+    for name, side in (("left", 1), ("right", -1)):
+        mine = None if fit is None or dbg.evidence is None else fit.side == side
+        far = float(dbg.evidence.points_m[mine, 0].max()) if mine is not None and mine.any() else ev.x_far_m
+        out[name] = (near, float(np.clip(far, ev.x_near_m + 5.0, ev.x_far_m)))
+    return out
 
 
 class FootageLanes:
-    """The lane detector on recorded footage of one camera: stills (a fresh detector per image, no tracking)
-    or a video (one rig for the whole video, Kalman tracking at the assumed speed)."""
+    """The lane detector on recorded footage of one camera: stills (a fresh detector and horizon per image, no
+    tracking) or a video (one geometry for the whole video, Kalman tracking at the assumed speed). Without a
+    given height, ``calibrate`` measures it over a set of stills (one camera); otherwise each still measures its
+    own."""
 
     def __init__(self, cfg: RealLaneConfig = RealLaneConfig(), calibration: CameraCalibration | None = None):
         self.cfg, self.calibration = cfg, calibration
         self._undistort = calibration.undistorter() if calibration is not None else None
+        self.height_m: float | None = cfg.mount_height_m
+        self.height_source = "given" if cfg.mount_height_m is not None else None
 
     def prepare(self, image: np.ndarray) -> np.ndarray:
         """Undistort with the calibration (maps computed once; ValueError on a size mismatch), or pass through."""
@@ -161,43 +192,44 @@ class FootageLanes:
             return self.calibration.camera
         return PinholeCamera.from_hfov(width, height, self.cfg.hfov_rad)
 
-    def rig_for(self, images: list[np.ndarray]) -> tuple[StereoRig, VanishingPoint | None]:
-        """The rig for ``images`` (prepared, one size, one camera): the median vanishing point of the Hough
-        segments (without any, the horizon is ``horizon_frac`` of the height), then the median vanishing point of
-        the marking evidence a detector on that rig labels, when it lies within 8 % of the height of the first."""
+    def geometry(self, images: list[np.ndarray]) -> FootageGeometry:
+        """The geometry of prepared ``images`` of one size (``footage_geometry``), at the known height if any."""
         h, w = images[0].shape[:2]
-        cam, cfg = self.camera(w, h), self.cfg
-        vp = _median_vp([estimate_vanishing_point(im, cfg.roi_top_frac, cfg.bottom_margin_frac) for im in images])
-        row = vp.v if vp is not None else cfg.horizon_frac * (h - 1)
-        rig = make_rig(cam, row, cfg.mount_height_m)
-        det = make_detector(rig, cfg)
-        found = []
-        for im in images:
-            det.reset()
-            _, dbg = det.process(im)
-            if dbg.fit is not None:
-                found.append(marking_vanishing_point(dbg.evidence, dbg.fit))
-        refined = _median_vp(found)
-        if refined is not None and abs(refined.v - row) < 0.08 * h:
-            return make_rig(cam, refined.v, cfg.mount_height_m), refined
-        return rig, vp
+        g = footage_geometry(images, self.camera(w, h), self.cfg, self.height_m)
+        return g if self.height_source is None else replace(g, height_source=self.height_source)
 
-    def _result(self, det: LaneDetector, est: LaneEstimate, dbg: LaneDebug, vp) -> LaneResult:
-        near, far = _drawn_range(det, dbg)
-        pts = boundary_points_px(det.rig, est, near, far) if est.valid else {}
-        return LaneResult(est, dbg, det.rig, vp, pts, (near, far))
+    def calibrate(self, images: list[np.ndarray]) -> float | None:
+        """Measure the camera height over stills of one camera (each with its own horizon): the median of the
+        heights the lane-width prior gives on each; later stills use it. None (and nothing changes) when no still
+        shows both boundaries or the height is given."""
+        if self.height_m is not None:
+            return None
+        heights = []
+        for im in images:
+            g = self.geometry([self.prepare(im)])
+            if g.height_source == "lane-width prior":
+                heights.append(g.rig.mount_height_m)
+        if not heights:
+            return None
+        self.height_m, self.height_source = float(np.median(heights)), f"lane-width prior ({len(heights)} images)"
+        return self.height_m
+
+    def _result(self, det: LaneDetector, est: LaneEstimate, dbg: LaneDebug, geometry: FootageGeometry) -> LaneResult:
+        ranges = _drawn_ranges(det, dbg)
+        pts = boundaries_over_ranges(det.rig, est, ranges) if est.valid else {}
+        return LaneResult(est, dbg, geometry, pts, ranges)
 
     def still(self, image: np.ndarray) -> LaneResult:
-        """One image on its own: its own vanishing point, a fresh detector, the frame's fit (no tracking)."""
+        """One image on its own: its own horizon (and height, unless known), a fresh detector, the frame's fit."""
         img = self.prepare(image)
-        rig, vp = self.rig_for([img])
-        det = make_detector(rig, self.cfg)
+        g = self.geometry([img])
+        det = make_detector(g.rig, self.cfg, g.bottom_row_px)
         _, dbg = det.process(img)
         est = dbg.fit.estimate if dbg.fit is not None else LaneEstimate(0.0, 0.0, 0.0, 0.0, 0.0, valid=False)
-        return self._result(det, est, dbg, vp)
+        return self._result(det, est, dbg, g)
 
     def video(self, frames, fps: float):
-        """Yield (prepared frame, LaneResult) per frame of the iterable ``frames`` (BGR); the rig comes from the
+        """Yield (prepared frame, LaneResult) per frame of the iterable ``frames`` (BGR); the geometry comes from the
         first ``cfg.horizon_frames`` frames; tracking with dt = 1 / fps [s] at the assumed speed."""
         it = iter(frames)
         head = []
@@ -207,8 +239,8 @@ class FootageLanes:
                 break
         if not head:
             return
-        rig, vp = self.rig_for(head)
-        det = make_detector(rig, self.cfg)
+        g = self.geometry(head)
+        det = make_detector(g.rig, self.cfg, g.bottom_row_px)
         dt = 1.0 / fps if fps and fps > 0 else 1.0 / 25
 
         def all_frames():
@@ -218,5 +250,4 @@ class FootageLanes:
 
         for img in all_frames():
             est, dbg = det.process(img, self.cfg.speed_mps, 0.0, dt)
-            yield img, self._result(det, est, dbg, vp)
-
+            yield img, self._result(det, est, dbg, g)

@@ -64,8 +64,8 @@ def test_straight_lines_are_straight(name, calibrated, request):
     r = FootageLanes(RealLaneConfig(), cal).still(read_image(LANES / "test_images" / name))
     assert r.both_found
     assert r.debug.fit.inliers_left > 40 and r.debug.fit.inliers_right > 40
-    # radius > 1 km
-    assert abs(r.estimate.curvature_1pm) < 1e-3
+    # radius > 2 km with the camera's calibration (its lens bends straight lines), > 1 km without
+    assert abs(r.estimate.curvature_1pm) < (5e-4 if calibrated else 1e-3)
     assert abs(r.estimate.heading_rad) < 0.04 and 3.0 < r.estimate.width_m < 4.3
     assert r.vanishing_point is not None and r.vanishing_point.source == "markings"
 
