@@ -93,11 +93,23 @@ class _Band:
         self.rays = (rays_c @ rig.rotation_cam_from_vehicle()).astype(np.float32)
         self.fb = cam.fx * rig.baseline_m
 
+    def shrink(self, image: np.ndarray) -> np.ndarray:
+        """The band's rows of a full-resolution grey image at the band's scale: only those rows are averaged down
+        (INTER_AREA at a whole-number factor averages blocks, so this equals shrinking the whole image and then
+        cutting the band out of it; other factors do just that)."""
+        k = round(1.0 / self.s)
+        if abs(k * self.s - 1.0) > 1e-9:
+            # not a whole-number factor: shrink it all, then cut
+            h = int(round(image.shape[0] * self.s))
+            return cv2.resize(image, (self.w, h), interpolation=cv2.INTER_AREA)[self.r0:self.r1]
+        return cv2.resize(image[self.r0 * k:self.r1 * k], (self.w, self.r1 - self.r0), interpolation=cv2.INTER_AREA)
+
     def match(self, left: np.ndarray, right: np.ndarray, u0: float, u1: float):
-        """Matched pixels with full-resolution columns in [u0, u1): (u, v, depth Z [m], ray (N, 3), area [px])."""
+        """Matched pixels with full-resolution columns in [u0, u1): (u, v, depth Z [m], ray (N, 3), area [px]);
+        ``left``, ``right``: the band's rows at its scale (``shrink``)."""
         c0 = max(int(np.floor(u0 * self.s)) - self.nd, 0)
         c1 = min(int(np.ceil(u1 * self.s)) + 1, self.w)
-        d16 = self.matcher.compute(left[self.r0:self.r1, c0:c1], right[self.r0:self.r1, c0:c1])
+        d16 = self.matcher.compute(left[:, c0:c1], right[:, c0:c1])
         ok = d16 > 0
         ok[:, :min(self.nd, c1 - c0) if c0 > 0 else 0] = False  # no search room left of the crop
         # Z = f b / d with d = (d16 / 16) / s full-resolution pixels
@@ -140,9 +152,7 @@ class ObstacleFinder:
         cfg, cam = self.cfg, self.rig.camera
         parts = []
         for band, (u0, u1) in ((self.far, self._far_columns(path)), (self.near, (0.0, float(cam.width)))):
-            size = (band.w, int(round(cam.height * band.s)))
-            small = [cv2.resize(im, size, interpolation=cv2.INTER_AREA) for im in (left_gray, right_gray)]
-            parts.append(band.match(*small, u0, u1))
+            parts.append(band.match(band.shrink(left_gray), band.shrink(right_gray), u0, u1))
         u, v, z, rays = (np.concatenate([p[k] for p in parts]) for k in range(4))
         area = np.concatenate([np.full(len(p[0]), p[4], np.float32) for p in parts])
         keep = (z > cfg.min_range_m) & (z < cfg.max_range_m)
@@ -165,12 +175,13 @@ class ObstacleFinder:
         order = np.argsort(k, kind="stable")
         ks = k[order]
         run = np.concatenate([[0.0], np.cumsum(area[order], dtype=np.float64)])
-        for b in np.unique(ks):
-            lo, hi = np.searchsorted(ks, b - 1, "left"), np.searchsorted(ks, b + 1, "right")
-            # a full-resolution pixel covers (Z / f)^2 m^2 at range Z: the pixels an area needs there
-            need = max(cfg.min_area_m2 * (cam.fx / np.exp(b * np.log1p(cfg.bin_rel))) ** 2, 24)
-            if run[hi] - run[lo] < need * (1 - 1e-4):
-                continue
+        bins = np.unique(ks)
+        los, his = np.searchsorted(ks, bins - 1, "left"), np.searchsorted(ks, bins + 1, "right")
+        # a full-resolution pixel covers (Z / f)^2 m^2 at range Z: the pixels an area needs there
+        needs = np.maximum(cfg.min_area_m2 * (cam.fx / np.exp(bins * np.log1p(cfg.bin_rel))) ** 2, 24)
+        # only bins (with their neighbours) holding that much area can hold the obstacle: nearest first
+        for i in np.flatnonzero(run[his] - run[los] >= needs * (1 - 1e-4)):
+            lo, hi, need = los[i], his[i], needs[i]
             near = np.sort(order[lo:hi])
             if area[near].sum() < need:
                 continue
