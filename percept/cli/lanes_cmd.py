@@ -56,19 +56,10 @@ def register(app: typer.Typer) -> None:
         """
         from percept.cli.common import check_outputs, fail
         from percept.cli.footage_out import overlay_path
-        from percept.cli.options import check_number
         from percept.lanes.realworld import FootageLanes, RealLaneConfig
         from percept.sensors import CameraCalibration, FootageKind, list_footage
 
-        check_number("--mount-height", mount_height, 0.2, 10.0)
-        check_number("--lane-width", lane_width, 2.0, 6.0)
-        if fmt not in ("percept", "tusimple"):
-            fail(f"--format must be percept or tusimple, got {fmt!r}")
-        if fmt == "tusimple" and json_path is None:
-            fail("--format tusimple describes the --json file; give --json OUT")
-        check_number("--hfov", hfov, 3.0, 177.0)
-        check_number("--speed", speed, 0.0, 100.0)
-        check_number("--max-frames", max_frames, 1, 10**7)
+        _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt, json_path)
         try:
             cfg = RealLaneConfig(hfov_rad=math.radians(hfov), mount_height_m=mount_height, lane_width_m=lane_width,
                                  speed_mps=speed)
@@ -91,6 +82,22 @@ def register(app: typer.Typer) -> None:
             _run_video(runner, files[0], out, json_path, max_frames, header)
         else:
             _run_images(runner, files, out, json_path, header, single=source.is_file(), tusimple=fmt == "tusimple")
+
+
+def _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt: str, json_path) -> None:
+    """One-line errors (exit 2) for option values out of range or that do not go together."""
+    from percept.cli.common import fail
+    from percept.cli.options import check_number
+
+    check_number("--mount-height", mount_height, 0.2, 10.0)
+    check_number("--lane-width", lane_width, 2.0, 6.0)
+    check_number("--hfov", hfov, 3.0, 177.0)
+    check_number("--speed", speed, 0.0, 100.0)
+    check_number("--max-frames", max_frames, 1, 10**7)
+    if fmt not in ("percept", "tusimple"):
+        fail(f"--format must be percept or tusimple, got {fmt!r}")
+    if fmt == "tusimple" and json_path is None:
+        fail("--format tusimple describes the --json file; give --json OUT")
 
 
 def _record(result, **keys) -> dict:

@@ -1,14 +1,14 @@
-"""Self-calibration of a dash camera from the road it films: the lowest road row (above the hood), the horizon
-(pitch) from the lane lines' vanishing point, and the camera height from a lane-width prior.
+"""Self-calibration of a dash camera from the road it films: the lowest road row (above the hood), the horizon (pitch)
+from the lane lines' vanishing point, and the camera height from a lane-width prior.
 
 Recorded footage comes without extrinsics. The hood, when the camera sees one, ends the road (``hood.py``); the
 horizon comes from the Hough segments' vanishing point, refined from the marking evidence the detector labels
 (``horizon.py``; Hartley & Zisserman sec. 8.6). Every ground distance seen by one camera scales with its height
-above the road (for a level camera a road point at row v lies at x = h fy / (v - v_h), y = -(u - cx) x / fx),
-so a fit made at a nominal height measures the lane width up to the factor h / h_nominal; the lanes' known width (US freeways 3.6-3.7 m) turns the
-median measured width into the height: h = h_nominal W_prior / median(W_measured), measured twice (the fit's own
-width prior pulls the first measurement towards 3.7 m). Over a folder or the head of a video the medians are
-taken over all frames, so that each frame's width is then a measurement, not the prior.
+above the road (for a level camera a road point at row v lies at x = h fy / (v - v_h), y = -(u - cx) x / fx), so a
+fit made at a nominal height measures the lane width up to the factor h / h_nominal; the lanes' known width (US
+freeways 3.6-3.7 m) turns the median measured width into the height: h = h_nominal W_prior / median(W_measured),
+measured twice (the fit's own width prior pulls the first measurement towards 3.7 m). Over a folder or the head of a
+video the medians are taken over all frames, so that each frame's width is then a measurement, not the prior.
 """
 
 from __future__ import annotations

@@ -23,9 +23,10 @@ def hood_row(image: np.ndarray, band_frac: float = 0.3, rows: int = 8, blocks: i
     """Row [px] of the hood's top edge in a BGR image, or None. The image's columns are cut into ``blocks``; in each
     block of the middle 80 % the colour step (``rows`` rows above against ``rows`` rows below, summed over the
     channels, median over the block's columns) is followed up from the bottom to the first peak that reaches
-    HOOD_STEP_GREY (a shadow's or a car's edge above the hood can step as much); a hood puts that peak within MAX_CURVE_PX of the blocks' median row in all but one of the blocks, and its
-    edge (curved, most of all after undistortion) is reported at its highest block row. Rows within 2 ``rows`` of the bottom are not candidates (a dark border there
-    is not a hood)."""
+    HOOD_STEP_GREY (a shadow's or a car's edge above the hood can step as much); a hood puts that peak within
+    MAX_CURVE_PX of the blocks' median row in all but one of the blocks, and its edge (curved, most of all after
+    undistortion) is reported at its highest block row. Rows within 2 ``rows`` of the bottom are not candidates
+    (a dark border there is not a hood)."""
     img = np.asarray(image)
     if img.ndim != 3 or img.shape[2] != 3:
         raise ValueError(f"expected an (H, W, 3) BGR image, got shape {img.shape}")

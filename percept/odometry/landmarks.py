@@ -39,8 +39,9 @@ class LandmarkSighting:
 @dataclass(frozen=True)
 class SightingConfig:
     """min_range_m, max_range_m: camera depths at which a sign is looked for; corner_sigma_px: a refined marker
-    corner's error at the least (a sighting whose corners disagree between the images gets more); face_sigma_m: how far the face centre may lie from the mapped point (face offset, survey);
-    margin_px: added around a predicted window; sigma_window: pose-uncertainty sigmas the window covers."""
+    corner's error at the least (a sighting whose corners disagree between the images gets more); face_sigma_m:
+    how far the face centre may lie from the mapped point (face offset, survey); margin_px: added around a
+    predicted window; sigma_window: pose-uncertainty sigmas the window covers."""
 
     min_range_m: float = 4.0
     max_range_m: float = 32.0
