@@ -154,6 +154,8 @@ class LongitudinalSlot:
             return None
         m[:, :cols[0]] = False
         m[:, cols[-1] + 1:] = False
+        if m.sum() < 12:
+            return None
         full = refine_disparity(L, R, box, m, d0, huber=self.cfg.huber)
         if full is None:
             return None

@@ -1,14 +1,15 @@
-"""Pose fusion: an extended Kalman filter (filterpy) over planar pose, speed, gyro and accelerometer biases and
-the wheel-speed scale.
+"""Pose fusion: an extended Kalman filter (filterpy) over planar pose, speed, gyro and accelerometer biases and the
+wheel-speed scale.
 
 The IMU (yaw rate, forward acceleration) predicts through the kinematic bicycle model (the vehicle centre's
 velocity leans from the heading by the slip angle in a turn; Rajamani, *Vehicle Dynamics and Control*, sec. 2.2);
-the wheel speed, visual odometry and landmark fixes update. Visual odometry measures the motion between two
-images, so the filter keeps a copy of the pose at the last keyframe (stochastic cloning: Roumeliotis & Burdick 2002, "Stochastic cloning: a generalized framework
-for processing relative state measurements", ICRA) and updates with the relative pose between the copy and now.
-A NaN or absurd sensor sample is rejected, never propagated: the prediction then uses the last good reading with
-its uncertainty widened. References: Thrun, Burgard & Fox, *Probabilistic Robotics*, ch. 3 and 7 (EKF, landmark
-updates); Bar-Shalom, Li & Kirubarajan 2001, sec. 5.4 (normalised innovation gating).
+the wheel speed, visual odometry and landmark fixes update. Visual odometry measures the motion between two images,
+so the filter keeps a copy of the pose at the last keyframe (stochastic cloning: Roumeliotis & Burdick 2002,
+"Stochastic cloning: a generalized framework for processing relative state measurements", ICRA) and updates with
+the relative pose between the copy and now. A NaN or absurd sensor sample is rejected, never propagated: the
+prediction then uses the last good reading with its uncertainty widened. References: Thrun, Burgard & Fox,
+*Probabilistic Robotics*, ch. 3 and 7 (EKF, landmark updates); Bar-Shalom, Li & Kirubarajan 2001, sec. 5.4
+(normalised innovation gating).
 """
 
 from __future__ import annotations
@@ -99,7 +100,8 @@ def _angle_residual(index: int):
 
 class PoseFilter:
     """Planar pose, speed, gyro and accelerometer biases and wheel scale from IMU + wheel speed, updated by visual
-    odometry's relative motion and by landmark positions. ``start``: the known start pose; speed starts from the first wheel reading."""
+    odometry's relative motion and by landmark positions. ``start``: the known start pose; speed starts from the
+    first wheel reading."""
 
     def __init__(self, start: Pose2D, noise: FusionNoise = FusionNoise()):
         self.noise = noise
@@ -124,10 +126,6 @@ class PoseFilter:
     @property
     def speed_mps(self) -> float:
         return float(self.kf.x[V, 0])
-
-    @property
-    def gyro_bias_rps(self) -> float:
-        return float(self.kf.x[BG, 0])
 
     @property
     def pose_covariance(self) -> np.ndarray:

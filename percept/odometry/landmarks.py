@@ -20,7 +20,6 @@ from percept.sensors import LandmarkMap, Pose2D, Side, StereoRig
 from .features import to_gray
 
 ARUCO_DICTIONARY = cv2.aruco.DICT_4X4_50
-UPSAMPLE, UPSAMPLE_BELOW_PX = 2, 0
 
 
 @dataclass(frozen=True)
@@ -84,20 +83,14 @@ class LandmarkFinder:
         return out
 
     def _find(self, gray: np.ndarray, box: tuple[int, int, int, int], marker_id: int) -> np.ndarray | None:
-        """The marker's corners (4, 2) in ``box`` of the image, or None. Small windows are searched at twice the
-        size (a far marker's cells are 2-3 px: too few for ArUco's thresholds and contours)."""
+        """The marker's corners (4, 2) in ``box`` of the image, or None."""
         u0, v0, u1, v1 = box
-        crop = gray[v0:v1, u0:u1]
-        k = UPSAMPLE if max(crop.shape) < UPSAMPLE_BELOW_PX else 1
-        if k > 1:
-            crop = cv2.resize(crop, None, fx=k, fy=k, interpolation=cv2.INTER_CUBIC)
-        corners, ids, _ = self.detector.detectMarkers(crop)
+        corners, ids, _ = self.detector.detectMarkers(gray[v0:v1, u0:u1])
         if ids is None:
             return None
         for c, i in zip(corners, ids.ravel()):
             if int(i) == marker_id:
-                # upsampled pixel centres: x_small = (x_big + 0.5) / k - 0.5
-                return (c.reshape(4, 2).astype(np.float64) + 0.5) / k - 0.5 + (u0, v0)
+                return c.reshape(4, 2).astype(np.float64) + (u0, v0)
         return None
 
     def sight(self, left: np.ndarray, right: np.ndarray, pose: Pose2D, pose_cov: np.ndarray) -> list[LandmarkSighting]:
