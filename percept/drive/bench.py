@@ -20,9 +20,9 @@ from .tasks import SlotContext, Task
 
 @dataclass(frozen=True)
 class StageCost:
-    """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (mean or median, see
-    ``bench_task``); peer: the peer's name and peer_ms its cost in the same run (None where no peer does the same
-    job); ratio = ms / peer_ms; target_ms: the stage's budget, if any."""
+    """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (a slot's mean per frame,
+    else the median; see ``bench_task``); peer: the peer's name and peer_ms its cost in the same run (None where
+    no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any."""
 
     stage: str
     what: str
@@ -42,8 +42,8 @@ class StageCost:
                 "ratio": None if r is None else round(r, 3), "target_ms": self.target_ms}
 
 
-def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2, mean: bool = False) -> float:
-    """Median (or mean) wall time of ``fn`` in milliseconds."""
+def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2) -> float:
+    """Median wall time of ``fn`` in milliseconds."""
     for _ in range(warmup):
         fn()
     times = []
@@ -51,7 +51,33 @@ def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2, mean: boo
         t0 = time.perf_counter()
         fn()
         times.append((time.perf_counter() - t0) * 1e3)
-    return float(np.mean(times) if mean else np.median(times))
+    return float(np.median(times))
+
+
+SLOT_PASSES = 3
+"""Timed passes of a slot over its frames; the stage's cost is the median of their means."""
+
+
+def slot_ms(slot, shots: list, passes: int = SLOT_PASSES, progress: Callable[[], None] | None = None) -> float:
+    """Mean cost per frame [ms] of a stateful slot stepped through consecutive ``shots`` ((frame, upstream)
+    pairs) from ``reset()``: one warm-up pass (caches, first allocations), then the median over ``passes`` passes
+    of each pass's mean, so that one stall of the machine in one pass does not move the figure."""
+    means = []
+    for i in range(passes + 1):
+        slot.reset()
+        t0 = time.perf_counter()
+        for frame, upstream in shots:
+            slot.step(frame, upstream)
+            if progress:
+                progress()
+        if i:
+            means.append((time.perf_counter() - t0) * 1e3 / len(shots))
+    return float(np.median(means))
+
+
+def bench_ticks(frames: int, slots: int, peers: int) -> int:
+    """Progress ticks of a whole bench: the render and its peer, each slot's passes and each slot peer's calls."""
+    return 2 * (frames + 2) + slots * (SLOT_PASSES + 1) * frames + peers * (frames + 2)
 
 
 def _cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], object]:
@@ -100,8 +126,8 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
                progress: Callable[[], None] | None = None) -> StageCost:
     """A task's vision slot on rendered frames of its bench scenario (640x480, one thread); the slots upstream of
     it are privileged (computed beforehand, not timed). A slot keeps state from frame to frame (trackers, filters,
-    a search spread over frames), so it is timed on consecutive frames and reported as its mean cost; the stateless
-    peer as its median."""
+    a search spread over frames), so it is timed on consecutive frames from a reset, as its mean cost per frame
+    (``slot_ms``); the stateless peer as its median."""
     from percept.sims import SimWorld, WorldConfig
     from percept.sims.coords import hw_pose
 
@@ -119,9 +145,8 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
         frame, feed.truth = world.observe()
         shots.append((frame, {u: s.step(frame, {})[0] for u, s in upstream.items()}))
         world.step()
-    slot = task.vision(ctx)
+    ms = slot_ms(task.vision(ctx), shots, progress=progress)
     shot = _cycle(shots, progress)
-    ms = median_ms(lambda: slot.step(*shot()), frames, mean=True)
     peer, peer_ms = None, None
     if task.bench_peer is not None:
         peer, run = task.bench_peer([f for f, _ in shots])

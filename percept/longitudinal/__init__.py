@@ -16,11 +16,11 @@ from .ground import GroundConfig, GroundPlane
 from .metrics import (BAD_PIXEL_PX, RANGE_BINS_M, bin_key, disparity_metrics, disparity_summary, range_abs_rel_err,
                       range_abs_rel_err_by_bin, ttc_abs_err_s)
 from .obstacles import Obstacle, ObstacleConfig, ObstacleFinder
-from .refine import Refined, refine_disparity, surface_mask
+from .refine import PatchAligner, Refined, refine_disparity, surface_mask
 from .slot import LeadConfig, LeadDebug, LongitudinalSlot
 
 __all__ = ["BAD_PIXEL_PX", "Contact", "ContactConfig", "ContactRange", "DenseConfig", "Expansion", "ExpansionTracker",
            "FlowConfig", "GroundConfig", "GroundPlane", "LeadConfig", "LeadDebug", "LongitudinalSlot", "RANGE_BINS_M",
-           "Obstacle", "ObstacleConfig", "ObstacleFinder", "Refined", "bin_key", "dense_disparity",
+           "Obstacle", "ObstacleConfig", "ObstacleFinder", "PatchAligner", "Refined", "bin_key", "dense_disparity",
            "disparity_metrics", "disparity_summary", "range_abs_rel_err", "range_abs_rel_err_by_bin",
            "refine_disparity", "row_misalignment_px", "sgbm_disparity", "surface_mask", "ttc_abs_err_s"]

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .quantiles import median
+
 
 @dataclass(frozen=True)
 class FlowConfig:
@@ -105,8 +107,8 @@ def _expansion(g0: np.ndarray, g1: np.ndarray, box: tuple[int, int, int, int], d
     if far.sum() < cfg.min_pairs:
         return None
     ratio = np.linalg.norm(b[i] - b[j], axis=1)[far] / d0[far]
-    s = float(np.median(ratio))
+    s = float(median(ratio))
     # robust spread (MAD) over about as many independent pairs as features
-    mad = 1.4826 * float(np.median(np.abs(ratio - s)))
+    mad = 1.4826 * float(median(np.abs(ratio - s)))
     sigma = max(mad, 1e-4) * np.sqrt(np.pi / 2) / np.sqrt(len(a))
     return Expansion(s, sigma, dt, int(len(a)))

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .quantiles import median
+
 
 @dataclass(frozen=True)
 class GroundConfig:
@@ -86,7 +88,7 @@ class GroundPlane:
         if len(bins) < 4:
             return
         zs = z[near]
-        med = np.array([np.median(zs[k == b]) for b in bins])
+        med = np.array([median(zs[k == b]) for b in bins])
         xc = cfg.min_range_m + (bins + 0.5) * cfg.bin_m
         # least squares z = a + b x through the bins' medians
         (b, a) = np.polyfit(xc, med, 1)

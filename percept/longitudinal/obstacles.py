@@ -19,6 +19,7 @@ from percept.sensors import EgoPath, Side, StereoRig
 
 from .dense import check_num_disparities
 from .ground import GroundConfig, GroundPlane
+from .quantiles import median, percentile, percentiles
 
 
 @dataclass(frozen=True)
@@ -186,15 +187,15 @@ class ObstacleFinder:
             if area[near].sum() < need:
                 continue
             blob = near[self._largest_blob(u[near], v[near], area[near])]
-            if area[blob].sum() >= need and np.percentile(pv[blob, 2], 5) < cfg.grounded_m:
+            if area[blob].sum() >= need and percentile(pv[blob, 2], 5) < cfg.grounded_m:
                 break
         else:
             return None
         us, vs = u[blob], v[blob]
-        u0, u1 = np.percentile(us, [2, 98])
-        v0, v1 = np.percentile(vs, [2, 98])
+        u0, u1 = percentiles(us, (2, 98))
+        v0, v1 = percentiles(vs, (2, 98))
         box = (int(max(u0 - 1, 0)), int(max(v0 - 1, 0)), int(min(u1 + 2, cam.width)), int(min(v1 + 2, cam.height)))
-        return Obstacle(float(np.median(z[blob])), box, float(area[blob].sum()))
+        return Obstacle(float(median(z[blob])), box, float(area[blob].sum()))
 
     def _largest_blob(self, u: np.ndarray, v: np.ndarray, area: np.ndarray) -> np.ndarray:
         """Indices of the pixels of the largest connected blob (by area) among pixels (u, v) [px]: one object is

@@ -59,39 +59,58 @@ def surface_mask(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, 
             & (c1 < max_cost_ratio * mean))
 
 
+class PatchAligner:
+    """A left-image patch prepared for alignment with the right image: the right image and its row gradient as
+    the two channels of one image (one remap samples both), and the patch's pixel grid. ``refine`` may be called
+    several times (other masks, other starts) on the same preparation. ``left``, ``right``: float32 grey images of
+    one size; ``box``: (u0, v0, u1, v1)."""
+
+    def __init__(self, left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int]):
+        u0, v0, u1, v1 = box
+        self.box, self.width = box, right.shape[1]
+        self.L = left[v0:v1, u0:u1]
+        gx = cv2.Sobel(right, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
+        self.right_gx = cv2.merge([right, gx])
+        self.vv, self.uu = np.mgrid[v0:v1, u0:u1].astype(np.float32)
+
+    def refine(self, mask: np.ndarray | None, d0: float, iterations: int = 10, huber: float = 6.0,
+               tol: float = 1e-3) -> Refined | None:
+        """Disparity [px] of the patch's pixels in ``mask`` ((v1-v0, u1-u0) bool, None = all) from ``d0``; None when
+        the patch has no texture or leaves the image."""
+        u0, v0, u1, v1 = self.box
+        if u1 - u0 < 3 or v1 - v0 < 3 or not np.isfinite(d0):
+            return None
+        L, w = self.L, self.width
+        keep = np.ones(L.shape, bool) if mask is None else mask[:L.shape[0], :L.shape[1]]
+        d, converged, step = float(d0), False, np.inf
+        for _ in range(iterations):
+            # the sampled columns u - d (float32, as remap reads them) must leave room for the cubic kernel
+            if float(np.float32(u0) - np.float32(d)) < 1 or float(np.float32(u1 - 1) - np.float32(d)) > w - 2:
+                return None
+            both = cv2.remap(self.right_gx, self.uu - d, self.vv, cv2.INTER_CUBIC)
+            Rw, g = both[..., 0], both[..., 1]
+            r = L - Rw
+            # Huber weights: w = 1 inside the threshold, k / |r| outside
+            a = np.abs(r)
+            wts = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-6)) * keep
+            H = float(np.sum(wts * g * g))
+            if H < 1e-3:
+                return None
+            # Gauss-Newton: delta = -sum(w g r) / sum(w g^2)
+            step = -float(np.sum(wts * g * r)) / H
+            d += min(max(step, -1.0), 1.0)
+            if abs(step) < tol:
+                converged = True
+                break
+        n = int(keep.sum())
+        # standard error of the estimate: sigma^2 = sum(w r^2) / (n - 1) / sum(w g^2)
+        s2 = float(np.sum(wts * r * r)) / max(n - 1, 1) / H
+        return Refined(d, float(np.sqrt(s2)), n, converged)
+
+
 def refine_disparity(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int], mask: np.ndarray | None,
                      d0: float, iterations: int = 10, huber: float = 6.0, tol: float = 1e-3) -> Refined | None:
     """Disparity [px] of the pixels of ``box`` (u0, v0, u1, v1) in ``mask`` ((v1-v0, u1-u0) bool, None = all),
-    starting from ``d0``; float32 grey images of one size. None when the patch has no texture or leaves the image."""
-    u0, v0, u1, v1 = box
-    h, w = right.shape
-    if u1 - u0 < 3 or v1 - v0 < 3 or not np.isfinite(d0):
-        return None
-    L = left[v0:v1, u0:u1]
-    gx_full = cv2.Sobel(right, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
-    vv, uu = np.mgrid[v0:v1, u0:u1].astype(np.float32)
-    keep = np.ones(L.shape, bool) if mask is None else mask[:L.shape[0], :L.shape[1]]
-    d, converged, step = float(d0), False, np.inf
-    for _ in range(iterations):
-        mx = uu - d
-        if mx.min() < 1 or mx.max() > w - 2:
-            return None
-        Rw = cv2.remap(right, mx, vv, cv2.INTER_CUBIC)
-        g = cv2.remap(gx_full, mx, vv, cv2.INTER_CUBIC)
-        r = L - Rw
-        # Huber weights: w = 1 inside the threshold, k / |r| outside
-        a = np.abs(r)
-        wts = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-6)) * keep
-        H = float(np.sum(wts * g * g))
-        if H < 1e-3:
-            return None
-        # Gauss-Newton: delta = -sum(w g r) / sum(w g^2)
-        step = -float(np.sum(wts * g * r)) / H
-        d += float(np.clip(step, -1.0, 1.0))
-        if abs(step) < tol:
-            converged = True
-            break
-    n = int(keep.sum())
-    # standard error of the estimate: sigma^2 = sum(w r^2) / (n - 1) / sum(w g^2)
-    s2 = float(np.sum(wts * r * r)) / max(n - 1, 1) / H
-    return Refined(d, float(np.sqrt(s2)), n, converged)
+    starting from ``d0``; float32 grey images of one size. None when the patch has no texture or leaves the image.
+    One alignment; ``PatchAligner`` shares the preparation between several."""
+    return PatchAligner(left, right, box).refine(mask, d0, iterations, huber, tol)

@@ -24,7 +24,7 @@ from percept.sensors import EgoPath, Frame, Lead, ObjectKind, StereoRig, iou
 from .contact import Contact, ContactConfig, ContactRange
 from .flow import Expansion, ExpansionTracker, FlowConfig
 from .obstacles import Obstacle, ObstacleConfig, ObstacleFinder
-from .refine import Refined, refine_disparity, surface_mask
+from .refine import PatchAligner, Refined, surface_mask
 
 
 _RANGE = np.array([[1.0, 0.0, 0.0]])
@@ -156,7 +156,8 @@ class LongitudinalSlot:
         m[:, cols[-1] + 1:] = False
         if m.sum() < 12:
             return None
-        full = refine_disparity(L, R, box, m, d0, huber=self.cfg.huber)
+        aligner = PatchAligner(L, R, box)
+        full = aligner.refine(m, d0, huber=self.cfg.huber)
         if full is None:
             return None
         # then without their outline: a 5x5 block straddling it matches at the obstacle's disparity with half of it
@@ -170,7 +171,7 @@ class LongitudinalSlot:
         inner[:, cols[-1] + 1 - k:] = False
         if inner.sum() < 12:
             return full
-        ref = refine_disparity(L, R, box, inner, full.disparity_px, huber=self.cfg.huber)
+        ref = aligner.refine(inner, full.disparity_px, huber=self.cfg.huber)
         if ref is None or abs(ref.disparity_px - full.disparity_px) > MAX_OUTLINE_SHIFT_PX:
             return full
         return ref

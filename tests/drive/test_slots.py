@@ -103,3 +103,26 @@ def test_privileged_metrics_are_pinned(scenario, seed, group, key, value):
     r = run_drive(DriveConfig(WorldConfig(scenario, seed)), render=False)
     assert r[group][key] == value
     assert r["collisions"] == 0 and r["lane_departures"] == 0
+
+
+def test_the_bench_times_a_slot_from_reset_as_the_median_of_its_passes():
+    from percept.drive.bench import SLOT_PASSES, slot_ms
+
+    class Slot:
+        def __init__(self):
+            self.resets, self.steps, self.since_reset = 0, 0, []
+
+        def reset(self):
+            self.resets += 1
+            self.since_reset.append(0)
+
+        def step(self, frame, upstream):
+            self.steps += 1
+            self.since_reset[-1] += 1
+
+    slot, ticks = Slot(), []
+    ms = slot_ms(slot, [(None, {})] * 4, progress=lambda: ticks.append(1))
+    assert ms > 0
+    # a warm-up pass, then the timed ones, each from a reset over every shot
+    assert slot.resets == SLOT_PASSES + 1 and slot.since_reset == [4] * (SLOT_PASSES + 1)
+    assert len(ticks) == slot.steps == 4 * (SLOT_PASSES + 1)

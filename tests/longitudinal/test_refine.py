@@ -72,3 +72,19 @@ def test_the_finder_reports_a_wall_standing_in_the_path_at_its_range():
     assert ob.box_px[3] == pytest.approx(foot - cam.fy * ObstacleConfig().min_height_m / z_wall, abs=3)
     with pytest.raises(ValueError, match="num_disparities must be a multiple of 16"):
         ObstacleConfig(num_disparities=(40, 32))
+
+
+def test_one_preparation_serves_several_alignments_as_separate_calls_would():
+    from percept.longitudinal.refine import PatchAligner
+
+    left = textured(100, 200, seed=3)
+    right = shifted(left, 9.6)
+    box = (50, 20, 150, 80)
+    inner = np.zeros((60, 100), bool)
+    inner[:, 10:90] = True
+    aligner = PatchAligner(left, right, box)
+    first = aligner.refine(None, 9.0)
+    second = aligner.refine(inner, first.disparity_px)
+    assert first == refine_disparity(left, right, box, None, 9.0)
+    assert second == refine_disparity(left, right, box, inner, first.disparity_px)
+    assert second.disparity_px == pytest.approx(9.6, abs=0.02) and second.pixels == 60 * 80

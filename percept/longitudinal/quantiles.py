@@ -1,0 +1,46 @@
+"""Percentiles and medians of the small arrays of one frame, equal bit for bit to numpy's, at a fraction of the
+cost: ``np.percentile`` and ``np.median`` spend ~20 µs each on generic machinery (axes, NaN checks, dtype rules)
+that a 1-D array of a few hundred finite values does not need; a frame calls them a dozen times.
+
+numpy's default ("linear", Hyndman & Fan's method 7): the value at virtual index i = (n - 1) q of the sorted
+array, interpolated between its neighbours (numpy.lib._function_base_impl._quantile and _lerp). A scalar q gives
+the array's dtype (numpy treats it as a weak Python float); a list of q gives float64.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _linear(a: np.ndarray, q: float, weak: bool):
+    n = a.size
+    # virtual index i = (n - 1) q, q in [0, 1]
+    v = (n - 1) * np.true_divide(q, 100)
+    if v >= n - 1:
+        top = np.partition(a, -1)[-1]
+        return top if weak else np.float64(top)
+    lo = int(v)
+    p = np.partition(a, (lo, lo + 1))
+    x0, x1 = p[lo], p[lo + 1]
+    t = float(v - lo) if weak else np.float64(v - lo)
+    d = x1 - x0
+    # numpy's _lerp: x0 + d t below t = 0.5, x1 - d (1 - t) from it (exact at both ends)
+    return x1 - d * (1 - t) if t >= 0.5 else x0 + d * t
+
+
+def percentile(a: np.ndarray, q: float):
+    """``np.percentile(a, q)`` for a non-empty 1-D float array without NaN and a scalar q in [0, 100]."""
+    return _linear(a, q, weak=True)
+
+
+def percentiles(a: np.ndarray, qs: tuple[float, ...]) -> list[np.float64]:
+    """``list(np.percentile(a, qs))`` for a non-empty 1-D float array without NaN and a sequence of q."""
+    return [_linear(a, q, weak=False) for q in qs]
+
+
+def median(a: np.ndarray):
+    """``np.median(a)`` for a non-empty 1-D float array without NaN: the middle value, or the mean of the two."""
+    n, h = a.size, a.size // 2
+    if n % 2:
+        return np.mean(np.partition(a, h)[h:h + 1])
+    return np.mean(np.partition(a, (h - 1, h))[h - 1:h + 1])
