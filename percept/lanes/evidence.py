@@ -43,7 +43,8 @@ class EvidenceConfig:
     where one pixel spans at most this much ground across [m] (further away its weight falls as the span squared);
     min_contrast: absolute top-hat threshold [grey levels]; rel_contrast: threshold relative to the frame's strong
     responses; brightness: the paint measure; max_row_px: image rows below this are not road (a car's hood),
-    None = all rows."""
+    None = all rows; row_step_px: None = grid rows every dx_m; else every row_step_px image rows where that is
+    closer (near the camera, where a dx_m step skips many image rows), never further apart than dx_m."""
 
     x_near_m: float = 6.0
     x_far_m: float = 50.0
@@ -56,6 +57,7 @@ class EvidenceConfig:
     rel_contrast: float = 0.3
     brightness: Brightness = Brightness.MAX_RG
     max_row_px: float | None = None
+    row_step_px: float | None = None
 
     def __post_init__(self) -> None:
         if not 0 < self.x_near_m < self.x_far_m:
@@ -64,6 +66,23 @@ class EvidenceConfig:
             raise ValueError("grid steps dx_m, dy_m must be positive")
         if not self.full_weight_span_m > 0:
             raise ValueError(f"full_weight_span_m must be positive, got {self.full_weight_span_m}")
+        if self.row_step_px is not None and not self.row_step_px > 0:
+            raise ValueError(f"row_step_px must be positive, got {self.row_step_px}")
+
+
+def grid_ranges(rig: StereoRig, cfg: EvidenceConfig, side: Side = Side.LEFT) -> np.ndarray:
+    """Ground ranges [m] of the bird's-eye grid rows, near to far: every dx_m, or (row_step_px set) equally spaced
+    in s with ds/dx = max(|dv/dx| / row_step_px, 1 / dx_m), v(x) the image row of the ground at range x."""
+    if cfg.row_step_px is None:
+        rows = int(round((cfg.x_far_m - cfg.x_near_m) / cfg.dx_m)) + 1
+        return cfg.x_near_m + cfg.dx_m * np.arange(rows)
+    fine = np.linspace(cfg.x_near_m, cfg.x_far_m, 4096)
+    vh = rig.ground_homography(side) @ np.stack([fine, np.zeros_like(fine), np.ones_like(fine)])
+    dvdx = np.abs(np.gradient(vh[1] / vh[2], fine))
+    rate = np.maximum(dvdx / cfg.row_step_px, 1.0 / cfg.dx_m)
+    # s(x) = integral of ds/dx (trapezoids); rows at whole steps of s
+    s = np.concatenate([[0.0], np.cumsum((rate[1:] + rate[:-1]) / 2 * np.diff(fine))])
+    return np.interp(np.arange(int(np.floor(s[-1])) + 1), s, fine)
 
 
 class MarkingExtractor:
@@ -71,15 +90,13 @@ class MarkingExtractor:
 
     def __init__(self, rig: StereoRig, cfg: EvidenceConfig = EvidenceConfig(), side: Side = Side.LEFT):
         self.rig, self.cfg = rig, cfg
-        self.rows = int(round((cfg.x_far_m - cfg.x_near_m) / cfg.dx_m)) + 1
+        self.x = grid_ranges(rig, cfg, side)
+        self.rows = len(self.x)
         self.cols = int(round(2 * cfg.half_width_m / cfg.dy_m)) + 1
-        self.x = cfg.x_near_m + cfg.dx_m * np.arange(self.rows)
         self.y = cfg.half_width_m - cfg.dy_m * np.arange(self.cols)
-        # grid pixel (c, r) -> ground (x, y): x = x_near + r dx, y = half_width - c dy
-        A = np.array([[0.0, cfg.dx_m, cfg.x_near_m], [-cfg.dy_m, 0.0, cfg.half_width_m], [0.0, 0.0, 1.0]])
-        self.M = rig.ground_homography(side) @ A  # grid -> image
-        uv = self.M @ np.stack([np.tile(np.arange(self.cols), self.rows), np.repeat(np.arange(self.rows), self.cols),
-                                np.ones(self.rows * self.cols)])
+        # grid pixel (c, r) -> ground (x_r, y_c), y_c = half_width - c dy -> image through the ground homography
+        uv = rig.ground_homography(side) @ np.stack([np.repeat(self.x, self.cols), np.tile(self.y, self.rows),
+                                                     np.ones(self.rows * self.cols)])
         self.uv = (uv[:2] / uv[2]).T.reshape(self.rows, self.cols, 2)
         cam = rig.camera
         bottom = cam.height - 1 if cfg.max_row_px is None else min(cfg.max_row_px, cam.height - 1)

@@ -54,12 +54,21 @@ def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list
                 score = min(hist[i], hist[j]) + 0.1 * (hist[i] + hist[j]) - 2.0 * abs(w - cfg.width_prior_m)
                 pairs.append((score, centres[i], centres[j]))
     pairs.sort(reverse=True)
+    # the clusters' own peaks: a seed takes no point nearer another peak than its own (a seam or an old line beside
+    # a marking is a rival to be fitted on its own, not averaged with it)
+    peaks = centres[(hist >= 2) & (hist >= np.roll(hist, 1)) & (hist >= np.roll(hist, -1))]
+
+    def gate(y: float) -> float:
+        others = np.abs(peaks - y)
+        others = others[others > 0.2]
+        return min(cfg.gate_m, 0.5 * float(others.min())) if others.size else cfg.gate_m
+
     out = []
     for _, yl, yr in pairs[:candidates]:
         # straight-line seeds over the near range only; the fit then grows along each boundary
         sides = np.zeros(len(pts), dtype=int)
-        sides[near & (np.abs(pts[:, 1] - yl) < cfg.gate_m)] = 1
-        sides[near & (np.abs(pts[:, 1] - yr) < cfg.gate_m)] = -1
+        sides[near & (np.abs(pts[:, 1] - yl) < gate(yl))] = 1
+        sides[near & (np.abs(pts[:, 1] - yr) < gate(yr))] = -1
         out.append(sides)
     return out
 
@@ -101,7 +110,11 @@ class _Points(NamedTuple):
 
 
 class _Grown(NamedTuple):
+    """support: inlier count favouring both sides seen; strength: the same over the inliers' evidence weights (a
+    bright marking outweighs a faint seam or strip of pale concrete beside it)."""
+
     support: int
+    strength: float
     params: np.ndarray
     sides: np.ndarray
     residual: np.ndarray
@@ -155,10 +168,32 @@ def _grow(pts: _Points, sides: np.ndarray, cfg: FitConfig) -> _Grown | None:
     if not 2.4 <= params[3] <= 5.2:
         return None
     inl = np.abs(r) < 3 * cfg.huber_m
-    nl = int(((sides[m] == 1) & inl).sum())
-    nr = int(((sides[m] == -1) & inl).sum())
+    left, right = (sides[m] == 1) & inl, (sides[m] == -1) & inl
+    nl, nr = int(left.sum()), int(right.sum())
+    wl, wr = float(pts.base[m][left].sum()), float(pts.base[m][right].sum())
     # support favours both sides seen
-    return _Grown(nl + nr + 2 * min(nl, nr), params, sides, r, m, cov, inl, nl, nr)
+    return _Grown(nl + nr + 2 * min(nl, nr), wl + wr + 2 * min(wl, wr), params, sides, r, m, cov, inl, nl, nr)
+
+
+RIVAL_SHIFT_M = 0.5
+"""A fitted lane is a rival of the best when either of its boundaries lies this far from the best's [m] (at
+RIVAL_RANGE_M ahead): another pair of markings, not the same pair fitted again."""
+RIVAL_RANGE_M = 10.0
+
+
+def _boundaries_at(params: np.ndarray, x: float) -> np.ndarray:
+    """(left, right) y [m] of a fit at x [m]: y = a0 + a1 x + a2 x^2 + a3 x^3 +- w / 2."""
+    a0, a1, a2, w, a3 = params
+    centre = a0 + a1 * x + a2 * x * x + a3 * x ** 3
+    return np.array([centre + w / 2, centre - w / 2])
+
+
+def _ambiguity(best: _Grown, grown: list[_Grown]) -> float:
+    """The best rival's share of the evidence, s_rival / (s_best + s_rival) (``strength``; 0 without a rival)."""
+    ref = _boundaries_at(best.params, RIVAL_RANGE_M)
+    rivals = [g.strength for g in grown
+              if np.abs(_boundaries_at(g.params, RIVAL_RANGE_M) - ref).max() > RIVAL_SHIFT_M]
+    return max(rivals) / (best.strength + max(rivals)) if rivals else 0.0
 
 
 def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = FitConfig()) -> LaneFit | None:
@@ -175,16 +210,16 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
     else:
         seeds = _initial_sides(ev.points_m, cfg)
     pts = _Points.of(ev)
-    best = None
-    for sides in seeds:
-        g = _grow(pts, sides, cfg)
-        if g is not None and (best is None or g.support > best.support):
-            best = g
-    if best is None:
+    grown = [g for g in (_grow(pts, sides, cfg) for sides in seeds) if g is not None]
+    if not grown:
         return None
+    best = max(grown, key=lambda g: g.strength)  # the first of equals
     a0, a1, a2, w, a3 = best.params
     nl, nr = best.n_left, best.n_right
-    support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6)
+    ambiguity = _ambiguity(best, grown)
+    # confidence: how much evidence, both sides seen, and the best lane's share of the support against its best
+    # rival (two equally supported lanes about the car: a coin toss, 0.5 at most)
+    support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6) * (1.0 - ambiguity)
     est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support),
                        curvature_rate_1pm2=float(6 * a3))
     r, inl = best.residual, best.inliers
@@ -192,4 +227,4 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
     # (a0, a1, a2, w, a3) -> (offset, heading, curvature, curvature_rate, width): rows of the Jacobian
     J = np.zeros((5, 5))
     J[0, 0], J[1, 1], J[2, 2], J[3, 4], J[4, 3] = -1.0, -1.0 / (1 + a1 * a1), 2.0, 6.0, 1.0
-    return LaneFit(est, np.where(best.used, best.sides, 0), res, nl, nr, J @ best.cov @ J.T)
+    return LaneFit(est, np.where(best.used, best.sides, 0), res, nl, nr, J @ best.cov @ J.T, ambiguity)

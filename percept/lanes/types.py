@@ -24,9 +24,11 @@ class MarkingEvidence:
 
 @dataclass(frozen=True)
 class LaneFit:
-    """One frame's robust fit. estimate: the fitted lane (confidence from support); side: (N,) +1 left,
+    """One frame's robust fit. estimate: the fitted lane (confidence from support and ambiguity); side: (N,) +1 left,
     -1 right, 0 outlier, per evidence point; residual_m: RMS residual of the inliers [m]; cov: (5, 5)
-    covariance of (offset, heading, curvature, curvature_rate, width) from the least-squares normal equations."""
+    covariance of (offset, heading, curvature, curvature_rate, width) from the least-squares normal equations;
+    ambiguity: the support of the best rival lane (other boundaries, also about the car) as a share of both, 0..0.5
+    (0: no rival)."""
 
     estimate: LaneEstimate
     side: np.ndarray
@@ -34,3 +36,4 @@ class LaneFit:
     inliers_left: int
     inliers_right: int
     cov: np.ndarray
+    ambiguity: float = 0.0

@@ -168,3 +168,22 @@ def test_tracking_on_the_simulated_highway():
         w.step(step.accel_mps2, step.steering_rad + 0.01 * np.sin(i / 8))
     rmse = np.sqrt(np.mean(np.square(err), axis=0))
     assert rmse[0] < 0.05 and rmse[1] < 0.005
+
+
+def _lines(ys: dict[float, int]) -> MarkingEvidence:
+    """Straight markings along the road at lateral positions y [m], each with this many points over 6-40 m."""
+    pts = np.concatenate([np.column_stack([np.linspace(6.0, 40.0, n), np.full(n, y)]) for y, n in ys.items()])
+    return MarkingEvidence(pts, np.full(len(pts), 40.0), np.zeros((len(pts), 2)))
+
+
+def test_two_equally_supported_lanes_about_the_car_halve_the_confidence():
+    # a seam 0.6 m inside the right marking, as strong as it: two lanes (3.7 m and 3.1 m wide) about the car
+    fit = fit_lane(_lines({1.85: 60, -1.85: 60, -1.25: 60}), None)
+    assert fit.ambiguity == pytest.approx(0.5) and fit.estimate.confidence == pytest.approx(0.5)
+    # the same seam, faint: the lane is clear
+    fit = fit_lane(_lines({1.85: 60, -1.85: 60, -1.25: 8}), None)
+    assert fit.ambiguity < 0.3 and fit.estimate.confidence > 0.7
+    assert fit.estimate.width_m == pytest.approx(3.7, abs=0.05)
+    # the neighbouring lanes' markings do not compete: they are not about the car
+    fit = fit_lane(_lines({1.85: 60, -1.85: 60, 5.55: 60, -5.55: 60}), None)
+    assert fit.ambiguity == 0.0 and fit.estimate.confidence == 1.0

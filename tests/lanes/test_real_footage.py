@@ -82,7 +82,7 @@ def test_every_test_image_gets_both_boundaries_on_the_markings(folder, tmp_path)
     assert [Path(x["file"]).name for x in d["results"]] == [p.name for p in files]
     assert d["summary"]["both_boundaries"] == len(files)
     for res in d["results"]:
-        assert res["both_boundaries"] and res["confidence"] > 0.5
+        assert res["both_boundaries"] and res["confidence"] > 0.5 and 0.0 <= res["ambiguity"] <= 0.5
         for k in ("offset_m", "heading_rad", "curvature_1pm"):
             assert isinstance(res[k], float)
         image = read_image(res["file"])
