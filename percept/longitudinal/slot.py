@@ -214,31 +214,51 @@ class LongitudinalSlot:
         sd = max(ref.sigma_px if ref is not None else 1.0, self.cfg.sigma_d_px)
         # stereo range noise: sigma_Z = Z^2 sigma_d / (f b)
         sigma = z * z * sd / self.fb
-        previous, self.box = self.box, ob.box_px
-        if self.kf is None or (self.hits < self.cfg.confirm and iou(previous, ob.box_px) < self.cfg.same_object_iou):
-            # a track is confirmed only by an obstacle that stays where it was in the image (rain streaks and
-            # matches made by chance jump about)
-            self._new_track(z, sigma)
-            return ("stereo",)
-        used: tuple[str, ...] = ()
-        if self._gated_update(z, sigma, _RANGE):
-            used = ("stereo",)
-            self.outliers = 0
+        if ref is None:
+            # a group whose disparity does not refine (no surface with a clear match: chance matches on the dark,
+            # noisy background at the road's far end at night) neither starts, confirms nor replaces a track, nor
+            # passes for a lead manoeuvring: its coarse range only updates a confirmed track it agrees with, its
+            # noise taken at the track's range (at its own, a match 60 m off a track at 12 m would pass the gate)
+            if self.kf is None or self.hits < self.cfg.confirm:
+                return ()
+            near = float(self.kf.x[0, 0])
+            if not self._gated_update(z, near * near * sd / self.fb, _RANGE):
+                return ()
+            self.box, used = ob.box_px, ("stereo",)
         else:
-            self.outliers += 1
-            if self.outliers >= 2 and iou(previous, ob.box_px) < self.cfg.same_object_iou:
-                self._new_track(z, sigma)  # the lead changed (a cut-in, the lead leaving): follow the new one
+            previous, self.box = self.box, ob.box_px
+            if self.kf is None or (self.hits < self.cfg.confirm
+                                   and iou(previous, ob.box_px) < self.cfg.same_object_iou):
+                # a track is confirmed only by an obstacle that stays where it was in the image (rain streaks
+                # and matches made by chance jump about)
+                self._new_track(z, sigma)
                 return ("stereo",)
-            if self.outliers >= 2:
-                # the same object, manoeuvring (braking hard): open the filter up and take the measurement
-                self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
-                self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
-                used, self.outliers = ("stereo",), 0
+            used = self._refined_update(z, sigma, iou(previous, ob.box_px))
+            if used == ("new",):
+                return ("stereo",)
         if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, _RANGE):
             used += ("contact",)
         if used:
             self.hits, self.misses = self.hits + 1, 0
         return used
+
+    def _refined_update(self, z: float, sigma: float, overlap: float) -> tuple[str, ...]:
+        """A refined stereo range of a track's obstacle (``overlap``: its box's IoU with the last one): gated; two
+        outliers in a row are a new lead when the box moved (("new",)), else the lead manoeuvring."""
+        if self._gated_update(z, sigma, _RANGE):
+            self.outliers = 0
+            return ("stereo",)
+        self.outliers += 1
+        if self.outliers >= 2 and overlap < self.cfg.same_object_iou:
+            self._new_track(z, sigma)  # the lead changed (a cut-in, the lead leaving): follow the new one
+            return ("new",)
+        if self.outliers >= 2:
+            # the same object, manoeuvring (braking hard): open the filter up and take the measurement
+            self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
+            self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
+            self.outliers = 0
+            return ("stereo",)
+        return ()
 
     def _update_rate(self, e: Expansion) -> bool:
         """The range rate from the image's expansion at the current range: dZ/dt = -Z (s - 1) / dt."""

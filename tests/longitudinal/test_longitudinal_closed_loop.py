@@ -58,3 +58,24 @@ def test_stereo_contact_and_flow_all_reach_the_filter():
     assert lead is not None and abs(lead.range_m - true) / true < 0.01
     # ground contact alone, at about 45 m: a few per cent (a row is 2.6 m there)
     assert np.median(errors) < 0.04
+
+
+def test_a_range_that_does_not_refine_neither_starts_a_track_nor_drags_one_away():
+    from percept.longitudinal import Obstacle, Refined
+
+    slot = LongitudinalSlot(StereoRig(), 1 / 15)
+    ob = Obstacle(61.0, (309, 239, 316, 250), 28.0)
+    # chance matches on the dark background at the road's far end: a coarse range without a refined disparity
+    for _ in range(5):
+        assert slot._update(61.0, None, ob, None) == () and slot.kf is None
+    refined = Refined(slot.fb / 12.0, 0.02, 200, True)
+    car = Obstacle(12.0, (290, 220, 350, 290), 2000.0)
+    for _ in range(slot.cfg.confirm):
+        slot._predict()
+        assert slot._update(12.0, refined, car, None) == ("stereo",)
+    # confirmed at 12 m: the far match's noise is taken at the track's range, so it is no measurement of it ...
+    slot._predict()
+    assert slot._update(61.0, None, ob, None) == () and slot.kf.x[0, 0] == pytest.approx(12.0, abs=0.2)
+    # ... while a coarse range near the track still updates it (a lead whose face did not refine this frame)
+    slot._predict()
+    assert slot._update(12.3, None, car, None) == ("stereo",)
