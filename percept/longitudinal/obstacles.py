@@ -25,15 +25,14 @@ from .quantiles import median, percentile, percentiles
 @dataclass(frozen=True)
 class ObstacleConfig:
     """near_m: range splitting the two bands [m]: beyond it (the far band, rows above the road at near_m) only the
-    columns the path can reach are matched at ``far_scale``; nearer (the rows below) the whole width at
-    ``near_scale``, where obstacles are large; num_disparities / block_size: StereoBM's per band (far, near);
-    min_range_m, max_range_m: ranges searched [m]; half_width_m: corridor half-width about the path centre [m];
-    min_height_m, max_height_m: a pixel between these heights above the road stands up [m]; min_area_m2: smallest
-    frontal area that counts as an obstacle [m²]; bin_rel: relative width of a range bin; grounded_m: a group's
-    lowest pixels must be below this height (obstacles stand on the road; a patch of sky or glare matched by
-    chance floats) [m]; texture_threshold: StereoBM's (flat regions are not matched); blob_cell_px: cells of the image grid in which a
-    range group must form one connected blob [px]; ground: the online road-plane
-    fit (heights are measured from it)."""
+    columns the path can reach are matched at ``far_scale``; nearer (the rows below) the whole width at ``near_scale``,
+    where obstacles are large; num_disparities / block_size: StereoBM's per band (far, near); min_range_m, max_range_m:
+    ranges searched [m]; half_width_m: corridor half-width about the path centre [m]; min_height_m, max_height_m: a
+    pixel between these heights above the road stands up [m]; min_area_m2: smallest frontal area that counts as an
+    obstacle [m²]; bin_rel: relative width of a range bin; grounded_m: a group's lowest pixels must be below this height
+    (obstacles stand on the road; a patch of sky or glare matched by chance floats) [m]; texture_threshold: StereoBM's
+    (flat regions are not matched); blob_cell_px: cells of the image grid in which a range group must form one connected
+    blob [px]; ground: the online road-plane fit (heights are measured from it)."""
 
     near_m: float = 15.0
     far_scale: float = 0.5

@@ -40,16 +40,16 @@ MAX_OUTLINE_SHIFT_PX = 0.4
 
 @dataclass(frozen=True)
 class LeadConfig:
-    """face_m: heights above the road of the band whose disparity is refined (a vehicle's body faces the ego
-    there) [m]; sigma_d_px: floor on the disparity noise [px] (the refinement's own standard error is often far
-    smaller; the floor covers what it does not model: slanted faces, pixels at the outline); column_fill: a column
-    of the band belongs to the obstacle when this fraction of it matches the obstacle's disparity; huber: the
-    refinement's Huber threshold [grey levels]; jerk_sigma_mps3: white jerk noise of the range (the filter is
-    constant-acceleration, so that a lead braking hard is followed without lag) [m/s³]; gate_sigma: innovations
-    beyond this many sigma are outliers; two in a row are a new lead when its box overlaps the last one by less than
-    same_object_iou (IoU), else the same one manoeuvring: the filter's rate and acceleration variances grow by
-    manoeuvre_rate_mps² and manoeuvre_accel_mps2² and it takes the measurement; confirm: hits before a track is reported; hold_s: how long a track is
-    predicted without measurements [s]; obstacles, contact, flow: the cues' own settings."""
+    """face_m: heights above the road of the band whose disparity is refined (a vehicle's body faces the ego there)
+    [m]; sigma_d_px: floor on the disparity noise [px] (the refinement's own standard error is often far smaller; the
+    floor covers what it does not model: slanted faces, pixels at the outline); column_fill: a column of the band
+    belongs to the obstacle when this fraction of it matches the obstacle's disparity; huber: the refinement's Huber
+    threshold [grey levels]; jerk_sigma_mps3: white jerk noise of the range (the filter is constant-acceleration, so
+    that a lead braking hard is followed without lag) [m/s³]; gate_sigma: innovations beyond this many sigma are
+    outliers; two in a row are a new lead when its box overlaps the last one by less than same_object_iou (IoU), else
+    the same one manoeuvring: the filter's rate and acceleration variances grow by manoeuvre_rate_mps² and
+    manoeuvre_accel_mps2² and it takes the measurement; confirm: hits before a track is reported; hold_s: how long a
+    track is predicted without measurements [s]; obstacles, contact, flow: the cues' own settings."""
 
     face_m: tuple[float, float] = (0.4, 0.9)
     sigma_d_px: float = 0.05

@@ -171,7 +171,8 @@ def test_cli_bad_input(tmp_path):
     _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "notes.txt")]), "neither an image")
     _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg"), "--calib", str(tmp_path / "notes.txt")]),
                     "not a percept calibration file")
-    _one_error_line(runner.invoke(app, ["lanes", str(empty), "--mount-height", "0"]), "--mount-height must be a finite number")
+    _one_error_line(runner.invoke(app, ["lanes", str(empty), "--mount-height", "0"]),
+                    "--mount-height must be a finite number")
     _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.mp4"), "--max-frames", "0"]), "--max-frames")
 
 
