@@ -38,7 +38,7 @@ class FitConfig:
 
 def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list[np.ndarray]:
     """Without a prediction: side assignments seeded by the strongest pairs of near-range lateral clusters that
-    straddle the car about a lane apart (each is fitted; the best-supported fit wins)."""
+    straddle the car about a lane apart (each is fitted; the fit with the strongest evidence wins)."""
     near = pts[:, 0] < 16.0
     if near.sum() < 4:
         return []
@@ -110,10 +110,9 @@ class _Points(NamedTuple):
 
 
 class _Grown(NamedTuple):
-    """support: inlier count favouring both sides seen; strength: the same over the inliers' evidence weights (a
-    bright marking outweighs a faint seam or strip of pale concrete beside it)."""
+    """strength: the inliers' evidence weights, favouring both sides seen (a bright marking outweighs a faint seam
+    or strip of pale concrete beside it)."""
 
-    support: int
     strength: float
     params: np.ndarray
     sides: np.ndarray
@@ -159,7 +158,7 @@ samples: (25, 40) and (20, 30, 40) straighten 1.jpg as well but leave its right 
 
 def _grow(pts: _Points, sides: np.ndarray, cfg: FitConfig, reach: tuple[float, ...] = ()) -> _Grown | None:
     """Fit, re-gate the points around the fitted boundaries (those nearer than each range of ``reach`` first,
-    then all of them) and refit, twice at most over all of them, until the assignment settles."""
+    then all of them: twice at most without a reach, until the assignment settles, once after one) and refit."""
     if (sides != 0).sum() < cfg.min_points:
         return None
     params, r, m, cov = _solve(pts, sides, cfg)
@@ -178,8 +177,8 @@ def _grow(pts: _Points, sides: np.ndarray, cfg: FitConfig, reach: tuple[float, .
     left, right = (sides[m] == 1) & inl, (sides[m] == -1) & inl
     nl, nr = int(left.sum()), int(right.sum())
     wl, wr = float(pts.base[m][left].sum()), float(pts.base[m][right].sum())
-    # support favours both sides seen
-    return _Grown(nl + nr + 2 * min(nl, nr), wl + wr + 2 * min(wl, wr), params, sides, r, m, cov, inl, nl, nr)
+    # strength favours both sides seen
+    return _Grown(wl + wr + 2 * min(wl, wr), params, sides, r, m, cov, inl, nl, nr)
 
 
 RIVAL_SHIFT_M = 0.5
@@ -225,7 +224,7 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
     a0, a1, a2, w, a3 = best.params
     nl, nr = best.n_left, best.n_right
     ambiguity = _ambiguity(best, grown)
-    # confidence: how much evidence, both sides seen, and the best lane's share of the support against its best
+    # confidence: how much evidence, both sides seen, and the best lane's share of the evidence against its best
     # rival (two equally supported lanes about the car: a coin toss, 0.5 at most)
     support = min(1.0, (nl + nr) / 80.0) * (1.0 if nl >= 5 and nr >= 5 else 0.6) * (1.0 - ambiguity)
     est = LaneEstimate(-float(a0), float(np.arctan(-a1)), float(2 * a2), float(w), float(support),
