@@ -134,3 +134,20 @@ def test_tree_shadows_on_real_asphalt_give_no_boundary_evidence():
     assert inside.sum() < 0.05 * len(uv) and (side[inside] == 0).all()
     for pts in r.boundaries_px.values():
         assert on_marking_fraction(image, pts) > 0.3
+
+
+def test_a_barrier_and_the_cars_beside_the_lane_give_no_boundary_evidence():
+    if not UDACITY.is_dir():
+        pytest.skip(f"{UDACITY} is absent (real data in ../shared/data)")
+    image = cv2.imread(str(UDACITY / "test5.jpg"))  # a concrete barrier with a rail on the left, two cars ahead right
+    r = FootageLanes(RealLaneConfig(mount_height_m=1.2)).still(image)
+    uv, side = r.debug.evidence.uv_px, r.debug.fit.side
+    left_u = r.u_at_rows(uv[:, 1])["left"]
+    barrier = np.isfinite(left_u) & (uv[:, 0] < left_u - 60)
+    cars = [(uv[:, 0] > u0) & (uv[:, 0] < u1) & (uv[:, 1] > v0) & (uv[:, 1] < v1)
+            for u0, u1, v0, v1 in ((808, 933, 408, 492), (1083, 1280, 400, 508))]
+    # their edges pass the stripe test (evidence is there) but neither boundary takes any of it
+    for region in [barrier] + cars:
+        assert region.sum() >= 10 and (side[region] == 0).all()
+    for pts in r.boundaries_px.values():
+        assert on_marking_fraction(image, pts) > 0.3
