@@ -211,54 +211,55 @@ class LongitudinalSlot:
 
     def _update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
         """The range measurements: stereo (which also starts and replaces tracks), then ground contact."""
-        sd = max(ref.sigma_px if ref is not None else 1.0, self.cfg.sigma_d_px)
-        # stereo range noise: sigma_Z = Z^2 sigma_d / (f b)
-        sigma = z * z * sd / self.fb
-        if ref is None:
+        if ref is None and (self.kf is None or self.hits < self.cfg.confirm):
             # a group whose disparity does not refine (no surface with a clear match: chance matches on the dark,
-            # noisy background at the road's far end at night) neither starts, confirms nor replaces a track, nor
-            # passes for a lead manoeuvring: its coarse range only updates a confirmed track it agrees with, its
-            # noise taken at the track's range (at its own, a match 60 m off a track at 12 m would pass the gate)
-            if self.kf is None or self.hits < self.cfg.confirm:
-                return ()
-            near = float(self.kf.x[0, 0])
-            if not self._gated_update(z, near * near * sd / self.fb, _RANGE):
+            # noisy background at the road's far end at night) neither starts nor confirms a track
+            return ()
+        sd = max(ref.sigma_px if ref is not None else 1.0, self.cfg.sigma_d_px)
+        # stereo range noise: sigma_Z = Z^2 sigma_d / (f b), for an unrefined range at the track's range (at its
+        # own, a chance match 60 m off a track at 12 m would pass the gate)
+        at = z if ref is not None else float(self.kf.x[0, 0])
+        sigma = at * at * sd / self.fb
+        if ref is None:
+            # nor replaces one or passes for a lead manoeuvring: it only updates a confirmed track it agrees with
+            if not self._gated_update(z, sigma, _RANGE):
                 return ()
             self.box, used = ob.box_px, ("stereo",)
         else:
             previous, self.box = self.box, ob.box_px
-            if self.kf is None or (self.hits < self.cfg.confirm
-                                   and iou(previous, ob.box_px) < self.cfg.same_object_iou):
+            overlap = 0.0 if self.kf is None else iou(previous, ob.box_px)
+            if self.kf is None or (self.hits < self.cfg.confirm and overlap < self.cfg.same_object_iou):
                 # a track is confirmed only by an obstacle that stays where it was in the image (rain streaks
                 # and matches made by chance jump about)
                 self._new_track(z, sigma)
                 return ("stereo",)
-            used = self._refined_update(z, sigma, iou(previous, ob.box_px))
-            if used == ("new",):
-                return ("stereo",)
+            used, restarted = self._refined_update(z, sigma, overlap)
+            if restarted:
+                return used
         if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, _RANGE):
             used += ("contact",)
         if used:
             self.hits, self.misses = self.hits + 1, 0
         return used
 
-    def _refined_update(self, z: float, sigma: float, overlap: float) -> tuple[str, ...]:
-        """A refined stereo range of a track's obstacle (``overlap``: its box's IoU with the last one): gated; two
-        outliers in a row are a new lead when the box moved (("new",)), else the lead manoeuvring."""
+    def _refined_update(self, z: float, sigma: float, overlap: float) -> tuple[tuple[str, ...], bool]:
+        """A refined stereo range of a track's obstacle (``overlap``: its box's IoU with the last one), gated: two
+        outliers in a row are a new lead when the box moved, else the lead manoeuvring. (used cues, whether a new
+        track was started)."""
         if self._gated_update(z, sigma, _RANGE):
             self.outliers = 0
-            return ("stereo",)
+            return ("stereo",), False
         self.outliers += 1
-        if self.outliers >= 2 and overlap < self.cfg.same_object_iou:
+        if self.outliers < 2:
+            return (), False
+        if overlap < self.cfg.same_object_iou:
             self._new_track(z, sigma)  # the lead changed (a cut-in, the lead leaving): follow the new one
-            return ("new",)
-        if self.outliers >= 2:
-            # the same object, manoeuvring (braking hard): open the filter up and take the measurement
-            self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
-            self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
-            self.outliers = 0
-            return ("stereo",)
-        return ()
+            return ("stereo",), True
+        # the same object, manoeuvring (braking hard): open the filter up and take the measurement
+        self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
+        self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
+        self.outliers = 0
+        return ("stereo",), False
 
     def _update_rate(self, e: Expansion) -> bool:
         """The range rate from the image's expansion at the current range: dZ/dt = -Z (s - 1) / dt."""
