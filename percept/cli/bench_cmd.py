@@ -19,13 +19,16 @@ def bench(
 ):
     """Per-stage cost on one thread (stages named by the run JSON's timing_ms keys), against the named peers
     measured in the same run (ratio = ours / peer)."""
+    from threadpoolctl import threadpool_limits
+
     from percept.drive import TASKS
     from percept.drive.bench import bench_render, bench_task, bench_ticks
 
     opt.check_number("--frames", frames, 1, 10000)
     check_outputs([json_path])
     tasks = [t for t in TASKS if t.vision is not None]
-    with progress_bar() as bar:
+    # one thread: OpenCV's is set per stage, numpy's BLAS here
+    with progress_bar() as bar, threadpool_limits(1):
         peers = sum(t.bench_peer is not None for t in tasks)
         task = bar.add_task("benchmarking", total=bench_ticks(frames, len(tasks), peers))
         tick = lambda: bar.advance(task)  # noqa: E731

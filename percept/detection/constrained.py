@@ -29,7 +29,7 @@ import numpy as np
 from percept.sensors import EgoPath, StereoRig
 
 from .hog import CELL_PX, WINDOW_PX, LinearModel, block_grid
-from .pyramid import Detection, group
+from .pyramid import Detection, group, lone_windows
 
 PERSON_PX = 96
 """Height of the person inside a 64x128 window [px]."""
@@ -55,6 +55,7 @@ class SearchConfig:
     cell_px: int = 4
     threshold: float = 0.0
     group_threshold: int = 1
+    lone_threshold: float | None = 0.25
 
 
 @dataclass(frozen=True)
@@ -188,6 +189,10 @@ class ConstrainedSearch:
     def search(self, image: np.ndarray, path: EgoPath, levels: Iterable[int] | None = None,
                rois: Sequence[Box] = ()) -> tuple[list[Detection], SearchStats]:
         """Detections (windows, best first) at ``levels`` (default: every scale) over the corridor, and at the
-        neighbouring scales of each region of interest."""
+        neighbouring scales of each region of interest; then the lone windows scoring ``lone_threshold``."""
         boxes, scores, stats = self.windows(image, path, levels, rois)
-        return group(np.round(boxes).astype(np.int32), scores, self.cfg.group_threshold), stats
+        boxes = np.round(boxes).astype(np.int32)
+        dets = group(boxes, scores, self.cfg.group_threshold)
+        if self.cfg.lone_threshold is not None and self.cfg.group_threshold >= 1:
+            dets += [d for d in lone_windows(boxes, scores) if d.score >= self.cfg.lone_threshold]
+        return dets, stats

@@ -9,16 +9,18 @@ shares them too, within a scale). A linear model w on a window at block (x, y) s
 
     s(x, y) = b + sum_{i < 7, j < 15} w_ij . B(x + i, y + j)
 
-which is computed as one product of every block with all 105 weight vectors, then 105 shifted sums.
+which is computed as one product of every block with all 105 weight vectors, then sums along shifted views.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import cv2
 import numpy as np
+from numpy.lib.stride_tricks import as_strided
 
 WINDOW_PX = (64, 128)
 """Detection window (width, height) [px]."""
@@ -128,13 +130,18 @@ class LinearModel:
         """Score of the window at every block position of ``blocks`` (nbx, nby, 36): (nbx - 6, nby - 14)."""
         nbx, nby, _ = blocks.shape
         nx, ny = nbx - BLOCKS[0] + 1, nby - BLOCKS[1] + 1
-        w = self.weights.reshape(BLOCKS[0], BLOCKS[1], BLOCK_LEN)
-        s = np.full((nx, ny), self.bias, np.float32)
-        for j in range(BLOCKS[1]):
-            # the blocks that weight row j meets (rows j .. j + ny - 1) against its 7 weight vectors at once:
-            # P[bx, y, i] = w_ij . B(bx, y + j)
-            p = (blocks[:, j:j + ny].reshape(-1, BLOCK_LEN) @ w[:, j].T).reshape(nbx, ny, BLOCKS[0])
-            for i in range(BLOCKS[0]):
-                # s(x, y) += w_ij . B(x + i, y + j)
-                s += p[i:i + nx, :, i]
+        # every block against all 105 weight vectors in one product: P[bx, by, i, j] = w_ij . B(bx, by)
+        p = (blocks.reshape(-1, BLOCK_LEN) @ self._weights_t).reshape(nbx, nby, BLOCKS[0], BLOCKS[1])
+        sx, sy, si, sj = p.strides
+        # Q[bx, y, i] = sum_j P[bx, y + j, i, j]: a view whose last axis steps one block down and one j along
+        q = as_strided(p, (nbx, ny, BLOCKS[0], BLOCKS[1]), (sx, sy, si, sy + sj), writeable=False).sum(axis=3)
+        # s(x, y) = b + sum_i Q[x + i, y, i]
+        s = q[:nx, :, 0] + np.float32(self.bias)
+        for i in range(1, BLOCKS[0]):
+            s += q[i:i + nx, :, i]
         return s
+
+    @cached_property
+    def _weights_t(self) -> np.ndarray:
+        """The weights as a (36, 105) matrix, column i * 15 + j the vector w_ij of block (i, j) of a window."""
+        return np.ascontiguousarray(self.weights.reshape(BLOCKS[0] * BLOCKS[1], BLOCK_LEN).T)

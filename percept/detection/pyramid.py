@@ -20,10 +20,12 @@ from .hog import CELL_PX, WINDOW_PX, LinearModel, block_grid
 
 @dataclass(frozen=True)
 class Detection:
-    """box_px: (u0, v0, u1, v1) in the image [px]; score: the linear model's margin (0 is the decision boundary)."""
+    """box_px: (u0, v0, u1, v1) in the image [px]; score: the linear model's margin (0 is the decision boundary);
+    windows: how many windows were grouped into it (1: a lone window)."""
 
     box_px: tuple[float, float, float, float]
     score: float
+    windows: int = 1
 
     def to_dict(self) -> dict:
         return {"box_px": [round(float(c), 1) for c in self.box_px], "score": round(float(self.score), 4)}
@@ -59,16 +61,31 @@ def group(boxes: np.ndarray, scores: np.ndarray, group_threshold: int = 2, eps: 
     the best of the windows overlapping it by IoU >= 0.5."""
     if not len(boxes):
         return []
-    grouped, _ = cv2.groupRectangles(boxes.tolist(), group_threshold, eps)
+    grouped, weights = cv2.groupRectangles(boxes.tolist(), group_threshold, eps)
     out = []
-    for gx, gy, gw, gh in np.asarray(grouped).reshape(-1, 4):
+    for (gx, gy, gw, gh), n in zip(np.asarray(grouped).reshape(-1, 4), np.asarray(weights).ravel()):
         # IoU of the group's box with each window
         ix = np.clip(np.minimum(gx + gw, boxes[:, 0] + boxes[:, 2]) - np.maximum(gx, boxes[:, 0]), 0, None)
         iy = np.clip(np.minimum(gy + gh, boxes[:, 1] + boxes[:, 3]) - np.maximum(gy, boxes[:, 1]), 0, None)
         inter = ix * iy
         iou = inter / (gw * gh + boxes[:, 2] * boxes[:, 3] - inter)
         best = float(scores[iou >= 0.5].max()) if (iou >= 0.5).any() else float(scores.max())
-        out.append(Detection((float(gx), float(gy), float(gx + gw), float(gy + gh)), best))
+        out.append(Detection((float(gx), float(gy), float(gx + gw), float(gy + gh)), best, int(n)))
+    return sorted(out, key=lambda d: -d.score)
+
+
+def lone_windows(boxes: np.ndarray, scores: np.ndarray, eps: float = 0.2) -> list[Detection]:
+    """The windows (x, y, w, h) that ``group`` can never keep: those like no other window, by OpenCV's
+    ``SimilarRects`` (corners within delta = eps (min(w1, w2) + min(h1, h2)) / 2 of each other's), best first."""
+    if not len(boxes):
+        return []
+    b = boxes.astype(np.float64)
+    delta = eps * (np.minimum(b[:, None, 2], b[None, :, 2]) + np.minimum(b[:, None, 3], b[None, :, 3])) / 2
+    x1, y1 = b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]
+    similar = ((np.abs(b[:, None, 0] - b[None, :, 0]) <= delta) & (np.abs(b[:, None, 1] - b[None, :, 1]) <= delta)
+               & (np.abs(x1[:, None] - x1[None, :]) <= delta) & (np.abs(y1[:, None] - y1[None, :]) <= delta))
+    lone = np.flatnonzero(similar.sum(axis=1) == 1)
+    out = [Detection((float(b[i, 0]), float(b[i, 1]), float(x1[i]), float(y1[i])), float(scores[i])) for i in lone]
     return sorted(out, key=lambda d: -d.score)
 
 

@@ -16,8 +16,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
-
 from percept.sensors import BrakingRequest, EgoPath, Frame, ObjectKind, StereoRig
 from percept.sensors.conflict import person_conflict
 
@@ -100,7 +98,9 @@ class PedestrianSlot:
             levels = tuple(k for k in range(n) if k % self.sweep_frames == frame.index % self.sweep_frames)
             dets, stats = self.search.search(frame.left, path, levels, rois=[window_of(b) for b in predicted])
             boxes = [person_box(d.box_px) for d in dets]
-            tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame) if boxes else None)
+            # a lone window is a person only where the stereo pair agrees with its ground contact
+            tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame) if boxes else None,
+                                         verify=[d.windows < 2 for d in dets])
         request, rid = self._request(tracks, path, speed)
         return request, PedestrianDebug(tuple(dets), tuple(tracks), levels, stats, rid)
 
@@ -109,9 +109,7 @@ class PedestrianSlot:
         it fails), for the tracker's measurements; None without a right image."""
         if frame.right is None:
             return None
-        left = cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY)
-        right = cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY)
-        return lambda box, z_ground_m: box_depth(left, right, box, self.tracker.rig, z_ground_m)
+        return lambda box, z_ground_m: box_depth(frame.left, frame.right, box, self.tracker.rig, z_ground_m)
 
     def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M

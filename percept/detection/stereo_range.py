@@ -4,8 +4,9 @@ right image (rectified rig), around the disparity their ground contact predicts.
 Z = f b / d, so a disparity error sigma_d gives sigma_Z = Z^2 sigma_d / (f b): at 35 m (d = 8.5 px on the default
 rig) 0.4 px, about what a small person patch matches to, is 4.7 % of the range, about what a detection window's
 feet row gives (a pixel there is 4.5 %); the two are independent, so they are fused. The patch is the middle of
-the box's width and its upper part (head and torso), so that the background beside the legs does not vote; the cost is the sum of squared differences (``cv2.matchTemplate``), refined to a fraction of a pixel by a
-parabola through the best cost and its neighbours.
+the box's width and its upper part (head and torso), so that the background beside the legs does not vote; the
+cost is the sum of squared differences (``cv2.matchTemplate``), refined to a fraction of a pixel by a parabola
+through the best cost and its neighbours.
 """
 
 from __future__ import annotations
@@ -21,12 +22,17 @@ MIN_TEXTURE = 4.0
 """Smallest grey-level standard deviation of a patch worth matching."""
 
 
-def box_depth(left_grey: np.ndarray, right_grey: np.ndarray, box: tuple[float, float, float, float],
+def _grey(image: np.ndarray) -> np.ndarray:
+    return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+
+
+def box_depth(left: np.ndarray, right: np.ndarray, box: tuple[float, float, float, float],
               rig: StereoRig, z_guess_m: float) -> tuple[float, float] | None:
-    """Camera depth Z [m] and its standard deviation of the person in ``box`` (u0, v0, u1, v1) of the left image,
-    searched between 0.6 and 1.6 times the disparity of ``z_guess_m``; None when the patch is too small or
-    featureless, or the match is not distinct."""
-    h, w = left_grey.shape
+    """Camera depth Z [m] and its standard deviation of the person in ``box`` (u0, v0, u1, v1) of the left image
+    (the pair grey or BGR; only the patch and the strip it is searched along are made grey), searched between 0.6
+    and 1.6 times the disparity of ``z_guess_m``; None when the patch is too small or featureless, or the match is
+    not distinct."""
+    h, w = left.shape[:2]
     u0, v0, u1, v1 = box
     bw, bh = u1 - u0, v1 - v0
     # head and torso, the middle half of the width
@@ -34,7 +40,7 @@ def box_depth(left_grey: np.ndarray, right_grey: np.ndarray, box: tuple[float, f
     pv0, pv1 = int(round(v0 + 0.05 * bh)), int(round(v0 + 0.6 * bh))
     if pu1 - pu0 < 3 or pv1 - pv0 < 6 or pu0 < 0 or pv0 < 0 or pu1 > w or pv1 > h:
         return None
-    patch = left_grey[pv0:pv1, pu0:pu1]
+    patch = _grey(left[pv0:pv1, pu0:pu1])
     if float(patch.std()) < MIN_TEXTURE:
         return None
     fb = rig.camera.fx * rig.baseline_m
@@ -44,7 +50,7 @@ def box_depth(left_grey: np.ndarray, right_grey: np.ndarray, box: tuple[float, f
     s0, s1 = pu0 - d_hi, pu1 - d_lo
     if s0 < 0 or s1 > w:
         return None
-    cost = cv2.matchTemplate(right_grey[pv0:pv1, s0:s1], patch, cv2.TM_SQDIFF).ravel()
+    cost = cv2.matchTemplate(_grey(right[pv0:pv1, s0:s1]), patch, cv2.TM_SQDIFF).ravel()
     k = int(np.argmin(cost))
     if k == 0 or k == len(cost) - 1 or cost[k] > 0.5 * float(np.median(cost)):
         return None

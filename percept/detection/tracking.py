@@ -35,7 +35,9 @@ class TrackConfig:
     accel_mps2: the people's white-noise acceleration [m/s²]; row_sigma_frac: feet-row noise as a fraction of the
     person's height; col_sigma_frac: column noise as a fraction of the height; iou_gate: smallest overlap of a
     detection with a track's predicted box that pairs them; gate_chi2: squared Mahalanobis gate on the ground (2
-    degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s)."""
+    degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s);
+    verify_chi2: a detection that must be verified (a lone window) is kept only when its stereo depth and its
+    ground contact's agree within this squared number of standard deviations (one degree of freedom)."""
 
     confirm_hits: int = 3
     max_misses: int = 8
@@ -46,6 +48,7 @@ class TrackConfig:
     iou_gate: float = 0.3
     gate_chi2: float = 9.21
     sigma_v0_mps: float = 1.0
+    verify_chi2: float = 9.0
 
 
 @dataclass(frozen=True)
@@ -108,10 +111,13 @@ class PersonTracker:
     def reset(self) -> None:
         self.tracks, self._next_id = [], 1
 
-    def measure(self, box: Box, stereo: StereoDepth | None = None) -> tuple[np.ndarray, np.ndarray, float] | None:
+    def measure(self, box: Box, stereo: StereoDepth | None = None,
+                verify: bool = False) -> tuple[np.ndarray, np.ndarray, float] | None:
         """A person box -> feet (x, y) [m], its 2x2 covariance and the person's height [m]; None above the horizon
         or nearer than the camera. ``stereo(box, z_ground_m)``, when given, returns the box's stereo depth and its
-        standard deviation [m] (or None), fused with the ground contact's by their inverse variances."""
+        standard deviation [m] (or None), fused with the ground contact's by their inverse variances. ``verify``:
+        None also unless the stereo depth agrees with the ground contact's (``TrackConfig.verify_chi2``): a person
+        stands where their feet touch the road, a pattern on the road or the scenery behind it does not."""
         cam, h_cam = self.rig.camera, self.rig.mount_height_m
         u0, v0, u1, v1 = box
         h_px = v1 - v0
@@ -123,7 +129,11 @@ class PersonTracker:
             return None
         # sigma_Z = Z^2 sigma_v / (fy h)
         var_z = max(z * z * self.cfg.row_sigma_frac * h_px / (cam.fy * h_cam), 0.1) ** 2
-        if stereo is not None and (zs := stereo(box, z)) is not None:
+        zs = stereo(box, z) if stereo is not None else None
+        # (z_s - z_g)^2 <= chi2 (s_g^2 + s_s^2)
+        if verify and (zs is None or (zs[0] - z) ** 2 > self.cfg.verify_chi2 * (var_z + zs[1] ** 2)):
+            return None
+        if zs is not None:
             z_s, s_s = zs
             # inverse-variance fusion: z = (z_g / s_g^2 + z_s / s_s^2) / (1 / s_g^2 + 1 / s_s^2)
             w_g, w_s = 1.0 / var_z, 1.0 / (s_s * s_s)
@@ -159,11 +169,13 @@ class PersonTracker:
             t.predicted = b
         return [boxes[i] for i in keep]
 
-    def update(self, boxes: list[Box], scores: list[float], seen: bool = True,
-               stereo: StereoDepth | None = None) -> list[PersonTrack]:
-        """Associate this frame's person boxes (measured with ``stereo`` when given, see ``measure``) with the
-        predicted tracks; ``seen`` False (a dropped frame): no detections and no misses counted."""
-        meas = [(m, b, s) for b, s in zip(boxes, scores) if (m := self.measure(b, stereo)) is not None]
+    def update(self, boxes: list[Box], scores: list[float], seen: bool = True, stereo: StereoDepth | None = None,
+               verify: list[bool] | None = None) -> list[PersonTrack]:
+        """Associate this frame's person boxes (measured with ``stereo`` when given, see ``measure``; those flagged
+        in ``verify`` kept only when the stereo depth agrees) with the predicted tracks; ``seen`` False (a dropped
+        frame): no detections and no misses counted."""
+        flags = verify if verify is not None else [False] * len(boxes)
+        meas = [(m, b, s) for b, s, f in zip(boxes, scores, flags) if (m := self.measure(b, stereo, f)) is not None]
         pairs = self._associate(meas)
         used = set()
         for ti, mi in pairs:
