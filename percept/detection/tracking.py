@@ -78,7 +78,8 @@ class _Track:
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([xy[0], xy[1], 0.0, 0.0])
         kf.H = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
-        kf.P = np.diag([r[0, 0], r[1, 1], cfg.sigma_v0_mps ** 2, cfg.sigma_v0_mps ** 2])
+        kf.P = np.diag([0.0, 0.0, cfg.sigma_v0_mps ** 2, cfg.sigma_v0_mps ** 2])
+        kf.P[:2, :2] = r
         self.kf, self.id, self.height_m, self.box, self.score = kf, tid, height_m, box, score
         self.hits, self.misses, self.cfg = 1, 0, cfg
         self.predicted = box  # the person box predicted for the current frame
@@ -133,6 +134,7 @@ class PersonTracker:
         # (z_s - z_g)^2 <= chi2 (s_g^2 + s_s^2)
         if verify and (zs is None or (zs[0] - z) ** 2 > self.cfg.verify_chi2 * (var_z + zs[1] ** 2)):
             return None
+        cy = float(self.rig.camera_position()[1])
         if zs is not None:
             z_s, s_s = zs
             # inverse-variance fusion: z = (z_g / s_g^2 + z_s / s_s^2) / (1 / s_g^2 + 1 / s_s^2)
@@ -140,13 +142,17 @@ class PersonTracker:
             z_new = (z * w_g + z_s * w_s) / (w_g + w_s)
             var_z = 1.0 / (w_g + w_s)
             # the same ray from the camera, at the fused depth
-            cy = float(self.rig.camera_position()[1])
             xy = np.array([self.cam_x + z_new, cy + (xy[1] - cy) * z_new / z])
             z = z_new
-        # sigma_Y = Z sigma_u / fx
+        # sigma_Y = Z sigma_u / fx: the bearing's own noise, across the ray
         s_y = max(z * self.cfg.col_sigma_frac * h_px / cam.fx, 0.05)
+        # the depth's noise moves the feet along their ray, y - cy = t Z with t = (y - cy) / Z, so x and y err
+        # together: R = var_Z [[1, t], [t, t^2]] + diag(0, s_y^2); an off-axis person's range settling is then not
+        # taken for a sideways walk
+        t = (xy[1] - cy) / z
+        r = var_z * np.array([[1.0, t], [t, t * t]]) + np.diag([0.0, s_y * s_y])
         # H = h_px Z / fy
-        return xy, np.diag([var_z, s_y * s_y]), float(h_px * z / cam.fy)
+        return xy, r, float(h_px * z / cam.fy)
 
     def predicted_box(self, t: _Track) -> Box:
         """The person box the track predicts in the left image: its feet projected, its height above them."""
