@@ -9,7 +9,6 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from percept.sensors.records import Source
 
 from . import options as opt
 from .common import check_outputs, console, fail, fmt, on_interrupt, progress_bar, write_error, write_json
@@ -20,11 +19,12 @@ def drive(
     seed: opt.Seed = 0,
     condition: opt.Condition = "clear",
     duration: opt.Duration = None,
-    lateral: opt.Lateral = Source.PRIVILEGED,
-    longitudinal: opt.Longitudinal = Source.PRIVILEGED,
-    pedestrians: opt.Pedestrians = Source.PRIVILEGED,
+    lateral: opt.Lateral = None,
+    longitudinal: opt.Longitudinal = None,
+    pedestrians: opt.Pedestrians = None,
     detector: opt.Detector = "sim",
-    odometry: opt.Odometry = Source.PRIVILEGED,
+    odometry: opt.Odometry = None,
+    privileged: opt.Privileged = False,
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
                                          "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,
@@ -47,7 +47,7 @@ def drive(
     opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
-                          opt.slot_sources(lateral, longitudinal, pedestrians, odometry), detector=detector)
+                          opt.slot_sources(lateral, longitudinal, pedestrians, odometry, privileged), detector=detector)
     except ValueError as e:
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")

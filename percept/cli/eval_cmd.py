@@ -10,7 +10,6 @@ from rich import box
 from rich.markup import escape
 from rich.table import Table
 
-from percept.sensors.records import Source
 
 from . import options as opt
 from .common import check_outputs, console, err, fail, fmt, on_interrupt, progress_bar, write_json
@@ -29,11 +28,12 @@ def eval_(
     address: Annotated[Optional[str], typer.Option("--address", help="Ray cluster address (default: start a "
                                                                      "local Ray).")] = None,
     duration: opt.Duration = None,
-    lateral: opt.Lateral = Source.PRIVILEGED,
-    longitudinal: opt.Longitudinal = Source.PRIVILEGED,
-    pedestrians: opt.Pedestrians = Source.PRIVILEGED,
+    lateral: opt.Lateral = None,
+    longitudinal: opt.Longitudinal = None,
+    pedestrians: opt.Pedestrians = None,
     detector: opt.Detector = "sim",
-    odometry: opt.Odometry = Source.PRIVILEGED,
+    odometry: opt.Odometry = None,
+    privileged: opt.Privileged = False,
     json_path: opt.JsonOut = None,
     redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
                                                       "settings (other slots, duration or percept version).")] = False,
@@ -55,7 +55,7 @@ def eval_(
     from percept.drive import TASKS
 
     plan, eng, files = _plan(scenario, condition, seeds, workers, engine, duration, detector, out, redo,
-                             opt.slot_sources(lateral, longitudinal, pedestrians, odometry))
+                             opt.slot_sources(lateral, longitudinal, pedestrians, odometry, privileged))
     check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
     for path, why in files.damaged:
         err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)

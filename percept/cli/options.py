@@ -14,7 +14,8 @@ from percept.sensors.records import Source
 
 MAX_SEED = 2**31 - 1
 """Largest --seed; the same as ``percept.drive.batch.MAX_SEED`` (not imported from there: --help stays fast)."""
-_SLOT = "{task} slot: vision (its perception module) or privileged (ground truth, the baseline)."
+_SLOT = ("{task} slot: vision (its perception module; the default) or privileged (ground truth, the baseline; "
+         "--privileged sets every slot).")
 
 Scenario = Annotated[str, typer.Option("--scenario", help="Scenario name (see `percept scenarios`).")]
 Seed = Annotated[int, typer.Option("--seed", help="Random seed (0 to 2^31-1); the same seed and options give the "
@@ -22,13 +23,16 @@ Seed = Annotated[int, typer.Option("--seed", help="Random seed (0 to 2^31-1); th
 Condition = Annotated[str, typer.Option("--condition", help="clear | night | rain | glare | noise | dropout.")]
 Duration = Annotated[Optional[float], typer.Option("--duration", help="Simulated seconds (default: the "
                                                                       "scenario's own).")]
-Lateral = Annotated[Source, typer.Option("--lateral", help=_SLOT.format(task="Lateral (lanes, steering)"))]
-Longitudinal = Annotated[Source, typer.Option("--longitudinal", help=_SLOT.format(
+Lateral = Annotated[Optional[Source], typer.Option("--lateral", help=_SLOT.format(task="Lateral (lanes, steering)"))]
+Longitudinal = Annotated[Optional[Source], typer.Option("--longitudinal", help=_SLOT.format(
     task="Longitudinal (lead range, following, braking)"))]
-Pedestrians = Annotated[Source, typer.Option("--pedestrians", help=_SLOT.format(task="Pedestrian"))]
+Pedestrians = Annotated[Optional[Source], typer.Option("--pedestrians", help=_SLOT.format(task="Pedestrian"))]
 Detector = Annotated[str, typer.Option("--detector", help="People model of the vision pedestrian slot: sim "
                                        "(trained on rendered people), inria (OpenCV's) or a model file.")]
-Odometry = Annotated[Source, typer.Option("--odometry", help=_SLOT.format(task="Odometry"))]
+Odometry = Annotated[Optional[Source], typer.Option("--odometry", help=_SLOT.format(task="Odometry"))]
+Privileged = Annotated[bool, typer.Option("--privileged", metavar="", help="Every slot on ground truth: the "
+                                          "baselines the vision modules are measured against (a slot's own option "
+                                          "still wins).")]
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",
                                                  dir_okay=False)]
 
@@ -58,6 +62,10 @@ def _bound(x: float) -> str:
     return str(int(x)) if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
 
 
-def slot_sources(lateral: Source, longitudinal: Source, pedestrians: Source, odometry: Source) -> dict:
-    """The slot options as the ``sources`` of a DriveConfig."""
-    return {"lateral": lateral, "longitudinal": longitudinal, "pedestrians": pedestrians, "odometry": odometry}
+def slot_sources(lateral: Source | None, longitudinal: Source | None, pedestrians: Source | None,
+                 odometry: Source | None, privileged: bool = False) -> dict:
+    """The slot options as the ``sources`` of a DriveConfig: a slot not given is on vision, or on ground truth with
+    ``--privileged``."""
+    default = Source.PRIVILEGED if privileged else Source.VISION
+    given = {"lateral": lateral, "longitudinal": longitudinal, "pedestrians": pedestrians, "odometry": odometry}
+    return {task: default if src is None else src for task, src in given.items()}

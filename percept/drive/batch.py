@@ -23,6 +23,7 @@ from typing import Callable, Iterator
 
 import cv2
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from percept.outputs import write_json_atomic
 from percept.sims import WorldConfig
@@ -115,16 +116,18 @@ class EvalPlan:
 
 
 def _worker_init() -> None:
-    """A worker process: one OpenCV thread; Ctrl-C is the parent's to handle (it terminates the workers)."""
+    """A worker process: Ctrl-C is the parent's to handle (it terminates the workers)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def run_job(plan: EvalPlan, job: Job) -> dict:
-    """Run one job (in a worker); the run JSON, or {"scenario", "condition", "seed", "error", "traceback"}."""
+    """Run one job (in a worker, on one thread: OpenCV's and numpy's BLAS, so that workers do not contend for the
+    cores); the run JSON, or {"scenario", "condition", "seed", "error", "traceback"}."""
     cv2.setNumThreads(1)
     try:
         cfg = plan.config(job)
-        return run_drive(cfg, render=cfg.needs_cameras)
+        with threadpool_limits(1):
+            return run_drive(cfg, render=cfg.needs_cameras)
     except Exception as e:  # noqa: BLE001 - one failed run must not take the batch down; it is reported
         return {"scenario": job.scenario, "condition": job.condition, "seed": job.seed,
                 "error": f"{type(e).__name__}: {e}", "traceback": traceback.format_exc()}

@@ -71,7 +71,12 @@ def reproduce_command(run: dict, settings: dict) -> str:
     """The ``percept drive`` command that drives this run again with the batch's settings."""
     cmd = ["percept drive", f"--scenario {run['scenario']}", f"--seed {run['seed']}",
            f"--condition {run['condition']}"]
-    cmd += [f"--{task} {src}" for task, src in settings.get("slots", {}).items() if src != "privileged"]
+    # every slot is on vision unless told otherwise: --privileged when none is, else each privileged slot
+    slots = settings.get("slots", {})
+    if slots and all(src == "privileged" for src in slots.values()):
+        cmd.append("--privileged")
+    else:
+        cmd += [f"--{task} privileged" for task, src in slots.items() if src == "privileged"]
     if settings.get("duration_s") is not None:
         cmd.append(f"--duration {settings['duration_s']:g}")
     if settings.get("detector") not in (None, "sim"):

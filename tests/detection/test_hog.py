@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from percept.detection import DESCRIPTOR_LEN, LinearModel, block_grid, detect_multiscale, hog_descriptor
-from percept.detection.pyramid import pyramid_scales
+from percept.detection.pyramid import group, lone_windows, pyramid_scales
 from percept.sensors import iou
 
 VTEST = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "opencv-samples" / "pedestrians" / "vtest.avi"
@@ -77,3 +77,18 @@ def test_the_pyramid_finds_what_opencv_detect_multiscale_finds_on_real_video():
         ours_hit += sum(any(iou(o, t) >= 0.5 for t in theirs) for o in ours)
     assert theirs_n >= 8
     assert theirs_hit >= 0.9 * theirs_n and ours_hit >= 0.9 * ours_n
+
+
+def test_lone_windows_are_those_opencv_never_groups_with_another():
+    rng = np.random.default_rng(3)
+    xy = rng.integers(0, 120, (40, 2))
+    wh = rng.choice([32, 36, 40, 64], 40)[:, None] * np.array([1, 2])
+    boxes = np.column_stack([xy, wh]).astype(np.int32)
+    lone = {d.box_px for d in lone_windows(boxes, np.arange(40, dtype=np.float32))}
+    for i, b in enumerate(boxes.tolist()):
+        # a pair groups (a cluster of 2 passes threshold 1) exactly when OpenCV finds the two windows similar
+        paired = any(len(cv2.groupRectangles([b, o], 1, 0.2)[0]) for j, o in enumerate(boxes.tolist()) if j != i)
+        assert ((b[0], b[1], b[0] + b[2], b[1] + b[3]) in lone) == (not paired)
+    assert 0 < len(lone) < 40
+    grouped = group(boxes, np.ones(40, np.float32), 1)
+    assert all(d.windows >= 2 for d in grouped)

@@ -73,3 +73,20 @@ def test_a_box_above_the_horizon_is_not_a_person_on_the_road():
     v_h = rig.horizon_row
     assert tr.measure((300.0, v_h - 80, 330.0, v_h - 10)) is None
     assert tr.update([(300.0, v_h - 80, 330.0, v_h - 10)], [1.0]) == []
+
+
+def test_a_box_to_verify_is_kept_only_where_its_stereo_depth_agrees_with_its_ground_contact():
+    rig = StereoRig()
+    tr = PersonTracker(rig, DT)
+    box = person_box(rig, 35.0, 0.0)
+    z = 35.0 - tr.cam_x
+    agree = lambda b, z_ground: (z + 0.5, 1.5)  # noqa: E731
+    behind = lambda b, z_ground: (z + 25.0, 3.0)  # noqa: E731  (the scenery behind, not a person standing there)
+    assert tr.measure(box, agree, verify=True) is not None
+    assert tr.measure(box, behind, verify=True) is None
+    assert tr.measure(box, lambda b, zg: None, verify=True) is None  # no stereo match: nothing confirms it
+    assert tr.measure(box, None, verify=True) is None  # no right image
+    assert tr.measure(box, behind) is not None  # a box that needs no verification is measured as before
+    far_behind = lambda b, z_ground: (z_ground + 25.0, 3.0) if z_ground > 30.0 else (z_ground, 1.0)  # noqa: E731
+    tracks = tr.update([box, person_box(rig, 20.0, 3.0)], [0.3, 1.0], stereo=far_behind, verify=[True, True])
+    assert [round(t.position_m[1]) for t in tracks] == [3]

@@ -27,6 +27,9 @@ def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
         assert k in d
     assert d["scenario"] == "highway" and d["frames"] == 15
     assert d["timing_ms"]["render"] > 0
+    # every slot sees by default, and each one's stage is timed
+    assert d["slots"] == {t: "vision" for t in ("lateral", "longitudinal", "pedestrians", "odometry")}
+    assert all(d["timing_ms"][k] > 0 for k in ("lanes", "longitudinal", "pedestrians", "odometry"))
     assert rrd.exists() and not (tmp_path / "run.rrd.part").exists()
     v = subprocess.run([rerun_bin(), "rrd", "verify", str(rrd)], capture_output=True, text=True,
                        env={"RERUN_ANALYTICS": "0", "PATH": ""})
@@ -44,6 +47,15 @@ def test_vision_lateral_recording_shows_what_the_lanes_module_saw(tmp_path):
     for entity in ("world/ego/camera/left/lateral/boundaries", "world/ego/camera/left/lateral/evidence",
                    "world/ego/lateral/path", "lateral/offset_m/estimate", "lateral/curvature_1pm/truth"):
         assert entity in p.stdout, entity
+
+
+def test_privileged_puts_every_slot_on_ground_truth_and_a_slot_option_still_wins(tmp_path):
+    js = tmp_path / "p.json"
+    r = runner.invoke(app, ["drive", "--duration", "0.5", "--privileged", "--lateral", "vision", "--no-record",
+                            "--json", str(js)])
+    assert r.exit_code == 0, r.output
+    assert json.loads(js.read_text())["slots"] == {"lateral": "vision", "longitudinal": "privileged",
+                                                   "pedestrians": "privileged", "odometry": "privileged"}
 
 
 def test_drive_default_recording_path(tmp_path, monkeypatch):

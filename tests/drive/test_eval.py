@@ -37,7 +37,7 @@ def test_parse_seeds_counts_a_range_before_expanding_it():
 
 def test_eval_writes_runs_and_a_summary_and_resumes(tmp_path):
     args = ["eval", "--scenario", "lead-brake", "--scenario", "cut-in", "--seeds", "0-1", "--duration", "2",
-            "--out", str(tmp_path), "--json", str(tmp_path / "s.json")]
+            "--privileged", "--out", str(tmp_path), "--json", str(tmp_path / "s.json")]
     r = runner.invoke(app, args)
     assert r.exit_code == 0, r.output
     runs = sorted(p.name for p in (tmp_path / "runs").iterdir())
@@ -168,10 +168,10 @@ def test_resume_never_mixes_runs_made_with_other_settings(tmp_path):
     run = json.loads((tmp_path / "runs" / "lead-brake-clear-0.json").read_text())
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert run["settings"] == summary["settings"] and run["settings"]["duration_s"] == 2.0
-    assert run["settings"]["slots"]["lateral"] == "privileged" and run["settings"]["percept"]
+    assert run["settings"]["slots"]["lateral"] == "vision" and run["settings"]["percept"]
     before = _files(tmp_path)
     for args, diff in ((["--duration", "1"], "duration_s 2.0 (now 1.0)"),
-                       (["--duration", "2", "--lateral", "vision"], "slots lateral=privileged (now vision)")):
+                       (["--duration", "2", "--lateral", "privileged"], "slots lateral=vision (now privileged)")):
         r = runner.invoke(app, [*base, *args])
         assert r.exit_code == 2 and "Traceback" not in r.output
         assert "made with other settings" in r.output and diff in r.output and "--redo" in r.output

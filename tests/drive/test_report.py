@@ -54,7 +54,12 @@ def test_unsafe_runs_come_with_the_command_that_reproduces_them():
     bad = unsafe_runs(runs)
     assert [(r["seed"], what) for r, what in bad] == [(1, "2 collisions")]
     assert reproduce_command(bad[0][0], SETTINGS) == ("percept drive --scenario highway --seed 1 --condition clear "
-                                                      "--lateral vision --duration 12")
+                                                      "--longitudinal privileged --pedestrians privileged "
+                                                      "--odometry privileged --duration 12")
+    every = {**SETTINGS, "slots": {k: "privileged" for k in SETTINGS["slots"]}}
+    assert reproduce_command(bad[0][0], every).endswith("--condition clear --privileged --duration 12")
+    vision = {**SETTINGS, "slots": {k: "vision" for k in SETTINGS["slots"]}, "detector": "inria"}
+    assert reproduce_command(bad[0][0], vision).endswith("--condition clear --duration 12 --detector inria")
 
 
 def test_reports_are_written_and_readable(tmp_path):

@@ -52,6 +52,19 @@ KNEE = np.array([2.0, 10.0, 15.0, 10.0, 8.0, 22.0, 36.0, 51.0, 38.0, 13.0, 2.0])
 FOOT = np.array([-10.0, 0.0, 0.0, 0.0, 5.0, 14.0, 34.0, 25.0, 5.0, -8.0, -10.0])
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors, written out: ``np.cross``'s own products and differences (the same floats) without
+    its generic axis handling, which cost more than the product on a figure's hundreds of small vectors."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
+def _norm(v: np.ndarray) -> float:
+    """|v| of a vector: the square root of the same dot product ``np.linalg.norm`` takes."""
+    return math.sqrt(float(v @ v))
+
+
 class _Figure:
     """Collects one pedestrian's patches, then drops them all so that the lowest point is at z = 0."""
 
@@ -63,7 +76,7 @@ class _Figure:
     def _toward_view(self, p: np.ndarray, bias: float) -> np.ndarray:
         d = self.view - p
         d[2] = 0.0
-        return p + bias * d / (np.linalg.norm(d) + 1e-12)
+        return p + bias * d / (_norm(d) + 1e-12)
 
     def limb(self, p0, p1, r0: float, r1: float, color, bias: float = 0.0, caps: tuple = (True, True)) -> None:
         """A tapered view-facing quad from p0 (half-width r0) to p1 (half-width r1) with round caps.
@@ -74,8 +87,8 @@ class _Figure:
         p0 = self._toward_view(np.asarray(p0, float), bias)
         p1 = self._toward_view(np.asarray(p1, float), bias)
         axis = p1 - p0
-        side = np.cross(axis, self.view - (p0 + p1) / 2)
-        n = np.linalg.norm(side)
+        side = _cross(axis, self.view - (p0 + p1) / 2)
+        n = _norm(side)
         if n < 1e-9:
             return
         side /= n
@@ -108,10 +121,10 @@ class _Figure:
         """A view-facing ellipse centred at c: half-height ry, half-width rx."""
         c = self._toward_view(np.asarray(c, float), bias)
         d = self.view - c
-        d /= np.linalg.norm(d) + 1e-12
-        right = np.cross(UP, d)
-        right /= np.linalg.norm(right) + 1e-12
-        upv = np.cross(d, right)
+        d /= _norm(d) + 1e-12
+        right = _cross(UP, d)
+        right /= _norm(right) + 1e-12
+        upv = _cross(d, right)
         self.rows.append((c - rx * right - ry * upv, 2 * rx * right, 2 * ry * upv, tuple(color), 1, None))
 
     def box(self, center, axes, size, color) -> None:
@@ -170,7 +183,7 @@ class _Body:
         self.c = (obj.gait_phase / (2 * math.pi)) % 1.0
         vdir = view - self.base
         vdir[2] = 0.0
-        vdir /= np.linalg.norm(vdir) + 1e-12
+        vdir /= _norm(vdir) + 1e-12
         self.vdir = vdir
         self.cf = abs(float(vdir @ self.fwd))
         self.cs = math.sqrt(max(0.0, 1.0 - self.cf * self.cf))
