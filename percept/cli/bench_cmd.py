@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, List, Optional
 
 import typer
 from rich.table import Table
 
 from . import options as opt
-from .common import check_outputs, console, fmt, progress_bar, write_json
+from .common import check_outputs, console, fail, fmt, progress_bar, write_json
 
 
 def bench(
@@ -16,6 +16,17 @@ def bench(
     frames: Annotated[int, typer.Option("--frames", help="Timed calls per stage, 1 to 10,000 (slots: the median "
                                                          "of 3 passes' means over consecutive frames; render "
                                                          "and peers: the median).")] = 30,
+    stack: Annotated[bool, opt.flag("--stack", help="Also the whole stack: every vision slot in the closed loop on "
+                                                    "each scenario beside the stock composition of the peers, the "
+                                                    "render cost per condition, the realtime factor with and "
+                                                    "without recording.")] = False,
+    scenario: Annotated[Optional[List[str]], typer.Option("--scenario", help="With --stack: only these scenarios "
+                                                          "(repeat; default every one).")] = None,
+    seconds: Annotated[float, typer.Option("--seconds", help="With --stack: simulated seconds of each closed loop, "
+                                                             "1 to 600.")] = 10.0,
+    soak_minutes: Annotated[float, typer.Option("--soak-minutes", help="Also a recorded closed loop (highway, "
+                                                "every slot on vision) this many simulated minutes long, with the "
+                                                "process's memory each minute (0: none; 20 takes ~10 min).")] = 0.0,
 ):
     """Per-stage cost on one thread (stages named by the run JSON's timing_ms keys), against the named peers
     measured in the same run (ratio = ours / peer)."""
@@ -25,6 +36,9 @@ def bench(
     from percept.drive.bench import bench_render, bench_task, bench_ticks
 
     opt.check_number("--frames", frames, 1, 10000)
+    opt.check_number("--seconds", seconds, 1, 600)
+    opt.check_number("--soak-minutes", soak_minutes, 0, 600)
+    scenarios = _scenarios(scenario) if stack else []
     check_outputs([json_path])
     tasks = [t for t in TASKS if t.vision is not None]
     # one thread: OpenCV's is set per stage, numpy's BLAS here
@@ -34,11 +48,65 @@ def bench(
         tick = lambda: bar.advance(task)  # noqa: E731
         results = [bench_render(frames, progress=tick)] + [bench_task(t, TASKS, frames, progress=tick)
                                                            for t in tasks]
+    console.print(_stage_table(results))
+    out = {"stages": [r.to_dict() for r in results]}
+    if stack or soak_minutes:
+        out.update(_stack(scenarios, seconds, soak_minutes))
+    write_json(json_path, out)
+
+
+def _stage_table(results) -> Table:
     t = Table(title="percept bench (one thread, ms per call: slots the median of 3 passes' means over consecutive "
                     "frames, the rest the median)")
     for col in ("stage", "what", "ms", "target ms", "peer", "peer ms", "ratio"):
         t.add_column(col, justify="left" if col in ("stage", "what", "peer") else "right")
     for r in results:
         t.add_row(r.stage, r.what, f"{r.ms:.2f}", fmt(r.target_ms), r.peer or "-", fmt(r.peer_ms), fmt(r.ratio))
-    console.print(t)
-    write_json(json_path, {"stages": [r.to_dict() for r in results]})
+    return t
+
+
+def _scenarios(names: list[str] | None) -> list[str]:
+    from percept.sims import SCENARIOS
+
+    for n in names or []:
+        if n not in SCENARIOS:
+            fail(f"unknown scenario '{n}'; choose from {', '.join(SCENARIOS)}")
+    return list(names) if names else list(SCENARIOS)
+
+
+def _stack(scenarios: list[str], seconds: float, soak_minutes: float) -> dict:
+    """The whole stack per scenario, the render per condition and the soak, printed and as the JSON's groups."""
+    from percept.drive.bench_stack import CONDITIONS, bench_stack, render_per_condition, soak
+    from percept.sims.env import SIMULATION_HZ
+
+    loop_frames = int(round(seconds * SIMULATION_HZ))
+    total = 2 * loop_frames * len(scenarios) + int(round(soak_minutes * 60 * SIMULATION_HZ))
+    with progress_bar() as bar:
+        task = bar.add_task("the whole stack", total=total)
+        tick = lambda: bar.advance(task)  # noqa: E731
+        stacks = [bench_stack(sc, seconds, progress=tick) for sc in scenarios]
+        conditions = render_per_condition() if scenarios else {}
+        soaked = soak(soak_minutes, progress=tick) if soak_minutes else None
+    out = {}
+    if stacks:
+        t = Table(title="the whole stack, every slot on vision, in the closed loop (one thread, ms per frame); the "
+                        "stock composition = detectMultiScale + StereoSGBM + a Hough lane fit on the same scenario")
+        for col in ("scenario", "render", "lanes", "longitudinal", "pedestrians", "odometry", "perception total",
+                    "stock", "faster", "top-down render", "realtime", "realtime recorded"):
+            t.add_column(col, justify="left" if col == "scenario" else "right")
+        for c in stacks:
+            tm = c.timing_ms
+            t.add_row(c.scenario, *(fmt(tm.get(k)) for k in ("render", "lanes", "longitudinal", "pedestrians",
+                                                             "odometry", "perception_total")),
+                      fmt(c.stock_ms), fmt(c.speedup), fmt(c.peers_ms["render"]), fmt(c.realtime_factor),
+                      fmt(c.realtime_factor_recording))
+        console.print(t)
+        console.print("stereo pair with each condition (highway, ms): " + ", ".join(
+            f"{k} {fmt(conditions[k])}" for k in CONDITIONS))
+        out.update({"stack": [c.to_dict() for c in stacks],
+                    "render_conditions_ms": {k: round(v, 3) for k, v in conditions.items()}})
+    if soaked:
+        console.print(f"soak: {soaked['minutes']:g} simulated minutes recorded, memory each minute {soaked['rss_mb']} "
+                      f"MB (peak {soaked['peak_mb']}, growth {soaked['growth_mb']}), realtime {soaked['realtime_factor']}")
+        out["soak"] = soaked
+    return out

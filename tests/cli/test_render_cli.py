@@ -89,3 +89,26 @@ def test_bench_prints_the_render_ratio(tmp_path):
     assert stage["ratio"] == pytest.approx(stage["ms"] / stage["peer_ms"], rel=1e-2)
     lanes = stages["lanes"]
     assert lanes["ms"] > 0 and lanes["peer"] is None and lanes["ratio"] is None and lanes["target_ms"] == 3.0
+
+
+def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_composition(tmp_path):
+    out = tmp_path / "bench.json"
+    r = runner.invoke(app, ["bench", "--frames", "2", "--stack", "--scenario", "crossing", "--seconds", "1",
+                            "--soak-minutes", "0.05", "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    d = json.loads(out.read_text())
+    (c,) = d["stack"]
+    tm = c["timing_ms"]
+    assert c["scenario"] == "crossing" and c["frames"] == 15
+    assert tm["perception_total"] == pytest.approx(sum(tm[k] for k in ("lanes", "longitudinal", "pedestrians",
+                                                                       "odometry")), abs=0.01)
+    assert c["stock_ms"] == pytest.approx(sum(c["peers_ms"][k] for k in ("people", "stereo", "lanes")), abs=0.01)
+    assert c["speedup"] == pytest.approx(c["stock_ms"] / tm["perception_total"], rel=1e-2)
+    assert c["realtime_factor"] > 0 and c["realtime_factor_recording"] > 0
+    assert set(d["render_conditions_ms"]) == {"clear", "night", "rain", "glare", "noise"}
+    assert d["soak"]["frames"] == 45 and len(d["soak"]["rss_mb"]) == 2 and d["soak"]["peak_mb"] > 0
+
+
+def test_bench_refuses_an_unknown_scenario_in_one_line():
+    r = runner.invoke(app, ["bench", "--stack", "--scenario", "moon"])
+    assert r.exit_code == 2 and "unknown scenario 'moon'" in r.output and "Traceback" not in r.output

@@ -1,0 +1,205 @@
+"""The whole stack's cost (``percept bench --stack``): every vision slot in the closed loop on each scenario, one
+thread, beside the stock composition of the peers on the same scenario's frames; the render cost per condition;
+the closed loop's realtime factor with and without recording; and the memory of a long drive.
+
+The stack is timed where it runs: ``run_drive`` with every slot on vision over the scenario's first seconds (seed
+0, so the sequence is fixed), which times each slot per frame under the run JSON's ``timing_ms`` keys and their
+sum (``perception_total``). The peers are the stock way to do each job, on frames of the same scenario: OpenCV's
+HOG ``detectMultiScale`` with its default people detector, ``StereoSGBM`` over the full frame, and a lane fit as
+OpenCV tutorials write it (Canny edges, a probabilistic Hough transform in a trapezoid, a line fitted to each
+side; the Udacity "finding lane lines" recipe). Their sum is the stock composition.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import cv2
+import numpy as np
+
+from .bench import median_ms, people_detector_full_frame, sgbm_full_frame
+
+VISION = {"lateral": "vision", "longitudinal": "vision", "pedestrians": "vision", "odometry": "vision"}
+CONDITIONS = ("clear", "night", "rain", "glare", "noise")
+
+
+def lane_fit_full_frame(frames: list) -> tuple[str, Callable]:
+    """The stock lane fit: grey, Gaussian blur, Canny, a trapezoid mask below the horizon, ``HoughLinesP``, and a
+    least-squares line through each side's segments (left: negative slope)."""
+    h, w = frames[0].left.shape[:2]
+    mask = np.zeros((h, w), np.uint8)
+    cv2.fillPoly(mask, [np.array([[0, h], [int(0.45 * w), int(0.55 * h)], [int(0.55 * w), int(0.55 * h)], [w, h]],
+                                 np.int32)], 255)
+
+    def run(frame) -> None:
+        edges = cv2.Canny(cv2.GaussianBlur(cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY), (5, 5), 0), 50, 150)
+        segs = cv2.HoughLinesP(edges & mask, 2, np.pi / 180, 20, minLineLength=20, maxLineGap=60)
+        if segs is None:
+            return
+        s = segs.reshape(-1, 4).astype(np.float64)
+        slope = (s[:, 3] - s[:, 1]) / np.maximum(np.abs(s[:, 2] - s[:, 0]), 1e-6) * np.sign(s[:, 2] - s[:, 0])
+        for side in (slope < -0.3, slope > 0.3):
+            if side.sum() >= 1:
+                # u = a v + b through both ends of the side's segments
+                np.polyfit(np.r_[s[side, 1], s[side, 3]], np.r_[s[side, 0], s[side, 2]], 1)
+    return "Canny + HoughLinesP + a line per side, full frame", run
+
+
+@dataclass(frozen=True)
+class StackCost:
+    """scenario; frames: frames the closed loop ran; timing_ms: the run JSON's (render, each slot, perception_total)
+    [ms/frame]; peers_ms: the stock way to do each job on the same scenario's frames (people, stereo, lanes) and
+    highway-env's top-down render [ms/frame]; realtime_factor: the closed loop without / with recording."""
+
+    scenario: str
+    frames: int
+    timing_ms: dict
+    peers_ms: dict
+    realtime_factor: float
+    realtime_factor_recording: float
+
+    @property
+    def stock_ms(self) -> float:
+        """The stock composition: people + stereo + lane fit [ms/frame]."""
+        return sum(self.peers_ms[k] for k in ("people", "stereo", "lanes"))
+
+    @property
+    def speedup(self) -> float | None:
+        """How many times faster the whole perception stack is than the stock composition."""
+        total = self.timing_ms.get("perception_total")
+        return self.stock_ms / total if total else None
+
+    def to_dict(self) -> dict:
+        r = lambda x: None if x is None else round(float(x), 3)  # noqa: E731
+        return {"scenario": self.scenario, "frames": self.frames,
+                "timing_ms": {k: r(v) for k, v in self.timing_ms.items()},
+                "peers_ms": {k: r(v) for k, v in self.peers_ms.items()}, "stock_ms": r(self.stock_ms),
+                "speedup": r(self.speedup), "realtime_factor": r(self.realtime_factor),
+                "realtime_factor_recording": r(self.realtime_factor_recording)}
+
+
+def _drive(scenario: str, seconds: float, record: Path | None = None, progress: Callable[[], None] | None = None,
+           each_frame: Callable[[int], None] | None = None) -> dict:
+    """One closed loop (seed 0) with every slot on vision, recorded to ``record`` when given (then
+    ``each_frame(frame_index)`` is called after each step is recorded)."""
+    from percept.sims import WorldConfig
+
+    from .config import DriveConfig
+    from .loop import run_drive
+
+    cfg = DriveConfig(WorldConfig(scenario, seed=0), duration_s=seconds, sources=VISION)
+    tick = (lambda i, n: progress()) if progress else None
+    if record is None:
+        return run_drive(cfg, progress=tick)
+    made = []
+
+    def factory(world):
+        from percept.review import RecordOptions, RunRecorder
+
+        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
+        made.append(_Ticking(RunRecorder(record, world.cfg.rig, lines, cfg.tasks, RecordOptions()), each_frame))
+        return made[0]
+
+    try:
+        return run_drive(cfg, recorder_factory=factory, progress=tick)
+    finally:
+        if made:
+            made[0].inner.close()
+
+
+class _Ticking:
+    """A recorder that also calls ``each_frame(frame_index)`` after each step it records."""
+
+    def __init__(self, inner, each_frame: Callable[[int], None] | None):
+        self.inner, self.each_frame = inner, each_frame
+
+    def log_step(self, frame, truth, step) -> None:
+        self.inner.log_step(frame, truth, step)
+        if self.each_frame is not None:
+            self.each_frame(frame.index)
+
+
+def _peer_frames(scenario: str, frames: int) -> tuple[list, float]:
+    """``frames`` frames of ``scenario`` (autopilot, seed 0) and highway-env's top-down render's median [ms]."""
+    from percept.sims import SimWorld, WorldConfig
+
+    world = SimWorld(WorldConfig(scenario, seed=0, autopilot=True))
+    world.env.render_mode = "rgb_array"
+    world.env.config.update(screen_width=world.cfg.rig.camera.width, screen_height=world.cfg.rig.camera.height)
+    shots = []
+    for _ in range(frames):
+        shots.append(world.observe()[0])
+        world.step()
+    top_ms = median_ms(world.env.render, min(frames, 10))
+    world.env.close()
+    return shots, top_ms
+
+
+def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20,
+                progress: Callable[[], None] | None = None) -> StackCost:
+    """The whole vision stack on ``scenario`` in the closed loop, without and with recording, and the peers."""
+    run = _drive(scenario, seconds, progress=progress)
+    with tempfile.TemporaryDirectory() as tmp:
+        recorded = _drive(scenario, seconds, Path(tmp) / "bench.rrd", progress=progress)
+    shots, top_ms = _peer_frames(scenario, peer_frames)
+    peers = {}
+    for key, make in (("people", people_detector_full_frame), ("stereo", sgbm_full_frame),
+                      ("lanes", lane_fit_full_frame)):
+        _, fn = make(shots)
+        it = iter(range(10 ** 9))
+        peers[key] = median_ms(lambda: fn(shots[next(it) % len(shots)]), len(shots))
+    peers["render"] = top_ms
+    return StackCost(scenario, run["frames"], run["timing_ms"], peers, run["realtime_factor"],
+                     recorded["realtime_factor"])
+
+
+def render_per_condition(frames: int = 20, scenario: str = "highway") -> dict:
+    """Median cost [ms] of one stereo pair with each condition's effects (``SimWorld.observe``: the render, the
+    condition applied to both images, the ground truth), on ``scenario``'s autopilot frames."""
+    from percept.sims import SimWorld, WorldConfig, check_condition
+
+    out = {}
+    for cond in CONDITIONS:
+        world = SimWorld(WorldConfig(scenario, seed=0, condition=check_condition(cond), autopilot=True))
+        times = []
+        for _ in range(frames):
+            times.append(median_ms(world.observe, 1, warmup=0))
+            world.step()
+        world.env.close()
+        out[cond] = float(np.median(times))
+    return out
+
+
+def soak(minutes: float, scenario: str = "highway", progress: Callable[[], None] | None = None) -> dict:
+    """Resident memory [MB] of the process through a recorded closed loop of ``minutes`` simulated minutes with
+    every slot on vision, sampled each simulated minute; ``growth_mb``: the last sample less the first."""
+    from percept.sims.env import SIMULATION_HZ
+
+    samples = []
+
+    def sample(index: int) -> None:
+        if index % (60 * SIMULATION_HZ) == 0:
+            samples.append(_rss_mb())
+
+    with tempfile.TemporaryDirectory() as tmp:
+        run = _drive(scenario, 60.0 * minutes, Path(tmp) / "soak.rrd", progress=progress, each_frame=sample)
+    samples.append(_rss_mb())
+    return {"scenario": scenario, "minutes": minutes, "frames": run["frames"], "rss_mb": [round(s, 1) for s in samples],
+            "peak_mb": round(max(samples), 1), "growth_mb": round(samples[-1] - samples[0], 1),
+            "realtime_factor": round(run["realtime_factor"], 3)}
+
+
+def _rss_mb() -> float:
+    """This process's resident memory [MB] (Linux /proc; the peak so far elsewhere)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
