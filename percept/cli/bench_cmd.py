@@ -106,7 +106,8 @@ def _stack(scenarios: list[str], seconds: float, soak_minutes: float) -> dict:
         out.update({"stack": [c.to_dict() for c in stacks],
                     "render_conditions_ms": {k: round(v, 3) for k, v in conditions.items()}})
     if soaked:
-        console.print(f"soak: {soaked['minutes']:g} simulated minutes recorded, memory each minute {soaked['rss_mb']} "
-                      f"MB (peak {soaked['peak_mb']}, growth {soaked['growth_mb']}), realtime {soaked['realtime_factor']}")
+        console.print(f"soak: {soaked['minutes']:g} simulated minutes recorded, memory each minute "
+                      f"{soaked['rss_mb']} MB (peak {soaked['peak_mb']}, growth {soaked['growth_mb']}), realtime "
+                      f"{soaked['realtime_factor']}")
         out["soak"] = soaked
     return out

@@ -4,10 +4,12 @@ walking into it.
 
 Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over the corridor (every level once in
 ``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
-frame, the two levels around each tracked person's predicted window. Only confirmed tracks act; a track walking
-sideways counts as walking only when it has ``WALK_HITS`` detections and its lateral speed is a person's and clear
-of its own uncertainty (1.5 standard deviations, and at least ``WALK_MIN_MPS``), so that people standing or
-walking along the verge do not cause braking. The conflict rule is the privileged slot's
+frame, the two levels around each tracked person's predicted window. A lone window (one that grouping would
+drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
+its feet touch the road. Only confirmed tracks act; a track walking sideways counts as walking only when it has
+``WALK_HITS`` detections and its lateral speed is a person's and clear of its own uncertainty (1.5 standard
+deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
+braking. The conflict rule is the privileged slot's
 (``percept.sensors.conflict``).
 """
 

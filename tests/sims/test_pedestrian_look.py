@@ -148,3 +148,12 @@ def test_feet_rest_on_the_road_where_the_rig_projects_them(road, speed):
         foot_row = int(np.round(uv[:, 1].max()))  # the pixel row it falls in (pixel centres at integer v)
         lowest_row = out.boxes_px[o.obj_id][3] - 1  # v1 is exclusive
         assert abs(lowest_row - foot_row) <= 1, (o.obj_id, lowest_row, uv[:, 1].max())
+
+
+def test_the_figure_builders_vector_formulas_equal_numpys_bit_for_bit():
+    from percept.sims.render.pedestrian import _cross, _norm
+
+    rng = np.random.default_rng(5)
+    for a, b in rng.normal(size=(500, 2, 3)) * rng.choice([1e-3, 1.0, 30.0], size=(500, 1, 1)):
+        assert np.array_equal(_cross(a, b), np.cross(a, b))
+        assert _norm(a) == np.linalg.norm(a)
