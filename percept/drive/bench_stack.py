@@ -20,7 +20,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from .bench import median_ms, people_detector_full_frame, sgbm_full_frame
+from .bench import _cycle, median_ms, people_detector_full_frame, sgbm_full_frame
 
 VISION = {"lateral": "vision", "longitudinal": "vision", "pedestrians": "vision", "odometry": "vision"}
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
@@ -145,12 +145,11 @@ def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20,
     with tempfile.TemporaryDirectory() as tmp:
         recorded = _drive(scenario, seconds, Path(tmp) / "bench.rrd", progress=progress)
     shots, top_ms = _peer_frames(scenario, peer_frames)
-    peers = {}
+    peers, shot = {}, _cycle(shots, None)
     for key, make in (("people", people_detector_full_frame), ("stereo", sgbm_full_frame),
                       ("lanes", lane_fit_full_frame)):
         _, fn = make(shots)
-        it = iter(range(10 ** 9))
-        peers[key] = median_ms(lambda: fn(shots[next(it) % len(shots)]), len(shots))
+        peers[key] = median_ms(lambda: fn(shot()), len(shots))
     peers["render"] = top_ms
     return StackCost(scenario, run["frames"], run["timing_ms"], peers, run["realtime_factor"],
                      recorded["realtime_factor"])
