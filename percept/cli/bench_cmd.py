@@ -66,11 +66,13 @@ def _stage_table(results) -> Table:
 
 
 def _scenarios(names: list[str] | None) -> list[str]:
-    from percept.sims import SCENARIOS
+    from percept.sims import SCENARIOS, check_scenario
 
-    for n in names or []:
-        if n not in SCENARIOS:
-            fail(f"unknown scenario '{n}'; choose from {', '.join(SCENARIOS)}")
+    try:
+        for n in names or []:
+            check_scenario(n)
+    except ValueError as e:
+        fail(str(e))
     return list(names) if names else list(SCENARIOS)
 
 

@@ -94,8 +94,7 @@ class Recording:
     def open(self, world):
         from percept.review import RunRecorder
 
-        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
-        self.recorder = RunRecorder(self.path, world.cfg.rig, lines, self.tasks, self.options)
+        self.recorder = RunRecorder(self.path, world.cfg.rig, world.road_geometry.lane_lines, self.tasks, self.options)
         return self.recorder
 
     def close(self, complete: bool = True) -> None:

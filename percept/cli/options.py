@@ -30,9 +30,6 @@ Pedestrians = Annotated[Optional[Source], typer.Option("--pedestrians", help=_SL
 Detector = Annotated[str, typer.Option("--detector", help="People model of the vision pedestrian slot: sim "
                                        "(trained on rendered people), inria (OpenCV's) or a model file.")]
 Odometry = Annotated[Optional[Source], typer.Option("--odometry", help=_SLOT.format(task="Odometry"))]
-Privileged = Annotated[bool, typer.Option("--privileged", metavar="", help="Every slot on ground truth: the "
-                                          "baselines the vision modules are measured against (a slot's own option "
-                                          "still wins).")]
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",
                                                  dir_okay=False)]
 
@@ -41,6 +38,10 @@ def flag(*names: str, help: str):
     """An on/off option (``Annotated[bool, flag("--force", help=...)]``): --help shows it without a value type,
     where typer would print ``<bool>`` as if it took one."""
     return typer.Option(*names, help=help, metavar="")
+
+
+Privileged = Annotated[bool, flag("--privileged", help="Every slot on ground truth: the baselines the vision modules "
+                                                       "are measured against (a slot's own option still wins).")]
 
 
 def check_number(flag: str, value, lo: float | None = None, hi: float | None = None):

@@ -93,6 +93,13 @@ def _cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], obj
     return nxt
 
 
+def topdown_ready(world):
+    """``world`` with highway-env's own top-down ``render()`` set to the camera's size (the render's peer)."""
+    world.env.render_mode = "rgb_array"
+    world.env.config.update(screen_width=world.cfg.rig.camera.width, screen_height=world.cfg.rig.camera.height)
+    return world
+
+
 def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] | None = None) -> StageCost:
     """One stereo pair of the ``highway`` scenario vs highway-env's top-down render of the same world."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -100,9 +107,7 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
     from percept.sims.snapshot import scene_from_road
 
     cv2.setNumThreads(1)
-    world = SimWorld(WorldConfig("highway", seed=seed, autopilot=True))
-    world.env.render_mode = "rgb_array"
-    world.env.config.update(screen_width=world.cfg.rig.camera.width, screen_height=world.cfg.rig.camera.height)
+    world = topdown_ready(SimWorld(WorldConfig("highway", seed=seed, autopilot=True)))
     scenes = []
     for _ in range(frames):
         world.step()

@@ -13,6 +13,7 @@ side; the Udacity "finding lane lines" recipe). Their sum is the stock compositi
 from __future__ import annotations
 
 import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -20,7 +21,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from .bench import _cycle, median_ms, people_detector_full_frame, sgbm_full_frame
+from .bench import _cycle, median_ms, people_detector_full_frame, sgbm_full_frame, topdown_ready
 
 VISION = {"lateral": "vision", "longitudinal": "vision", "pedestrians": "vision", "odometry": "vision"}
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
@@ -99,8 +100,8 @@ def _drive(scenario: str, seconds: float, record: Path | None = None, progress: 
     def factory(world):
         from percept.review import RecordOptions, RunRecorder
 
-        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
-        made.append(_Ticking(RunRecorder(record, world.cfg.rig, lines, cfg.tasks, RecordOptions()), each_frame))
+        recorder = RunRecorder(record, world.cfg.rig, world.road_geometry.lane_lines, cfg.tasks, RecordOptions())
+        made.append(_Ticking(recorder, each_frame))
         return made[0]
 
     try:
@@ -126,9 +127,7 @@ def _peer_frames(scenario: str, frames: int) -> tuple[list, float]:
     """``frames`` frames of ``scenario`` (autopilot, seed 0) and highway-env's top-down render's median [ms]."""
     from percept.sims import SimWorld, WorldConfig
 
-    world = SimWorld(WorldConfig(scenario, seed=0, autopilot=True))
-    world.env.render_mode = "rgb_array"
-    world.env.config.update(screen_width=world.cfg.rig.camera.width, screen_height=world.cfg.rig.camera.height)
+    world = topdown_ready(SimWorld(WorldConfig(scenario, seed=0, autopilot=True)))
     shots = []
     for _ in range(frames):
         shots.append(world.observe()[0])
@@ -165,7 +164,9 @@ def render_per_condition(frames: int = 20, scenario: str = "highway") -> dict:
         world = SimWorld(WorldConfig(scenario, seed=0, condition=check_condition(cond), autopilot=True))
         times = []
         for _ in range(frames):
-            times.append(median_ms(world.observe, 1, warmup=0))
+            t0 = time.perf_counter()
+            world.observe()
+            times.append((time.perf_counter() - t0) * 1e3)
             world.step()
         world.env.close()
         out[cond] = float(np.median(times))

@@ -44,6 +44,11 @@ class RoadGeometry:
     marking_color: np.ndarray
     edges: list[tuple[np.ndarray, int]]
 
+    @property
+    def lane_lines(self) -> list[np.ndarray]:
+        """Both sides of every strip: (N, 2) world polylines [m] (what a recording draws as the road)."""
+        return [s.left for s in self.strips] + [s.right for s in self.strips]
+
 
 def _sample(lane, s: np.ndarray, lateral_hw: float) -> np.ndarray:
     """World positions (N, 2) of lane coordinates (s, lateral) with highway-env's own lane.position."""

@@ -62,8 +62,7 @@ def record(path: Path, sources: dict, options: RecordOptions = RecordOptions(), 
     holder = {}
 
     def factory(world):
-        lines = [s.left for s in world.road_geometry.strips] + [s.right for s in world.road_geometry.strips]
-        holder["r"] = RunRecorder(path, world.cfg.rig, lines, cfg.tasks, options)
+        holder["r"] = RunRecorder(path, world.cfg.rig, world.road_geometry.lane_lines, cfg.tasks, options)
         return holder["r"]
 
     result = run_drive(cfg, recorder_factory=factory, render=True)
