@@ -123,7 +123,7 @@ def test_the_headlight_beam_lies_on_the_world_so_both_cameras_see_it_at_the_surf
     cam = rig.camera
     for z in (8.0, 30.0):
         wall = np.full((cam.height, cam.width), 1.0 / z, np.float32)
-        left, right = effects.night_gain(wall, 0)[..., 0], effects.night_gain(wall, 1)[..., 0]
+        left, right = effects.night_gain(wall, 0), effects.night_gain(wall, 1)
         # a point of the wall at left column u is at u - f b / Z in the right image: the same light there
         d = cam.fx * rig.baseline_m / z
         u = np.arange(100, 540)
