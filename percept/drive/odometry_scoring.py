@@ -12,6 +12,8 @@ import numpy as np
 
 from percept.odometry.metrics import ate_rmse_m, final_position_error_m, kitti_drift, path_length_m
 
+from .rows import Rows
+
 # P(chi2 with 2 dof <= 11.83) = 0.9973, the probability of a 1-D +-3 sigma interval
 NEES_3SIGMA_2DOF = 11.83
 TRAJECTORIES = ("vo", "dead_reckoning", "fused", "landmarks")
@@ -19,8 +21,8 @@ TRAJECTORY_EVERY = 15
 """The run JSON keeps one pose in this many frames of each trajectory (for plots), rounded to 1 cm."""
 
 
-def _pose(p) -> list[float]:
-    return [p.x_m, p.y_m, p.yaw_rad]
+def _pose(p) -> tuple[float, float, float]:
+    return p.x_m, p.y_m, p.yaw_rad
 
 
 def inside_3sigma(errors_xy: np.ndarray, covariances: np.ndarray) -> float | None:
@@ -38,21 +40,21 @@ class OdometryScorer:
 
     def __init__(self, ctx):
         self.ctx = ctx
-        self.true: list[list[float]] = []
-        self.paths: dict[str, list[list[float]]] = {k: [] for k in TRAJECTORIES}
-        self.cov = {"fused": [], "landmarks": []}
+        self.true = Rows(3)  # x [m], y [m], yaw [rad]
+        self.paths = {k: Rows(3) for k in TRAJECTORIES}
+        self.cov = {"fused": Rows(4), "landmarks": Rows(4)}  # the (x, y) block of the covariance [m²], row-major
         self.fixes = self.sightings = self.vo_failed = 0
 
     def update(self, pose, debug, step) -> None:
         if not self.ctx.vision or pose is None or debug is None:
             return
         e = step.truth.ego
-        self.true.append([e.x_m, e.y_m, e.yaw_rad])
+        self.true.append((e.x_m, e.y_m, e.yaw_rad))
         for key, p in (("vo", debug.vo_pose), ("dead_reckoning", debug.dead_reckoning_pose),
                        ("fused", debug.fused_pose), ("landmarks", pose.pose)):
             self.paths[key].append(_pose(p))
-        self.cov["fused"].append(debug.fused_covariance[:2, :2])
-        self.cov["landmarks"].append(pose.covariance[:2, :2])
+        self.cov["fused"].append(debug.fused_covariance[:2, :2].ravel())
+        self.cov["landmarks"].append(pose.covariance[:2, :2].ravel())
         self.fixes += debug.fixes
         self.sightings += len(debug.sightings)
         self.vo_failed += int(len(self.true) > 1 and not debug.vo_step.ok)
@@ -60,8 +62,8 @@ class OdometryScorer:
     def _trajectory(self, true: np.ndarray) -> dict:
         """x, y [m] of the truth and of each trajectory every TRAJECTORY_EVERY frames (and the last frame)."""
         idx = sorted(set(range(0, len(true), TRAJECTORY_EVERY)) | {len(true) - 1})
-        paths = {"true": true, "estimate": np.asarray(self.paths["landmarks"]),
-                 **{k: np.asarray(self.paths[k]) for k in ("fused", "vo", "dead_reckoning")}}
+        paths = {"true": true, "estimate": self.paths["landmarks"].values(),
+                 **{k: self.paths[k].values() for k in ("fused", "vo", "dead_reckoning")}}
         return {"every_frames": TRAJECTORY_EVERY,
                 **{k: np.round(p[idx, :2], 2).tolist() for k, p in paths.items()}}
 
@@ -72,17 +74,18 @@ class OdometryScorer:
                  "landmark_sightings", "vo_failed_frames", "trajectory"]
         if len(self.true) < 2:
             return dict.fromkeys(keys)
-        true = np.asarray(self.true)
+        true = self.true.values()
         out: dict = {}
         for k, path in self.paths.items():
-            est = np.asarray(path)
+            est = path.values()
             drift = kitti_drift(est, true)
             out[f"drift_pct_{k}"] = drift["drift_pct"]
             out[f"rot_drift_deg_per_100m_{k}"] = drift["rot_drift_deg_per_100m"]
             out[f"ate_rmse_{k}_m"] = ate_rmse_m(est, true)
             out[f"final_error_{k}_m"] = final_position_error_m(est, true)
         for key, k in (("consistency_3sigma", "landmarks"), ("consistency_3sigma_fused", "fused")):
-            out[key] = inside_3sigma(np.asarray(self.paths[k])[:, :2] - true[:, :2], np.asarray(self.cov[k]))
+            errors_xy = self.paths[k].values()[:, :2] - true[:, :2]
+            out[key] = inside_3sigma(errors_xy, self.cov[k].values().reshape(-1, 2, 2))
         out.update(path_length_m=path_length_m(true), landmark_fixes=self.fixes, landmark_sightings=self.sightings,
                    vo_failed_frames=self.vo_failed, trajectory=self._trajectory(true))
         return {k: out[k] for k in keys}

@@ -19,6 +19,7 @@ from percept.sensors import ObjectKind
 from percept.sensors.vehicle import EGO_WIDTH_M
 
 from .privileged import InPath, Obstacle, true_centre_y
+from .rows import Rows
 
 STOP_SPEED_MPS = 0.5
 PHANTOM_DECEL_MPS2 = -3.0
@@ -84,19 +85,19 @@ class LaneScorer:
 
     def __init__(self, ctx: ScoreContext):
         self.ctx = ctx
-        self.offsets_m: list[float] = []
-        self.errors: list[list[float]] = []
+        self.offsets_m = Rows(1)
+        self.errors = Rows(3)  # offset [m], heading [rad], curvature [1/m]
 
     def update(self, path, debug, step: StepTruth) -> None:
         lane = step.truth.lane
-        self.offsets_m.append(lane.offset_m)
+        self.offsets_m.append((lane.offset_m,))
         est = path.lane if path is not None else None
         if self.ctx.vision and est is not None and est.valid:
-            self.errors.append([est.offset_m - lane.offset_m, est.heading_rad - lane.heading_rad,
-                                est.curvature_1pm - lane.curvature_1pm])
+            self.errors.append((est.offset_m - lane.offset_m, est.heading_rad - lane.heading_rad,
+                                est.curvature_1pm - lane.curvature_1pm))
 
     def result(self) -> dict:
-        return {**rmse_columns(self.errors), **centering(self.offsets_m)}
+        return {**rmse_columns(self.errors.values()), **centering(self.offsets_m.values()[:, 0])}
 
 
 class LongitudinalScorer:
@@ -104,9 +105,9 @@ class LongitudinalScorer:
 
     def __init__(self, ctx: ScoreContext):
         self.ctx = ctx
-        self.gaps_s: list[float] = []
-        self.pairs: list[tuple[float, float, float, float]] = []  # est range, true range, est ttc, true ttc
-        self.steady_gaps_s: list[float] = []
+        self.gaps_s = Rows(1)
+        self.pairs = Rows(4)  # est range, true range, est ttc, true ttc
+        self.steady_gaps_s = Rows(1)
         self._calm_since_s: float | None = None
         self.phantom_brakes = 0
         self._braking = False
@@ -117,12 +118,12 @@ class LongitudinalScorer:
         following = (obstacle is not None and obstacle.kind is ObjectKind.VEHICLE and obstacle.gap_m < 100
                      and gt.speed_mps > 5)
         if following:
-            self.gaps_s.append(obstacle.gap_m / gt.speed_mps)
+            self.gaps_s.append((obstacle.gap_m / gt.speed_mps,))
         # steady following: the speeds have matched within STEADY_REL_MPS for STEADY_S
         if following and abs(obstacle.speed_mps - gt.speed_mps) < STEADY_REL_MPS:
             self._calm_since_s = gt.time_s if self._calm_since_s is None else self._calm_since_s
             if gt.time_s - self._calm_since_s >= STEADY_S:
-                self.steady_gaps_s.append(obstacle.gap_m / gt.speed_mps)
+                self.steady_gaps_s.append((obstacle.gap_m / gt.speed_mps,))
         else:
             self._calm_since_s = None
         # phantom brake: a hard deceleration that begins, above a walking pace, with nothing in the path within the
@@ -144,16 +145,15 @@ class LongitudinalScorer:
                 self.pairs.append((lead.range_m, t.obj.distance_m, est_ttc, true_ttc))
 
     def result(self) -> dict:
-        g = self.gaps_s
-        p = np.asarray(self.pairs, dtype=float).reshape(-1, 4)
+        g, steady, p = self.gaps_s.values()[:, 0], self.steady_gaps_s.values()[:, 0], self.pairs.values()
         scored = self.ctx.vision
         return {
             "range_abs_rel_err": range_abs_rel_err(p[:, 0], p[:, 1]) if scored else None,
             "range_abs_rel_err_by_bin": range_abs_rel_err_by_bin(p[:, 0], p[:, 1]) if scored else None,
             "ttc_abs_err_s": ttc_abs_err_s(p[:, 2], p[:, 3]) if scored else None,
-            "time_gap_mean_s": float(np.mean(g)) if g else None,
-            "time_gap_min_s": float(np.min(g)) if g else None,
-            "time_gap_steady_s": float(np.mean(self.steady_gaps_s)) if self.steady_gaps_s else None,
+            "time_gap_mean_s": float(np.mean(g)) if len(g) else None,
+            "time_gap_min_s": float(np.min(g)) if len(g) else None,
+            "time_gap_steady_s": float(np.mean(steady)) if len(steady) else None,
             "time_gap_setting_s": self.ctx.time_gap_setting_s,
             "phantom_brakes": self.phantom_brakes,
         }

@@ -1,0 +1,33 @@
+"""Per-frame rows of numbers kept compactly for scoring at the end of a run.
+
+A list of Python lists costs about 150 bytes a row of three floats, and a numpy view kept per frame holds its
+whole base array; over a 20-minute drive (18,000 frames) the scorers' histories grew the process by about
+1.5 MB a minute. ``Rows`` keeps the same values as float64 in the standard library's ``array`` (8 bytes each,
+amortised growth), and hands them to numpy at the end.
+"""
+
+from __future__ import annotations
+
+from array import array
+
+import numpy as np
+
+
+class Rows:
+    """Rows of ``width`` float64 values, appended one per frame; ``values()`` is the (N, width) array."""
+
+    def __init__(self, width: int):
+        self.width = width
+        self._data = array("d")
+
+    def append(self, row) -> None:
+        if len(row) != self.width:
+            raise ValueError(f"a row of {len(row)} values where {self.width} are kept")
+        self._data.extend(row)
+
+    def __len__(self) -> int:
+        return len(self._data) // self.width
+
+    def values(self) -> np.ndarray:
+        """The rows so far, (N, width) float64 (a copy: a view would stop the array from growing)."""
+        return np.array(self._data, dtype=np.float64).reshape(-1, self.width)
