@@ -141,12 +141,16 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
             images[f"longitudinal.range_error_by_range.{sc}.png"] = lines_png(
                 f"{sc}: in-path range error against range (median over runs)", "range [m]", "|dZ|/Z [%]", series)
     for sc, c in cells:
-        for r in _runs(results, sc, c):
-            traj = (r.get("odometry") or {}).get("trajectory")
-            if traj:
-                series = [(name, np.asarray(traj[name], float)) for name in TRAJECTORY_SERIES if traj.get(name)]
-                images[f"odometry.trajectory.{sc}-{c}-{r['seed']}.png"] = lines_png(
-                    f"odometry {sc} / {c} / seed {r['seed']}", "x [m]", "y [m]", series, equal=True)
+        # one trajectory per scenario x condition, the run whose estimate strayed furthest (landmark-fix ATE):
+        # a batch of hundreds of runs gets a plot a reader can look through
+        runs = [r for r in _runs(results, sc, c) if (r.get("odometry") or {}).get("trajectory")]
+        if runs:
+            r = max(runs, key=lambda r: r["odometry"].get("ate_rmse_landmarks_m") or 0.0)
+            traj = r["odometry"]["trajectory"]
+            series = [(name, np.asarray(traj[name], float)) for name in TRAJECTORY_SERIES if traj.get(name)]
+            images[f"odometry.trajectory.{sc}-{c}-{r['seed']}.png"] = lines_png(
+                f"odometry {sc} / {c} / seed {r['seed']} (worst ATE of {len(runs)})", "x [m]", "y [m]", series,
+                equal=True)
     folder.mkdir(parents=True, exist_ok=True)
     out = []
     for name, img in images.items():

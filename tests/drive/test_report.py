@@ -19,10 +19,10 @@ SETTINGS = {"percept": "0.1.0", "duration_s": 12.0, "detector": None,
                       "odometry": "privileged"}}
 
 
-def run(seed, collisions=0, recall=None, offset=0.01, stops=None, phantom=0, traj=False):
+def run(seed, collisions=0, recall=None, offset=0.01, stops=None, phantom=0, traj=False, ate=0.1):
     odo = {"ate_rmse_fused_m": None}
     if traj:
-        odo = {"ate_rmse_fused_m": 0.1, "trajectory": {"every_frames": 15, "true": [[0, 0], [10, 0], [20, 1]],
+        odo = {"ate_rmse_fused_m": 0.1, "ate_rmse_landmarks_m": ate, "trajectory": {"every_frames": 15, "true": [[0, 0], [10, 0], [20, 1]],
                                                         "estimate": [[0, 0], [10, 0.1], [20, 1.2]]}}
     return {"scenario": "highway", "condition": "clear", "seed": seed, "frames": 10, "collisions": collisions,
             "pedestrian_collisions": 0, "lane_departures": 0, "realtime_factor": 2.0 + seed,
@@ -63,7 +63,7 @@ def test_unsafe_runs_come_with_the_command_that_reproduces_them():
 
 
 def test_reports_are_written_and_readable(tmp_path):
-    runs = [run(k, recall=0.8, traj=k == 0) for k in range(4)] + [run(4, collisions=1)]
+    runs = [run(k, recall=0.8, traj=k < 2, ate=0.5 if k == 1 else 0.1) for k in range(4)] + [run(4, collisions=1)]
     written = write_reports(PLAN, runs, SETTINGS, tmp_path, TASKS)
     md = (tmp_path / "summary.md").read_text()
     assert "| highway | clear | 5 | 0 | 1 | 0 | 0 | 0 | 0 |" in md  # the safety totals
@@ -71,7 +71,9 @@ def test_reports_are_written_and_readable(tmp_path):
     pngs = [p for p in written if p.suffix == ".png"]
     names = {p.name for p in pngs}
     assert {"lane.centering_rms_m.png", "longitudinal.range_error_by_range.highway.png",
-            "odometry.trajectory.highway-clear-0.png"} <= names
+            "odometry.trajectory.highway-clear-1.png"} <= names
+    # one trajectory per scenario and condition: the run with the worst ATE
+    assert not any(n.startswith("odometry.trajectory.highway-clear-0") for n in names)
     for p in pngs:
         img = cv2.imread(str(p))
         assert img is not None and img.shape[2] == 3 and img.std() > 5  # something is drawn
