@@ -66,8 +66,8 @@ class ConditionEffects:
         # glare: the sun low ahead, a little left of centre, above the horizon
         self.sun_uv = (cam.cx - 0.25 * cam.cx, max(hz - 0.18 * H, 10))
         r = np.hypot(u - self.sun_uv[0], v - self.sun_uv[1])
-        glare = (255 * (np.exp(-r / 40.0) + 0.35 * np.exp(-r / 220.0))).astype(np.float32)[..., None]
-        self._glare_lit = _three(glare[..., 0] * 1.2)
+        glare = (255 * (np.exp(-r / 40.0) + 0.35 * np.exp(-r / 220.0))).astype(np.float32)
+        self._glare_lit = _three(glare * 1.2)
         # lens flare: ghosts on the line through the sun and the image centre, each kept with the box where its
         # blur is not zero (the blur's kernel reaches 4 sigma + 1 px beyond the disc)
         self._ghosts = []
