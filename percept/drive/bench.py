@@ -80,7 +80,7 @@ def bench_ticks(frames: int, slots: int, peers: int) -> int:
     return 2 * (frames + 2) + slots * (SLOT_PASSES + 1) * frames + peers * (frames + 2)
 
 
-def _cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], object]:
+def cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], object]:
     """A function that returns the next item each call (round robin), ticking ``progress``."""
     state = {"i": 0}
 
@@ -112,7 +112,7 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
     for _ in range(frames):
         world.step()
         scenes.append(scene_from_road(world.env.road, world.ego, world.ids))
-    scene = _cycle(scenes, progress)
+    scene = cycle(scenes, progress)
     size = (world.cfg.rig.camera.height, world.cfg.rig.camera.width)
 
     def peer():
@@ -151,7 +151,7 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
         shots.append((frame, {u: s.step(frame, {})[0] for u, s in upstream.items()}))
         world.step()
     ms = slot_ms(task.vision(ctx), shots, progress=progress)
-    shot = _cycle(shots, progress)
+    shot = cycle(shots, progress)
     peer, peer_ms = None, None
     if task.bench_peer is not None:
         peer, run = task.bench_peer([f for f, _ in shots])

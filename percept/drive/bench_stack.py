@@ -21,7 +21,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from .bench import _cycle, median_ms, people_detector_full_frame, sgbm_full_frame, topdown_ready
+from .bench import cycle, median_ms, people_detector_full_frame, sgbm_full_frame, topdown_ready
 
 VISION = {"lateral": "vision", "longitudinal": "vision", "pedestrians": "vision", "odometry": "vision"}
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
@@ -144,7 +144,7 @@ def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20,
     with tempfile.TemporaryDirectory() as tmp:
         recorded = _drive(scenario, seconds, Path(tmp) / "bench.rrd", progress=progress)
     shots, top_ms = _peer_frames(scenario, peer_frames)
-    peers, shot = {}, _cycle(shots, None)
+    peers, shot = {}, cycle(shots, None)
     for key, make in (("people", people_detector_full_frame), ("stereo", sgbm_full_frame),
                       ("lanes", lane_fit_full_frame)):
         _, fn = make(shots)

@@ -59,11 +59,11 @@ class OdometryScorer:
         self.sightings += len(debug.sightings)
         self.vo_failed += int(len(self.true) > 1 and not debug.vo_step.ok)
 
-    def _trajectory(self, true: np.ndarray) -> dict:
+    @staticmethod
+    def _trajectory(true: np.ndarray, est: dict[str, np.ndarray]) -> dict:
         """x, y [m] of the truth and of each trajectory every TRAJECTORY_EVERY frames (and the last frame)."""
         idx = sorted(set(range(0, len(true), TRAJECTORY_EVERY)) | {len(true) - 1})
-        paths = {"true": true, "estimate": self.paths["landmarks"].values(),
-                 **{k: self.paths[k].values() for k in ("fused", "vo", "dead_reckoning")}}
+        paths = {"true": true, "estimate": est["landmarks"], **{k: est[k] for k in ("fused", "vo", "dead_reckoning")}}
         return {"every_frames": TRAJECTORY_EVERY,
                 **{k: np.round(p[idx, :2], 2).tolist() for k, p in paths.items()}}
 
@@ -75,17 +75,16 @@ class OdometryScorer:
         if len(self.true) < 2:
             return dict.fromkeys(keys)
         true = self.true.values()
+        paths = {k: p.values() for k, p in self.paths.items()}
         out: dict = {}
-        for k, path in self.paths.items():
-            est = path.values()
+        for k, est in paths.items():
             drift = kitti_drift(est, true)
             out[f"drift_pct_{k}"] = drift["drift_pct"]
             out[f"rot_drift_deg_per_100m_{k}"] = drift["rot_drift_deg_per_100m"]
             out[f"ate_rmse_{k}_m"] = ate_rmse_m(est, true)
             out[f"final_error_{k}_m"] = final_position_error_m(est, true)
         for key, k in (("consistency_3sigma", "landmarks"), ("consistency_3sigma_fused", "fused")):
-            errors_xy = self.paths[k].values()[:, :2] - true[:, :2]
-            out[key] = inside_3sigma(errors_xy, self.cov[k].values().reshape(-1, 2, 2))
+            out[key] = inside_3sigma(paths[k][:, :2] - true[:, :2], self.cov[k].values().reshape(-1, 2, 2))
         out.update(path_length_m=path_length_m(true), landmark_fixes=self.fixes, landmark_sightings=self.sightings,
-                   vo_failed_frames=self.vo_failed, trajectory=self._trajectory(true))
+                   vo_failed_frames=self.vo_failed, trajectory=self._trajectory(true, paths))
         return {k: out[k] for k in keys}

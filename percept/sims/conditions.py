@@ -98,7 +98,7 @@ class ConditionEffects:
         call)."""
         inv = self.ground_inv if inv_depth is None else inv_depth
         # z = 1 / max(1/Z, 1e-6), inf for sky, capped at 1e4 m
-        z = np.maximum(inv, np.float32(1e-6), out=self._scratch("z"))
+        z = np.maximum(inv, np.float32(1e-6), out=self._scratch("noise"))
         np.divide(np.float32(1.0), z, out=z)
         z[inv <= 0] = np.inf
         np.minimum(z, np.float32(1e4), out=z)
@@ -177,6 +177,7 @@ class ConditionEffects:
         blurred = cv2.resize(small, (self.W, self.H), dst=self._scratch("blurred", 3), interpolation=cv2.INTER_LINEAR)
         # out = out (1 - 0.6 d) + 0.6 d blurred
         d *= np.float32(0.6)
+        # (1 - 0.6 d) goes into the drops' buffer, no longer needed once blurred
         cv2.multiply(out, _three(np.subtract(np.float32(1), d, out=drops), three), dst=out)
         return cv2.add(out, cv2.multiply(_three(d, three), blurred, dst=blurred), dst=out)
 
@@ -205,7 +206,7 @@ class ConditionEffects:
             f = self._scratch("f", 3)
             f[...] = img
             out = self._night(f, self._night_gain(inv_depth, camera), emission)
-            n = rng.standard_normal(out.shape[:2], dtype=np.float32, out=self._scratch("z"))
+            n = rng.standard_normal(out.shape[:2], dtype=np.float32, out=self._scratch("noise"))
             n *= np.float32(3.0)
             cv2.add(out, _three(n, self._scratch("three", 3)), dst=out)
         elif c is Condition.RAIN:

@@ -22,8 +22,9 @@ SETTINGS = {"percept": "0.1.0", "duration_s": 12.0, "detector": None,
 def run(seed, collisions=0, recall=None, offset=0.01, stops=None, phantom=0, traj=False, ate=0.1):
     odo = {"ate_rmse_fused_m": None}
     if traj:
-        odo = {"ate_rmse_fused_m": 0.1, "ate_rmse_landmarks_m": ate, "trajectory": {"every_frames": 15, "true": [[0, 0], [10, 0], [20, 1]],
-                                                        "estimate": [[0, 0], [10, 0.1], [20, 1.2]]}}
+        odo = {"ate_rmse_fused_m": 0.1, "ate_rmse_landmarks_m": ate,
+               "trajectory": {"every_frames": 15, "true": [[0, 0], [10, 0], [20, 1]],
+                              "estimate": [[0, 0], [10, 0.1], [20, 1.2]]}}
     return {"scenario": "highway", "condition": "clear", "seed": seed, "frames": 10, "collisions": collisions,
             "pedestrian_collisions": 0, "lane_departures": 0, "realtime_factor": 2.0 + seed,
             "lane": {"offset_rmse_m": offset, "centering_rms_m": 0.05},
