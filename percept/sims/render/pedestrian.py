@@ -19,6 +19,7 @@ over trunk, shirt over trousers, face over hair), never by rounding noise.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -26,6 +27,7 @@ import numpy as np
 from .patches import SUN_DIR
 from .raster import PatchBuilder
 from .scene import ObjectState
+from .vec3 import UP, Vec3, add, cross, dot, madd, mul, norm, sub, vec
 
 # BGR colours. Clothing keeps some luminance or hue contrast against the grey asphalt (~100, 97, 95).
 SHIRTS = [(40, 40, 175), (95, 45, 20), (35, 90, 30), (28, 28, 30), (225, 225, 222), (205, 140, 80),
@@ -37,8 +39,8 @@ SKINS = [(150, 180, 225), (125, 160, 210), (95, 130, 185), (70, 100, 150), (50, 
 HAIR = [(20, 20, 25), (25, 40, 65), (45, 75, 120), (80, 150, 190), (150, 150, 155), (30, 30, 90)]
 SHOES = [(25, 25, 28), (30, 50, 80), (215, 215, 215), (40, 40, 40)]
 
-"""Light direction (world) for the lit/shadowed halves; matches the renderer's sun."""
-UP = np.array([0.0, 0.0, 1.0])
+SUN = vec(SUN_DIR)
+"""Light direction (world) for the lit/shadowed halves: the renderer's sun."""
 
 # Normal walking over one gait cycle (fraction 0 = heel strike of that leg), degrees; after Winter's
 # normative sagittal kinematics. HIP: thigh forwards of the vertical; KNEE: flexion; FOOT: shoe pitch
@@ -52,31 +54,19 @@ KNEE = np.array([2.0, 10.0, 15.0, 10.0, 8.0, 22.0, 36.0, 51.0, 38.0, 13.0, 2.0])
 FOOT = np.array([-10.0, 0.0, 0.0, 0.0, 5.0, 14.0, 34.0, 25.0, 5.0, -8.0, -10.0])
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b of two 3-vectors, written out: ``np.cross``'s own products and differences (the same floats) without
-    its generic axis handling, which cost more than the product on a figure's hundreds of small vectors."""
-    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
-    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
-
-
-def _norm(v: np.ndarray) -> float:
-    """|v| of a vector: the square root of the same dot product ``np.linalg.norm`` takes."""
-    return math.sqrt(float(v @ v))
-
-
 class _Figure:
     """Collects one pedestrian's patches, then drops them all so that the lowest point is at z = 0."""
 
-    def __init__(self, view: np.ndarray, oid: int):
+    def __init__(self, view: Vec3, oid: int):
         self.view = view
         self.oid = oid
         self.rows: list[tuple] = []  # (origin, e1, e2, colour, outline, box-or-None)
 
-    def _toward_view(self, p: np.ndarray, bias: float) -> np.ndarray:
-        d = self.view - p
-        d[2] = 0.0
-        return p + bias * d / (_norm(d) + 1e-12)
+    def _toward_view(self, p: Vec3, bias: float) -> Vec3:
+        # p + bias d / |d|, d the horizontal direction from p to the viewer
+        d = (self.view[0] - p[0], self.view[1] - p[1], 0.0)
+        n = norm(d) + 1e-12
+        return (p[0] + bias * d[0] / n, p[1] + bias * d[1] / n, p[2] + bias * d[2] / n)
 
     def limb(self, p0, p1, r0: float, r1: float, color, bias: float = 0.0, caps: tuple = (True, True)) -> None:
         """A tapered view-facing quad from p0 (half-width r0) to p1 (half-width r1) with round caps.
@@ -84,48 +74,52 @@ class _Figure:
         Each half (either side of the axis) is a rectangle plus a parallelogram for the taper; the half
         facing the sun is a little brighter than the other.
         """
-        p0 = self._toward_view(np.asarray(p0, float), bias)
-        p1 = self._toward_view(np.asarray(p1, float), bias)
-        axis = p1 - p0
-        side = _cross(axis, self.view - (p0 + p1) / 2)
-        n = _norm(side)
+        p0 = self._toward_view(p0, bias)
+        p1 = self._toward_view(p1, bias)
+        axis = sub(p1, p0)
+        side = cross(axis, sub(self.view, ((p0[0] + p1[0]) / 2, (p0[1] + p1[1]) / 2, (p0[2] + p1[2]) / 2)))
+        n = norm(side)
         if n < 1e-9:
             return
-        side /= n
+        side = (side[0] / n, side[1] / n, side[2] / n)
         if r0 < r1:  # build from the wide end
-            p0, p1, r0, r1, axis, caps = p1, p0, r1, r0, -axis, caps[::-1]
+            p0, p1, r0, r1, axis, caps = p1, p0, r1, r0, (-axis[0], -axis[1], -axis[2]), caps[::-1]
         if r0 > 1.9 * r1:  # too steep a taper for one rectangle + parallelogram per half: split it
             rm = r0 / 1.8
-            pm = p0 + (r0 - rm) / (r0 - r1) * axis
+            pm = madd(p0, (r0 - rm) / (r0 - r1), axis)
             self.limb(p0, pm, r0, rm, color, caps=(caps[0], False))
             self.limb(pm, p1, rm, r1, color, caps=(False, caps[1]))
             return
-        lit = 1.0 if side @ SUN_DIR >= 0 else -1.0
+        sun = dot(side, SUN)
+        lit = 1.0 if sun >= 0 else -1.0
         for sgn in (lit, -lit):
-            s = sgn * side
-            k = 1.0 + (0.13 * abs(float(side @ SUN_DIR)) + 0.04) * (1 if sgn == lit else -1)
+            s = mul(sgn, side)
+            k = 1.0 + (0.13 * abs(sun) + 0.04) * (1 if sgn == lit else -1)
             col = tuple(min(255.0, c * k) for c in color)
             # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
             over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
-            q0 = self._toward_view(p0, nb) - over * s
-            self.rows.append((q0, (r1 + over) * s, axis, col, 0, None))
+            near = self._toward_view(p0, nb)
+            self.rows.append((madd(near, -over, s), mul(r1 + over, s), axis, col, 0, None))
             if r0 - r1 > 1e-6:
                 w = min(r0 - r1 + 0.1 * r1, r1)
-                e2 = axis + (r1 - r0) * s
-                self.rows.append((self._toward_view(p0, nb) + r0 * s, -w * s, e2, col, 0, None))
+                e2 = madd(axis, r1 - r0, s)
+                self.rows.append((madd(near, r0, s), mul(-w, s), e2, col, 0, None))
         for p, r, c in ((p0, r0, caps[0]), (p1, r1, caps[1])):
             if c:
                 self.disc(p, r, r, color)
 
     def disc(self, c, ry: float, rx: float, color, bias: float = 0.0) -> None:
         """A view-facing ellipse centred at c: half-height ry, half-width rx."""
-        c = self._toward_view(np.asarray(c, float), bias)
-        d = self.view - c
-        d /= _norm(d) + 1e-12
-        right = _cross(UP, d)
-        right /= _norm(right) + 1e-12
-        upv = _cross(d, right)
-        self.rows.append((c - rx * right - ry * upv, 2 * rx * right, 2 * ry * upv, tuple(color), 1, None))
+        c = self._toward_view(c, bias)
+        d = sub(self.view, c)
+        n = norm(d) + 1e-12
+        d = (d[0] / n, d[1] / n, d[2] / n)
+        right = cross(UP, d)
+        n = norm(right) + 1e-12
+        right = (right[0] / n, right[1] / n, right[2] / n)
+        upv = cross(d, right)
+        self.rows.append((madd(madd(c, -rx, right), -ry, upv), mul(2 * rx, right), mul(2 * ry, upv), tuple(color),
+                          1, None))
 
     def box(self, center, axes, size, color) -> None:
         """A box (see PatchBuilder.box): center (3,), axes (3, 3) rows = unit x, y, z, size (3,) [m]."""
@@ -134,24 +128,46 @@ class _Figure:
 
     def lowest_z(self) -> float:
         """Lowest z [m] of everything collected so far."""
-        z = np.inf
+        z = math.inf
         for o, e1, e2, _, outline, kind in self.rows:
             if kind == "box":
                 half = (e2 / 2)[:, None] * e1  # rows: half extents along each axis
-                z = min(z, o[2] - np.abs(half[:, 2]).sum())
+                z = min(z, float(o[2] - np.abs(half[:, 2]).sum()))
             elif outline == 1:
                 z = min(z, o[2] + 0.5 * (e1[2] + e2[2]) - 0.5 * math.hypot(e1[2], e2[2]))
             else:
                 z = min(z, o[2] + min(0.0, e1[2]) + min(0.0, e2[2]))
-        return float(z)
+        return z
 
-    def emit(self, b: PatchBuilder) -> None:
-        dz = np.array([0.0, 0.0, -self.lowest_z()])
+    def packed(self) -> np.ndarray:
+        """The patches lowered onto the ground, packed as ``PatchBatch.pack`` packs them: (P, 19) float64."""
+        dz = -self.lowest_z()
+        rows = []
         for o, e1, e2, color, outline, kind in self.rows:
             if kind == "box":
-                b.box(o + dz, e1, e2, color, obj_id=self.oid, bottom=True)
+                b = PatchBuilder()
+                b.box(o + np.array([0.0, 0.0, dz]), e1, e2, color, obj_id=self.oid, bottom=True)
+                rows.extend(b.build().pack())
             else:
-                b.add(o + dz, e1, e2, color, outline=outline, obj_id=self.oid, two_sided=True)
+                # two-sided, shaded, untextured (-1), repeat (1, 1)
+                rows.append((o[0] + 0.0, o[1] + 0.0, o[2] + dz, *e1, *e2, *color, -1, outline, self.oid, 1, 1, 1, 1))
+        return np.array(rows, dtype=np.float64)
+
+
+def _turn(a: float, u: Vec3, b: float, v: Vec3) -> Vec3:
+    """a u + b v."""
+    return (a * u[0] + b * v[0], a * u[1] + b * v[1], a * u[2] + b * v[2])
+
+
+@functools.lru_cache(maxsize=256)
+def _style(style: int) -> tuple:
+    """A figure's look drawn from its style seed, in a fixed order: shirt, trousers, skin, hair and shoe
+    colours (BGR), build, long sleeves, shorts, long hair, bulk (see ``_Body``)."""
+    rng = np.random.default_rng(style & 0xFFFFFFFF)
+    colours = tuple(palette[int(rng.integers(len(palette)))] for palette in (SHIRTS, PANTS, SKINS, HAIR, SHOES))
+    build = float(rng.uniform(0.92, 1.12))
+    flags = tuple(bool(rng.random() < q) for q in (0.5, 0.12, 0.3))
+    return (*colours, build, *flags, float(rng.uniform(1.0, 1.3)))
 
 
 def _scaled(color, k: float) -> tuple:
@@ -166,26 +182,21 @@ class _Body:
     factor), sleeves, shorts, long hair and bulk (upper-body clothing, from a shirt to a padded jacket; the
     hips get half of it), drawn in a fixed order so that a seed always dresses the same figure."""
 
-    def __init__(self, obj: ObjectState, view: np.ndarray):
-        rng = np.random.default_rng(int(obj.style) & 0xFFFFFFFF)
-        self.shirt, self.pants, self.skin, self.hair, self.shoes = (
-            palette[int(rng.integers(len(palette)))] for palette in (SHIRTS, PANTS, SKINS, HAIR, SHOES))
-        self.build = float(rng.uniform(0.92, 1.12))
-        self.long_sleeves, self.shorts, self.long_hair = (bool(rng.random() < q) for q in (0.5, 0.12, 0.3))
-        self.bulk = float(rng.uniform(1.0, 1.3))
+    def __init__(self, obj: ObjectState, view: Vec3):
+        (self.shirt, self.pants, self.skin, self.hair, self.shoes, self.build, self.long_sleeves, self.shorts,
+         self.long_hair, self.bulk) = _style(int(obj.style))
         self.hips = 1.0 + 0.5 * (self.bulk - 1.0)
         p = obj.pose
         self.h = obj.height_m
-        self.fwd = np.array([math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0])
-        self.left = np.array([-self.fwd[1], self.fwd[0], 0.0])
-        self.base = np.array([p.x_m, p.y_m, 0.0])
+        self.fwd = (math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0)
+        self.left = (-self.fwd[1], self.fwd[0], 0.0)
+        self.base = (float(p.x_m), float(p.y_m), 0.0)
         self.walking = obj.speed_mps > 0.05
         self.c = (obj.gait_phase / (2 * math.pi)) % 1.0
-        vdir = view - self.base
-        vdir[2] = 0.0
-        vdir /= _norm(vdir) + 1e-12
-        self.vdir = vdir
-        self.cf = abs(float(vdir @ self.fwd))
+        vdir = (view[0] - self.base[0], view[1] - self.base[1], 0.0)
+        n = norm(vdir) + 1e-12
+        self.vdir = (vdir[0] / n, vdir[1] / n, vdir[2] / n)
+        self.cf = abs(dot(self.vdir, self.fwd))
         self.cs = math.sqrt(max(0.0, 1.0 - self.cf * self.cf))
         self.lean = 0.06 if self.walking else 0.0  # trunk leans forwards a little when walking [rad]
 
@@ -194,13 +205,13 @@ class _Body:
         """(side, gait cycle fraction) of the left (+1) and right (-1) limbs: half a cycle apart."""
         return (+1, self.c), (-1, (self.c + 0.5) % 1.0)
 
-    def pt(self, x, y, z) -> np.ndarray:
+    def pt(self, x, y, z) -> Vec3:
         """The world point x forwards, y left, z up [m] of the figure's base."""
-        return self.base + x * self.fwd + y * self.left + z * UP
+        return madd(madd(madd(self.base, x, self.fwd), y, self.left), z, UP)
 
-    def seg(self, ang) -> np.ndarray:
+    def seg(self, ang) -> Vec3:
         """Unit vector at angle ``ang`` from straight down, rotated forwards (sagittal plane)."""
-        return math.sin(ang) * self.fwd - math.cos(ang) * UP
+        return _turn(math.sin(ang), self.fwd, -math.cos(ang), UP)
 
     def across(self, w, d, bk=None) -> float:
         """How wide a trunk part looks [m]: an elliptic cross-section of width w (across) and depth d (front to
@@ -208,7 +219,7 @@ class _Body:
         bk = self.bulk if bk is None else bk
         return math.hypot(w * self.cf, d * self.cs * bk) * self.h * self.build
 
-    def trunk(self, z, x=0.0) -> np.ndarray:
+    def trunk(self, z, x=0.0) -> Vec3:
         """A point on the trunk's mid-line at height z [fraction of h], leaning forwards about the hips."""
         h = self.h
         return self.pt(x * h + (z - 0.53) * h * math.sin(self.lean), 0.0, z * h)
@@ -227,10 +238,10 @@ def _legs(fig: _Figure, body: _Body) -> None:
             a, knee_flex, toe_down, stance_y = 0.02 * sgn, 0.03, 0.0, 0.055 * h
         b_ang = a - knee_flex
         hip = body.pt(0.0, sgn * stance_y, hip_z)
-        knee = hip + thigh * seg(a)
-        ankle = knee + shank * seg(b_ang)
+        knee = madd(hip, thigh, seg(a))
+        ankle = madd(knee, shank, seg(b_ang))
         if body.shorts:
-            mid = hip + 0.55 * thigh * seg(a)
+            mid = madd(hip, 0.55 * thigh, seg(a))
             fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, bias=0.005)
             fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, body.skin, bias=0.004, caps=(False, True))
             fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, bias=0.005)
@@ -238,10 +249,10 @@ def _legs(fig: _Figure, body: _Body) -> None:
             fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, bias=0.005)
             fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, bias=0.005)
         # the shoe, pitched toe-down at heel-off and toe-up at heel strike
-        f_dir = math.cos(toe_down) * fwd - math.sin(toe_down) * UP
-        f_up = math.sin(toe_down) * fwd + math.cos(toe_down) * UP
+        f_dir = _turn(math.cos(toe_down), fwd, -math.sin(toe_down), UP)
+        f_up = _turn(math.sin(toe_down), fwd, math.cos(toe_down), UP)
         shoe_h = 0.06 * h
-        centre = ankle + 0.28 * foot_l * f_dir + (shoe_h / 2 - ankle_h) * f_up
+        centre = madd(madd(ankle, 0.28 * foot_l, f_dir), shoe_h / 2 - ankle_h, f_up)
         fig.box(centre, np.stack([f_dir, left, f_up]), [foot_l, 0.058 * h * build, shoe_h], body.shoes)
 
 
@@ -266,18 +277,19 @@ def _head(fig: _Figure, body: _Body) -> None:
              bias=0.0, caps=(False, False))
     head_c = body.trunk(0.935, 0.012)
     head_w = (0.048 * cf + 0.055 * cs) * h
-    front = float(body.vdir @ fwd)
+    front = dot(body.vdir, fwd)
     face_bias, hair_bias = (0.02, 0.015) if front > -0.3 else (0.012, 0.02)
     fig.disc(head_c, 0.065 * h, head_w, skin, bias=face_bias)
-    fig.disc(head_c + 0.022 * h * UP - 0.012 * h * fwd, 0.046 * h, head_w * 1.08, hair, bias=hair_bias)
-    fig.disc(head_c + 0.006 * h * UP - 0.02 * h * fwd, 0.058 * h, head_w * 1.02, hair, bias=hair_bias - 0.004)
+    fig.disc(madd(madd(head_c, 0.022 * h, UP), -0.012 * h, fwd), 0.046 * h, head_w * 1.08, hair, bias=hair_bias)
+    fig.disc(madd(madd(head_c, 0.006 * h, UP), -0.02 * h, fwd), 0.058 * h, head_w * 1.02, hair,
+             bias=hair_bias - 0.004)
     if front > -0.2:  # eyes on the front of the head; hidden by the face or hair from behind
         for s in (+1, -1):
-            fig.disc(head_c + 0.046 * h * fwd + 0.018 * h * s * left + 0.004 * h * UP, 0.0055 * h, 0.008 * h,
-                     (40, 35, 35), bias=0.01)
+            eye = madd(madd(madd(head_c, 0.046 * h, fwd), 0.018 * h * s, left), 0.004 * h, UP)
+            fig.disc(eye, 0.0055 * h, 0.008 * h, (40, 35, 35), bias=0.01)
     if body.long_hair:
-        fig.limb(head_c - 0.025 * h * fwd, head_c - 0.03 * h * fwd - 0.13 * h * UP, 0.05 * h, 0.045 * h, hair,
-                 bias=0.012 * cs, caps=(True, False))
+        fig.limb(madd(head_c, -0.025 * h, fwd), madd(madd(head_c, -0.03 * h, fwd), -0.13 * h, UP), 0.05 * h,
+                 0.045 * h, hair, bias=0.012 * cs, caps=(True, False))
 
 
 def _arms(fig: _Figure, body: _Body) -> None:
@@ -292,25 +304,26 @@ def _arms(fig: _Figure, body: _Body) -> None:
             a2 = a + 0.3 + 0.8 * max(0.0, a)
         else:
             a, a2 = 0.0, 0.12
-        sh = body.trunk(0.795) + sgn * 0.113 * h * build * left
-        out = 0.07 * sgn * left  # slight abduction so that the arm hangs clear of the waist
-        elbow = sh + 0.186 * h * (seg(a) + out)
-        wrist = elbow + 0.146 * h * (seg(a2) + 0.5 * out)
+        sh = madd(body.trunk(0.795), sgn * 0.113 * h * build, left)
+        out = mul(0.07 * sgn, left)  # slight abduction so that the arm hangs clear of the waist
+        elbow = madd(sh, 0.186 * h, add(seg(a), out))
+        wrist = madd(elbow, 0.146 * h, madd(seg(a2), 0.5, out))
         fore = sleeve if body.long_sleeves else skin
         fig.limb(sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, bias=0.025)
         fig.limb(elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, bias=0.025, caps=(False, True))
-        fig.disc(wrist + 0.045 * h * seg(a2), 0.042 * h, 0.024 * h, skin, bias=0.03)
+        fig.disc(madd(wrist, 0.045 * h, seg(a2)), 0.042 * h, 0.024 * h, skin, bias=0.03)
 
 
-def pedestrian_patches(b: PatchBuilder, obj: ObjectState, view_world: np.ndarray) -> None:
-    """Add one pedestrian seen from ``view_world`` (3,) [m, world frame]. The pose's yaw is the walking (facing)
-    direction; ``obj.height_m`` its stature; ``obj.style`` seeds clothing, skin, hair and build; ``obj.gait_phase``
-    [rad] the walking cycle (0 = left heel strike), used when ``obj.speed_mps`` > 0.05. The lowest shoe point
-    touches the ground (z = 0) at the pose position; every patch carries ``obj.obj_id``."""
-    view = np.asarray(view_world, dtype=np.float64)
+def pedestrian_packed(obj: ObjectState, view_world) -> np.ndarray:
+    """One pedestrian seen from ``view_world`` (3,) [m, world frame]: its patches packed as ``PatchBatch.pack``
+    packs them, (P, 19). The pose's yaw is the walking (facing) direction; ``obj.height_m`` its stature;
+    ``obj.style`` seeds clothing, skin, hair and build; ``obj.gait_phase`` [rad] the walking cycle (0 = left heel
+    strike), used when ``obj.speed_mps`` > 0.05. The lowest shoe point touches the ground (z = 0) at the pose
+    position; every patch carries ``obj.obj_id``."""
+    view = vec(view_world)
     body = _Body(obj, view)
     fig = _Figure(view, obj.obj_id)
     # the patches in the order they have always been added (legs, trunk, head, arms): it is part of the output
     for part in (_legs, _trunk, _head, _arms):
         part(fig, body)
-    fig.emit(b)
+    return fig.packed()

@@ -24,7 +24,7 @@ from .ground import GroundLayer, Palette
 from .fragments import PreparedPatches, rasterize_prepared
 from .paint import GroundPaint, ground_paint
 from .patches import SUN_DIR, PatchBatch, PatchBuilder
-from .pedestrian import pedestrian_patches
+from .pedestrian import pedestrian_packed
 from .raster import LOD_PX, RenderTarget, prepare
 from .scene import ObjectKind, ObjectState, Scene
 from .scenery import SceneryTextures, build_scenery
@@ -119,7 +119,7 @@ class StereoRenderer:
 
     def _object_packed(self, scene: Scene) -> list[np.ndarray]:
         """Packed patches of the objects in range: rigid templates moved to their poses, pedestrians built."""
-        b = PatchBuilder()
+        people = []
         # the rig centre, between the two cameras: pedestrians' limbs face it, so both cameras see one geometry
         rig_centre = self.rig.camera_position(Side.LEFT) - [0, self.rig.baseline_m / 2, 0]
         view = scene.ego.world_from_vehicle().apply(rig_centre)
@@ -129,7 +129,7 @@ class StereoRenderer:
             if abs(obj.pose.x_m - ex) > SCENERY_RANGE_M or abs(obj.pose.y_m - ey) > SCENERY_RANGE_M:
                 continue
             if obj.kind is ObjectKind.PEDESTRIAN:
-                pedestrian_patches(b, obj, view)
+                people.append(pedestrian_packed(obj, view))
                 continue
             t = self._template(obj)
             parts.append(t)
@@ -147,8 +147,8 @@ class StereoRenderer:
             m[:, 1] += y
             m[:, 14] = oid
             out.append(m)
-        if b._rows:
-            out.append(b.build().pack())
+        if people:
+            out.append(np.concatenate(people))
         return out
 
     def object_patches(self, scene: Scene) -> PatchBatch:
