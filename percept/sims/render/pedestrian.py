@@ -25,7 +25,6 @@ import math
 import numpy as np
 
 from .patches import SUN_DIR
-from .raster import PatchBuilder
 from .scene import ObjectState
 from .vec3 import UP, Vec3, add, cross, dot, madd, mul, norm, sub, vec
 
@@ -121,18 +120,18 @@ class _Figure:
         self.rows.append((madd(madd(c, -rx, right), -ry, upv), mul(2 * rx, right), mul(2 * ry, upv), tuple(color),
                           1, None))
 
-    def box(self, center, axes, size, color) -> None:
-        """A box (see PatchBuilder.box): center (3,), axes (3, 3) rows = unit x, y, z, size (3,) [m]."""
-        self.rows.append((np.asarray(center, float), np.asarray(axes, float), np.asarray(size, float), color, -1,
-                          "box"))
+    def box(self, center: Vec3, axes: tuple[Vec3, Vec3, Vec3], size: Vec3, color) -> None:
+        """A box with its bottom (as PatchBuilder.box makes it): ``center``, ``axes`` (unit x, y, z of the box),
+        ``size`` along them [m]."""
+        self.rows.append((center, axes, size, color, -1, "box"))
 
     def lowest_z(self) -> float:
         """Lowest z [m] of everything collected so far."""
         z = math.inf
         for o, e1, e2, _, outline, kind in self.rows:
             if kind == "box":
-                half = (e2 / 2)[:, None] * e1  # rows: half extents along each axis
-                z = min(z, float(o[2] - np.abs(half[:, 2]).sum()))
+                # the centre less the half extents' heights along each axis
+                z = min(z, o[2] - (abs(e2[0] / 2 * e1[0][2]) + abs(e2[1] / 2 * e1[1][2]) + abs(e2[2] / 2 * e1[2][2])))
             elif outline == 1:
                 z = min(z, o[2] + 0.5 * (e1[2] + e2[2]) - 0.5 * math.hypot(e1[2], e2[2]))
             else:
@@ -145,13 +144,24 @@ class _Figure:
         rows = []
         for o, e1, e2, color, outline, kind in self.rows:
             if kind == "box":
-                b = PatchBuilder()
-                b.box(o + np.array([0.0, 0.0, dz]), e1, e2, color, obj_id=self.oid, bottom=True)
-                rows.extend(b.build().pack())
+                # one-sided, shaded, untextured faces, outwards as PatchBuilder.box orients them
+                rows += [(*f, *a, *b, *color, -1, 0, self.oid, 0, 1, 1, 1)
+                         for f, a, b in _box_faces((o[0] + 0.0, o[1] + 0.0, o[2] + dz), e1, e2)]
             else:
                 # two-sided, shaded, untextured (-1), repeat (1, 1)
                 rows.append((o[0] + 0.0, o[1] + 0.0, o[2] + dz, *e1, *e2, *color, -1, outline, self.oid, 1, 1, 1, 1))
         return np.array(rows, dtype=np.float64)
+
+
+def _box_faces(c: Vec3, axes: tuple[Vec3, Vec3, Vec3], size: Vec3) -> list[tuple[Vec3, Vec3, Vec3]]:
+    """(origin, e1, e2) of a box's front, back, left, right, top and bottom faces, as ``PatchBuilder.box``."""
+    hx, hy, hz = (mul(size[k] / 2, axes[k]) for k in range(3))
+    return [(sub(sub(add(c, hx), hy), hz), mul(2, hy), mul(2, hz)),
+            (sub(add(sub(c, hx), hy), hz), mul(-2, hy), mul(2, hz)),
+            (sub(add(add(c, hx), hy), hz), mul(-2, hx), mul(2, hz)),
+            (sub(sub(sub(c, hx), hy), hz), mul(2, hx), mul(2, hz)),
+            (add(sub(sub(c, hx), hy), hz), mul(2, hx), mul(2, hy)),
+            (sub(add(sub(c, hx), hy), hz), mul(2, hx), mul(-2, hy))]
 
 
 def _turn(a: float, u: Vec3, b: float, v: Vec3) -> Vec3:
@@ -253,7 +263,7 @@ def _legs(fig: _Figure, body: _Body) -> None:
         f_up = _turn(math.sin(toe_down), fwd, math.cos(toe_down), UP)
         shoe_h = 0.06 * h
         centre = madd(madd(ankle, 0.28 * foot_l, f_dir), shoe_h / 2 - ankle_h, f_up)
-        fig.box(centre, np.stack([f_dir, left, f_up]), [foot_l, 0.058 * h * build, shoe_h], body.shoes)
+        fig.box(centre, (f_dir, left, f_up), (foot_l, 0.058 * h * build, shoe_h), body.shoes)
 
 
 def _trunk(fig: _Figure, body: _Body) -> None:
