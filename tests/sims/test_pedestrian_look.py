@@ -164,3 +164,22 @@ def test_the_figure_builders_vector_formulas_equal_numpys():
         assert np.array_equal(mul(k, ta), k * a) and np.array_equal(madd(ta, k, tb), a + k * b)
         assert dot(ta, tb) == pytest.approx(float(a @ b), rel=1e-15, abs=1e-15 * float(np.abs(a) @ np.abs(b)))
         assert norm(ta) == pytest.approx(float(np.linalg.norm(a)), rel=4e-16)
+
+
+def test_a_figures_box_faces_are_the_patch_builders():
+    """The shoes are built as tuples; their packed faces equal ``PatchBuilder.box``'s bit for bit."""
+    from percept.sims.render import PatchBuilder
+    from percept.sims.render.pedestrian import _box_faces
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        c, size = rng.normal(size=3) * 10, rng.uniform(0.01, 0.3, size=3)
+        axes, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        b = PatchBuilder()
+        b.box(c, axes, size, (10, 20, 30), bottom=True)
+        want = b.build()
+        got = _box_faces(tuple(c), tuple(map(tuple, axes)), tuple(size))
+        for k, (o, e1, e2) in enumerate(got):
+            assert np.array_equal(o, want.origin[k]) and np.array_equal(e1, want.e1[k])
+            assert np.array_equal(e2, want.e2[k])
+        assert len(got) == len(want.origin)
