@@ -89,7 +89,7 @@ def test_drive_config_names_the_bad_task_or_source():
 
 
 @pytest.mark.parametrize("scenario, seed, group, key, value", [
-    # pinned bit for bit: first at the commit before the slot table (03a7a61, which the refactor kept), then re-measured
+    # pinned (to the last bits): first at the commit before the slot table (03a7a61, which the refactor kept), then re-measured
     # when the following law (gap referred to the lead's speed, braking capped behind standing targets) and the
     # lead-brake and cut-in scenarios (steady following before the event) changed; any change must be deliberate
     ("lead-brake", 0, "longitudinal", "time_gap_min_s", 1.5985146569594249),
@@ -101,7 +101,9 @@ def test_drive_config_names_the_bad_task_or_source():
 ])
 def test_privileged_metrics_are_pinned(scenario, seed, group, key, value):
     r = run_drive(DriveConfig(WorldConfig(scenario, seed)), render=False)
-    assert r[group][key] == value
+    # to the last few bits: numpy picks its SIMD kernels by the CPU, so sums can round differently on another
+    # machine (curves' centring RMS differed in the 16th digit on an AVX-512 CPU); a change of behaviour moves more
+    assert r[group][key] == (pytest.approx(value, rel=1e-12, abs=0) if isinstance(value, float) else value)
     assert r["collisions"] == 0 and r["lane_departures"] == 0
 
 
