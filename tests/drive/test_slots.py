@@ -89,9 +89,10 @@ def test_drive_config_names_the_bad_task_or_source():
 
 
 @pytest.mark.parametrize("scenario, seed, group, key, value", [
-    # pinned (to the last bits): first at the commit before the slot table (03a7a61, which the refactor kept), then
-    # re-measured when the following law (gap referred to the lead's speed, braking capped behind standing targets) and the
-    # lead-brake and cut-in scenarios (steady following before the event) changed; any change must be deliberate
+    # pinned (to the last bits): first at the commit before the slot table (03a7a61, which the refactor kept),
+    # then re-measured when the following law (gap referred to the lead's speed, braking capped behind standing
+    # targets) and the lead-brake and cut-in scenarios (steady following before the event) changed; any change
+    # must be deliberate
     ("lead-brake", 0, "longitudinal", "time_gap_min_s", 1.5985146569594249),
     ("lead-brake", 0, "longitudinal", "time_gap_steady_s", 1.8062480963572944),
     ("cut-in", 1, "longitudinal", "time_gap_min_s", 0.4391419492821637),
