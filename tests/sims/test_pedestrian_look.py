@@ -13,6 +13,7 @@ import math
 
 import cv2
 import numpy as np
+import numpy.testing as npt
 import pytest
 from highway_env.road.road import RoadNetwork
 
@@ -166,20 +167,23 @@ def test_the_figure_builders_vector_formulas_equal_numpys():
         assert norm(ta) == pytest.approx(float(np.linalg.norm(a)), rel=4e-16)
 
 
-def test_a_figures_box_faces_are_the_patch_builders():
-    """The shoes are built as tuples; their packed faces equal ``PatchBuilder.box``'s bit for bit."""
-    from percept.sims.render import PatchBuilder
-    from percept.sims.render.pedestrian import _box_faces
+def test_box_faces_are_the_boxs_six_sides_facing_out():
+    """``box_faces`` (PatchBuilder.box's and the shoes'): front, back, left, right, top, bottom, each centred half
+    the box's size from its centre along its axis, spanning the other two, e1 x e2 outwards."""
+    from percept.sims.render.patches import box_faces
 
     rng = np.random.default_rng(3)
     for _ in range(50):
-        c, size = rng.normal(size=3) * 10, rng.uniform(0.01, 0.3, size=3)
+        c, size = rng.normal(size=3) * 10, rng.uniform(0.01, 3.0, size=3)
         axes, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        b = PatchBuilder()
-        b.box(c, axes, size, (10, 20, 30), bottom=True)
-        want = b.build()
-        got = _box_faces(tuple(c), tuple(map(tuple, axes)), tuple(size))
-        for k, (o, e1, e2) in enumerate(got):
-            assert np.array_equal(o, want.origin[k]) and np.array_equal(e1, want.e1[k])
-            assert np.array_equal(e2, want.e2[k])
-        assert len(got) == len(want.origin)
+        axes = axes.T
+        faces = box_faces(tuple(c), tuple(map(tuple, axes)), tuple(size))
+        assert len(faces) == 6
+        for (o, e1, e2), (k, sign) in zip(faces, [(0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1)]):
+            o, e1, e2 = (np.asarray(v) for v in (o, e1, e2))
+            out = sign * axes[k]
+            npt.assert_allclose(o + (e1 + e2) / 2 - c, out * size[k] / 2, atol=1e-9)
+            n = np.cross(e1, e2)
+            assert n @ out > 0
+            others = [j for j in range(3) if j != k]
+            npt.assert_allclose(sorted([np.linalg.norm(e1), np.linalg.norm(e2)]), sorted(size[others]), rtol=1e-12)

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .vec3 import Vec3, add, mul, sub, vec
+
 SUN_DIR = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 """Unit vector towards the sun in the world frame (x forward, y left, z up); shading of every patch."""
 
@@ -70,6 +72,18 @@ class PatchBatch:
                           a[:, 17:19])
 
 
+def box_faces(c: Vec3, axes: tuple[Vec3, Vec3, Vec3], size: Vec3) -> list[tuple[Vec3, Vec3, Vec3]]:
+    """(origin, e1, e2) of the front (+x), back, left (+y), right, top (+z) and bottom faces of the box centred at
+    ``c`` with unit ``axes`` x, y, z and ``size`` along them [m]; e1 x e2 points outwards (for back-face culling)."""
+    hx, hy, hz = (mul(size[k] / 2, axes[k]) for k in range(3))
+    return [(sub(sub(add(c, hx), hy), hz), mul(2, hy), mul(2, hz)),
+            (sub(add(sub(c, hx), hy), hz), mul(-2, hy), mul(2, hz)),
+            (sub(add(add(c, hx), hy), hz), mul(-2, hx), mul(2, hz)),
+            (sub(sub(sub(c, hx), hy), hz), mul(2, hx), mul(2, hz)),
+            (add(sub(sub(c, hx), hy), hz), mul(2, hx), mul(2, hy)),
+            (sub(add(sub(c, hx), hy), hz), mul(2, hx), mul(-2, hy))]
+
+
 class PatchBuilder:
     """Accumulates patches one by one (readable model code), then packs them into a PatchBatch."""
 
@@ -87,19 +101,9 @@ class PatchBuilder:
         faces: which of front (+x), back, left (+y), right, top to add (plus the bottom if ``bottom``).
         Faces are oriented so that e1 x e2 points outwards (for back-face culling).
         """
-        c = np.asarray(center, dtype=np.float64)
-        ax = np.asarray(axes, dtype=np.float64)
-        hx, hy, hz = (np.asarray(size, dtype=np.float64) / 2)[:, None] * ax
-        all_faces = {
-            "f": (c + hx - hy - hz, 2 * hy, 2 * hz),  # front (+x)
-            "b": (c - hx + hy - hz, -2 * hy, 2 * hz),  # back (-x)
-            "l": (c + hx + hy - hz, -2 * hx, 2 * hz),  # left (+y)
-            "r": (c - hx - hy - hz, 2 * hx, 2 * hz),  # right (-y)
-            "t": (c - hx - hy + hz, 2 * hx, 2 * hy),  # top (+z)
-        }
-        chosen = [all_faces[k] for k in faces]
-        if bottom:
-            chosen.append((c - hx + hy - hz, 2 * hx, -2 * hy))
+        front, back, left, right, top, under = box_faces(vec(center), tuple(vec(a) for a in axes), vec(size))
+        all_faces = {"f": front, "b": back, "l": left, "r": right, "t": top}
+        chosen = [all_faces[k] for k in faces] + ([under] if bottom else [])
         for o, a, b in chosen:
             self.add(o, a, b, color, texture=texture, obj_id=obj_id, shade=shade)
 

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from .patches import SUN_DIR
+from .patches import SUN_DIR, box_faces
 from .scene import ObjectState
 from .vec3 import UP, Vec3, add, cross, dot, madd, mul, norm, sub, vec
 
@@ -63,6 +63,8 @@ class _Figure:
 
     def _toward_view(self, p: Vec3, bias: float) -> Vec3:
         # p + bias d / |d|, d the horizontal direction from p to the viewer
+        if bias == 0.0:
+            return p
         d = (self.view[0] - p[0], self.view[1] - p[1], 0.0)
         n = norm(d) + 1e-12
         return (p[0] + bias * d[0] / n, p[1] + bias * d[1] / n, p[2] + bias * d[2] / n)
@@ -146,22 +148,11 @@ class _Figure:
             if kind == "box":
                 # one-sided, shaded, untextured faces, outwards as PatchBuilder.box orients them
                 rows += [(*f, *a, *b, *color, -1, 0, self.oid, 0, 1, 1, 1)
-                         for f, a, b in _box_faces((o[0] + 0.0, o[1] + 0.0, o[2] + dz), e1, e2)]
+                         for f, a, b in box_faces((o[0] + 0.0, o[1] + 0.0, o[2] + dz), e1, e2)]
             else:
                 # two-sided, shaded, untextured (-1), repeat (1, 1)
                 rows.append((o[0] + 0.0, o[1] + 0.0, o[2] + dz, *e1, *e2, *color, -1, outline, self.oid, 1, 1, 1, 1))
         return np.array(rows, dtype=np.float64)
-
-
-def _box_faces(c: Vec3, axes: tuple[Vec3, Vec3, Vec3], size: Vec3) -> list[tuple[Vec3, Vec3, Vec3]]:
-    """(origin, e1, e2) of a box's front, back, left, right, top and bottom faces, as ``PatchBuilder.box``."""
-    hx, hy, hz = (mul(size[k] / 2, axes[k]) for k in range(3))
-    return [(sub(sub(add(c, hx), hy), hz), mul(2, hy), mul(2, hz)),
-            (sub(add(sub(c, hx), hy), hz), mul(-2, hy), mul(2, hz)),
-            (sub(add(add(c, hx), hy), hz), mul(-2, hx), mul(2, hz)),
-            (sub(sub(sub(c, hx), hy), hz), mul(2, hx), mul(2, hz)),
-            (add(sub(sub(c, hx), hy), hz), mul(2, hx), mul(2, hy)),
-            (sub(add(sub(c, hx), hy), hz), mul(2, hx), mul(-2, hy))]
 
 
 def _turn(a: float, u: Vec3, b: float, v: Vec3) -> Vec3:
