@@ -1,0 +1,199 @@
+"""Compiled per-pixel loops of the rasteriser (numba, cached on disk): the large patches one by one over their
+boxes, the small ones as one fragment per inside pixel, and the shading of the small ones' winners.
+
+The arithmetic is the vectorised numpy version's, operation for operation and in its precision (float32 for
+1/Z and texture coordinates, float64 where numpy promoted), so the images are the same bit for bit: every
+float32 value is cast explicitly, because numba (unlike numpy) widens float32 with a float64 literal to
+float64. ``fragments.py`` holds what OpenCV does (texture warps and samples) and the order of the passes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+f32 = np.float32
+
+
+@njit(cache=True)
+def _push(buf, n, value):  # pragma: no cover - compiled
+    """Append ``value`` to the growable buffer ``buf`` holding ``n`` items; returns the (maybe new) buffer."""
+    if n == len(buf):
+        grown = np.empty(2 * len(buf) + 1024, buf.dtype)
+        grown[:n] = buf[:n]
+        buf = grown
+    buf[n] = value
+    return buf
+
+
+@njit(cache=True)
+def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, ellipse, span_row, los, his,
+                obj_id, emissive, color_u8, defer, want_sil, inv_near):  # pragma: no cover - compiled
+    """Patches ``order[k]`` one by one over their boxes, z-tested against ``wbuf`` (H, W) float32 and written to
+    it, to ``ids`` and ``em`` (empty arrays to skip) and to ``img`` (H, W, 3) uint8 in the colour ``color_u8``,
+    except the patches with ``defer`` (textured), whose colour is written afterwards where ``winner`` (H, W),
+    the order index k of the last patch that won each pixel, still names them. ``span_row[i]``: the patch's
+    first row in ``los``, ``his`` (its inside columns per box row), or -1 for a patch crossing the near plane
+    (the exact test per pixel, c < ``inv_near``). Returns the pixels each k holds at the end and, when
+    ``want_sil``, every inside pixel (flat index) of the patches with an object id > 0 and that id."""
+    H, W = wbuf.shape
+    has_ids, has_em = ids.size > 0, em.size > 0
+    held = np.zeros(len(order), np.int64)
+    sil_pix = np.empty(0, np.int32)
+    sil_oid = np.empty(0, np.int32)
+    ns = 0
+    for k in range(len(order)):
+        i = order[k]
+        oid = obj_id[i]
+        sil = want_sil and oid > 0
+        mc0, mc1, mc2 = f32(mc[i, 0]), f32(mc[i, 1]), f32(mc[i, 2])
+        ma0, ma1, ma2 = f32(ma[i, 0]), f32(ma[i, 1]), f32(ma[i, 2])
+        mb0, mb1, mb2 = f32(mb[i, 0]), f32(mb[i, 1]), f32(mb[i, 2])
+        r = span_row[i]
+        for y in range(y0[i], y1[i]):
+            fy = f32(y)
+            # c(u, v) = 1/Z = mc0 u + mc1 v + mc2
+            cy = mc1 * fy + mc2
+            ay = ma1 * fy + ma2
+            by = mb1 * fy + mb2
+            for x in range(x0[i], x1[i]):
+                fx = f32(x)
+                c = mc0 * fx + cy
+                if r >= 0:
+                    inside = los[r + y - y0[i]] <= x <= his[r + y - y0[i]]
+                else:
+                    # crossing the near plane: the exact test per pixel, with c < 1/near
+                    ap = ma0 * fx + ay
+                    bp = mb0 * fx + by
+                    if ellipse[i]:
+                        inside = ap * ap + bp * bp <= c * c
+                    else:
+                        inside = max(abs(ap), abs(bp)) <= c
+                    inside = inside and c < inv_near and c > 0
+                if not inside:
+                    continue
+                if sil:
+                    sil_pix = _push(sil_pix, ns, y * W + x)
+                    sil_oid = _push(sil_oid, ns, oid)
+                    ns += 1
+                if not c > wbuf[y, x]:
+                    continue
+                wbuf[y, x] = c
+                if has_ids:
+                    ids[y, x] = oid
+                if has_em:
+                    em[y, x] = f32(emissive[i])
+                if winner[y, x] >= 0:
+                    held[winner[y, x]] -= 1
+                winner[y, x] = k
+                held[k] += 1
+                if not defer[i]:
+                    for ch in range(3):
+                        img[y, x, ch] = color_u8[i, ch]
+    return held, sil_pix[:ns], sil_oid[:ns]
+
+
+@njit(cache=True)
+def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # pragma: no cover - compiled
+    """One fragment per pixel centre first..last of each span (patch rp, row v): its 1/Z is written to ``wflat``
+    where it is the largest (the z-buffer). Returns the winners (fragments whose 1/Z is the pixel's largest;
+    equal ones are all kept): pixel, span, offset k along the span and 1/Z; and, when ``want_sil``, every
+    fragment's pixel and object id for the patches with an id > 0."""
+    total = 0
+    for s in range(len(rp)):
+        total += max(last[s] - first[s] + 1, 0)
+    fpix = np.empty(total, np.int32)
+    fspan = np.empty(total, np.int32)
+    fk = np.empty(total, np.float32)
+    fc = np.empty(total, np.float32)
+    m = 0
+    for s in range(len(rp)):
+        n = last[s] - first[s] + 1
+        if n <= 0:
+            continue
+        i = rp[s]
+        # c at the span's first pixel plus its slope along the row
+        c0 = f32(mc[i, 0] * first[s] + mc[i, 1] * v[s] + mc[i, 2])
+        slope = f32(mc[i, 0])
+        base = np.int32(v[s] * W + first[s])
+        for k in range(n):
+            kf = f32(k)
+            c = c0 + slope * kf
+            p = base + k
+            fpix[m], fspan[m], fk[m], fc[m] = p, s, kf, c
+            if c > wflat[p]:
+                wflat[p] = c
+            m += 1
+    nw = 0
+    for f in range(total):
+        if fc[f] == wflat[fpix[f]]:
+            nw += 1
+    wpix = np.empty(nw, np.int32)
+    wspan = np.empty(nw, np.int32)
+    wk = np.empty(nw, np.float32)
+    wc = np.empty(nw, np.float32)
+    j = 0
+    for f in range(total):
+        if fc[f] == wflat[fpix[f]]:
+            wpix[j], wspan[j], wk[j], wc[j] = fpix[f], fspan[f], fk[f], fc[f]
+            j += 1
+    ns = 0
+    if want_sil:
+        for f in range(total):
+            if obj_id[rp[fspan[f]]] > 0:
+                ns += 1
+    sil_pix = np.empty(ns, np.int32)
+    sil_oid = np.empty(ns, np.int32)
+    j = 0
+    if want_sil:
+        for f in range(total):
+            o = obj_id[rp[fspan[f]]]
+            if o > 0:
+                sil_pix[j], sil_oid[j] = fpix[f], o
+                j += 1
+    return wpix, wspan, wk, wc, sil_pix, sil_oid
+
+
+@njit(cache=True)
+def texel_coords(wspan, wk, wc, rp, v, first, ma, mb, entry, texsize, rects):  # pragma: no cover - compiled
+    """Atlas coordinates (x, y) float32 of the textured winners (-1 where a winner is untextured):
+    s = (a'/c + 1)/2 times the texels across, wrapped into the entry's tile, plus the tile's origin."""
+    n = len(wspan)
+    tx = np.full(n, f32(-1.0))
+    ty = np.full(n, f32(-1.0))
+    one = f32(1.0)
+    for w in range(n):
+        s = wspan[w]
+        i = rp[s]
+        e = entry[i]
+        if e < 0:
+            continue
+        # a' = a'_0 + a'_u k, b' likewise, with a'_0 = ma0 lo + ma1 v + ma2 at the span's first pixel
+        a0 = f32(ma[i, 0] * first[s] + ma[i, 1] * v[s] + ma[i, 2])
+        b0 = f32(mb[i, 0] * first[s] + mb[i, 1] * v[s] + mb[i, 2])
+        ap = a0 + f32(ma[i, 0]) * wk[w]
+        bp = b0 + f32(mb[i, 0]) * wk[w]
+        hx, hy = f32(0.5 * texsize[i, 0]), f32(0.5 * texsize[i, 1])
+        ex, ey, ew, eh = f32(rects[e, 0]), f32(rects[e, 1]), f32(rects[e, 2]), f32(rects[e, 3])
+        x = (ap / wc[w] + one) * hx
+        y = (bp / wc[w] + one) * hy
+        x -= f32(np.floor(x / ew)) * ew
+        y -= f32(np.floor(y / eh)) * eh
+        tx[w], ty[w] = x + ex, y + ey
+    return tx, ty
+
+
+@njit(cache=True)
+def shade_winners(img, ids, em, wpix, wspan, rp, obj_id, emissive, color, albedo):  # pragma: no cover - compiled
+    """Write each winner's object id, lamp flag and colour = shaded colour x albedo (float32, truncated), in
+    order (the last of equal fragments wins); ``img`` (H W, 3), ``ids`` and ``em`` flat (empty to skip)."""
+    has_ids, has_em = ids.size > 0, em.size > 0
+    for w in range(len(wpix)):
+        p, i = wpix[w], rp[wspan[w]]
+        if has_ids:
+            ids[p] = obj_id[i]
+        if has_em:
+            em[p] = f32(emissive[i])
+        a = albedo[w]
+        for ch in range(3):
+            img[p, ch] = np.uint8(color[i, ch] * a)

@@ -1,0 +1,73 @@
+"""The rasteriser's two compiled paths (large patches one by one, small ones as fragments) draw the same picture:
+the same scene forced through one path and then the other gives the same image, ids, lamp map and silhouettes."""
+
+import numpy as np
+import pytest
+
+from percept.sensors import PinholeCamera, Transform
+from percept.sims.render import fragments
+from percept.sims.render.patches import PatchBuilder
+from percept.sims.render.raster import RenderTarget, rasterize
+
+CAM = PinholeCamera(150.0, 150.0, 80.0, 60.0, 160, 120)
+
+
+def scene() -> PatchBuilder:
+    """Untextured quads and discs at several depths, overlapping, tilted, one of them a lamp."""
+    b = PatchBuilder()
+    rng = np.random.default_rng(5)
+    for k in range(14):
+        z = 3.0 + 0.7 * k
+        o = np.array([rng.uniform(-2, 1), rng.uniform(-1.5, 0.5), z])
+        e1 = np.array([rng.uniform(0.5, 1.5), 0.0, rng.uniform(-0.5, 0.5)])
+        e2 = np.array([rng.uniform(-0.3, 0.3), rng.uniform(0.5, 1.2), 0.0])
+        b.add(o, e1, e2, tuple(rng.uniform(20, 250, 3)), outline=int(k % 3 == 0), two_sided=True, shade=k % 4 != 1,
+              obj_id=k + 1)
+    return b
+
+
+def draw(monkeypatch, big_px: float) -> RenderTarget:
+    monkeypatch.setattr(fragments, "BIG_PX", big_px)
+    h, w = CAM.height, CAM.width
+    target = RenderTarget(np.full((h, w, 3), 30, np.uint8), np.full((h, w), np.inf, np.float32),
+                          np.zeros((h, w), np.int32), emission=np.zeros((h, w), np.float32))
+    rasterize(target, scene().build(), CAM, Transform(np.eye(3), np.zeros(3)), [np.zeros((4, 4), np.uint8)],
+              np.array([0.3, -1.0, -0.5]) / np.linalg.norm([0.3, -1.0, -0.5]))
+    return target
+
+
+def test_large_and_small_patch_paths_draw_the_same_picture(monkeypatch):
+    one_by_one = draw(monkeypatch, -1.0)   # every patch large: boxes, one at a time
+    fragments_ = draw(monkeypatch, np.inf)  # every patch small: fragments, all at once
+    assert (one_by_one.ids > 0).sum() > 3000, "the scene should cover a good part of the image"
+    assert len(np.unique(one_by_one.ids)) >= 10
+    np.testing.assert_array_equal(one_by_one.ids, fragments_.ids)
+    np.testing.assert_array_equal(one_by_one.image, fragments_.image)
+    np.testing.assert_array_equal(one_by_one.emission, fragments_.emission)
+    assert one_by_one.emission.max() == 1.0
+    np.testing.assert_allclose(one_by_one.depth, fragments_.depth, rtol=1e-6)
+    assert sorted(one_by_one.silhouettes) == sorted(fragments_.silhouettes)
+    for oid in one_by_one.silhouettes:
+        assert one_by_one.silhouette(oid) == fragments_.silhouette(oid)
+        # a silhouette counts every pixel the patch covers, hidden or not: more than it shows
+        box, count, seen = one_by_one.silhouette(oid)
+        assert 0 <= seen <= count
+
+
+@pytest.mark.parametrize("big_px", [-1.0, np.inf])
+def test_a_patch_behind_another_is_hidden_in_both_paths(monkeypatch, big_px):
+    monkeypatch.setattr(fragments, "BIG_PX", big_px)
+    h, w = CAM.height, CAM.width
+    target = RenderTarget(np.zeros((h, w, 3), np.uint8), None, np.zeros((h, w), np.int32),
+                          np.zeros((h, w), np.float32))
+    b = PatchBuilder()
+    # added far, near, farther: the near one wins whatever the order
+    for z, grey, oid in ((6.0, 200.0, 1), (4.0, 100.0, 2), (8.0, 50.0, 3)):
+        b.add(np.array([-1.0, -1.0, z]), np.array([2.0, 0, 0]), np.array([0, 2.0, 0]), (grey,) * 3,
+              two_sided=True, shade=False, obj_id=oid)
+    rasterize(target, b.build(), CAM, Transform(np.eye(3), np.zeros(3)), [np.zeros((4, 4), np.uint8)],
+              np.array([0.0, 0.0, -1.0]))
+    # the centre pixel sees the nearest patch (z = 4): its id, its colour and 1/Z = 1/4
+    assert target.ids[60, 80] == 2
+    assert tuple(target.image[60, 80]) == (100, 100, 100)
+    assert target.inv_depth[60, 80] == pytest.approx(0.25, rel=1e-6)
