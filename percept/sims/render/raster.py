@@ -24,6 +24,7 @@ import numpy as np
 
 from percept.sensors import PinholeCamera, Transform
 
+from .cull import inverse_rows, project_patches
 from .fragments import NEAR_M, PreparedPatches, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
 from .textures import TextureAtlas
@@ -33,8 +34,6 @@ __all__ = ["ELLIPSE", "LOD_PX", "NEAR_M", "OUTLINES", "QUAD", "PatchBatch", "Pat
 
 LOD_PX = 0.5
 """Scenery patches narrower than this on screen [px] are skipped."""
-_NEXT = np.array([1, 2, 3, 0])
-"""Index of the next corner around a patch."""
 
 
 @dataclass
@@ -149,48 +148,14 @@ def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transfo
 def _project(batch: PatchBatch, cam: PinholeCamera, O: np.ndarray, E1: np.ndarray, E2: np.ndarray,
              N: np.ndarray) -> dict | None:
     """Per camera (patches in its frame: O, E1, E2, normals N): back faces and patches behind the near plane
-    culled, the rest with their pixel box (x0, x1, y0, y1), nearest depth, crossing flag, area, width."""
-    W, H = cam.width, cam.height
-    fx, fy, cx, cy = cam.fx, cam.fy, cam.cx, cam.cy
-    # back-face test: a face is seen from the front when n·(o - camera) < 0, the camera being the origin
-    keep = (_dot(N, O) < 0) | batch.two_sided
-    # corners in order o, o + e1, o + e1 + e2, o + e2: depths first, for the near-plane test
-    z = np.column_stack([O[:, 2], O[:, 2] + E1[:, 2], O[:, 2] + E1[:, 2] + E2[:, 2], O[:, 2] + E2[:, 2]])
-    keep &= z.max(axis=1) > NEAR_M
-    idx = np.flatnonzero(keep)
+    culled, the rest with their pixel box (x0, x1, y0, y1), nearest depth, crossing flag, area, width
+    (``cull.project_patches``)."""
+    idx, box, zmin, crossing, area, width = project_patches(O, E1, E2, N, batch.two_sided, cam.fx, cam.fy, cam.cx,
+                                                            cam.cy, cam.width, cam.height, NEAR_M)
     if not len(idx):
         return None
-    o, e1, e2, z = O[idx], E1[idx], E2[idx], z[idx]
-    C = np.stack([o, o + e1, o + e1 + e2, o + e2], axis=1)  # (P, 4, 3)
-    zmin = z.min(axis=1)
-    crossing = zmin < NEAR_M
-    if crossing.any():
-        # polygon clipped at z = NEAR: corners in front plus the edge crossings a + (near - z_a)/(z_b - z_a) (b - a)
-        Cn, zn = C[:, _NEXT], z[:, _NEXT]
-        cross = (z - NEAR_M) * (zn - NEAR_M) < 0
-        f = np.where(cross, NEAR_M - z, 0.0) / np.where(cross, zn - z, 1.0)
-        X = np.where(cross[..., None], C + f[..., None] * (Cn - C), np.nan)
-        P8 = np.concatenate([np.where((z >= NEAR_M)[..., None], C, np.nan), X], axis=1)
-    else:
-        P8 = C
-    with np.errstate(invalid="ignore"):
-        # u = fx x / z + cx, v = fy y / z + cy
-        u = fx * P8[..., 0] / P8[..., 2] + cx
-        v = fy * P8[..., 1] / P8[..., 2] + cy
-        # pixel centres k with umin <= k <= umax (fmin and fmax skip the NaNs of corners behind the near plane)
-        x0 = np.clip(np.ceil(np.fmin.reduce(u, axis=1)), 0, W).astype(int)
-        x1 = np.clip(np.floor(np.fmax.reduce(u, axis=1)) + 1, 0, W).astype(int)
-        y0 = np.clip(np.ceil(np.fmin.reduce(v, axis=1)), 0, H).astype(int)
-        y1 = np.clip(np.floor(np.fmax.reduce(v, axis=1)) + 1, 0, H).astype(int)
-        # projected size of patches fully in front: area (shoelace) and width = area / longest side
-        uc, vc = u[:, :4], v[:, :4]
-        ur, vr = uc[:, _NEXT], vc[:, _NEXT]
-        area = 0.5 * np.abs(np.sum(uc * vr - ur * vc, axis=1))
-        width = area / np.sqrt(((uc - ur) ** 2 + (vc - vr) ** 2).max(axis=1))
-    area[crossing] = np.nan
-    width[crossing] = np.nan
-    return dict(idx=idx, o=o, e1=e1, e2=e2, x0=x0, x1=x1, y0=y0, y1=y1, zmin=zmin, crossing=crossing, area=area,
-                width=width)
+    return dict(idx=idx, o=O[idx], e1=E1[idx], e2=E2[idx], x0=box[:, 0], x1=box[:, 1], y0=box[:, 2], y1=box[:, 3],
+                zmin=zmin, crossing=crossing, area=area, width=width)
 
 
 def _mip_levels(batch: PatchBatch, atlas: TextureAtlas, area: np.ndarray) -> np.ndarray:
@@ -211,22 +176,12 @@ def _mip_levels(batch: PatchBatch, atlas: TextureAtlas, area: np.ndarray) -> np.
 def _finish(batch: PatchBatch, cam: PinholeCamera, v: dict, tiny: np.ndarray, level: np.ndarray, colors: np.ndarray,
             atlas: TextureAtlas) -> PreparedPatches | None:
     """The camera's drawable patches and their affine rows a', b', c (see fragments.py)."""
-    idx, o, e1, e2 = v["idx"], v["o"], v["e1"], v["e2"]
-    fx, fy, cx, cy = cam.fx, cam.fy, cam.cx, cam.cy
+    idx = v["idx"]
     ok = (v["x1"] > v["x0"]) & (v["y1"] > v["y0"]) & ~(tiny[idx] & ~v["crossing"])
-    # A = K [e1 e2 o]; A^-1 rows are (a2 x a3, a3 x a1, a1 x a2) / det
-    a1 = np.column_stack([fx * e1[:, 0] + cx * e1[:, 2], fy * e1[:, 1] + cy * e1[:, 2], e1[:, 2]])
-    a2 = np.column_stack([fx * e2[:, 0] + cx * e2[:, 2], fy * e2[:, 1] + cy * e2[:, 2], e2[:, 2]])
-    a3 = np.column_stack([fx * o[:, 0] + cx * o[:, 2], fy * o[:, 1] + cy * o[:, 2], o[:, 2]])
-    r0, r1, r2 = _cross(a2, a3), _cross(a3, a1), _cross(a1, a2)
-    det = _dot(a1, r0)
-    scale = np.sqrt(_dot(a1, a1) * _dot(a2, a2) * _dot(a3, a3))
-    ok &= np.abs(det) > 1e-9 * scale
-    sel = np.flatnonzero(ok)
+    # the affine rows a', b', c of each patch from A^-1, A = K [e1 e2 o] (singular ones dropped)
+    sel, ma, mb, mc = inverse_rows(v["o"], v["e1"], v["e2"], ok, cam.fx, cam.fy, cam.cx, cam.cy)
     if not len(sel):
         return None
-    det = det[sel, None]
-    m0, m1, m2 = r0[sel] / det, r1[sel] / det, r2[sel] / det
     pi = idx[sel]
     tex = batch.texture[pi]
     has = tex >= 0
@@ -237,7 +192,7 @@ def _finish(batch: PatchBatch, cam: PinholeCamera, v: dict, tiny: np.ndarray, le
     return PreparedPatches(
         x0=v["x0"][sel], x1=v["x1"][sel], y0=v["y0"][sel], y1=v["y1"][sel],
         # affine rows of a' = 2 s/Z - 1/Z, b' = 2 t/Z - 1/Z, c = 1/Z: inside a quad iff max(|a'|, |b'|) <= c
-        ma=2 * m0 - m2, mb=2 * m1 - m2, mc=m2,
+        ma=ma, mb=mb, mc=mc,
         ellipse=batch.outline[pi] == 1, crossing=crossing, zmin=np.maximum(v["zmin"][sel], NEAR_M),
         area=v["area"][sel], obj_id=batch.obj_id[pi].astype(np.int32), color=colors[pi], entry=entry,
         texsize=texsize, emissive=~batch.shade[pi] & ~has)

@@ -1,0 +1,131 @@
+"""Compiled per-patch loops of ``raster.prepare`` (numba, cached on disk): culling and projecting each patch into
+one camera, and the affine rows of its inverse homography.
+
+Float64 throughout, with the operations in the order of the vectorised numpy version they replace (dot products
+summed left to right, as numpy sums rows of three or four), so the prepared patches are the same bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _cross(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, error_model="numpy")
+def project_patches(O, E1, E2, N, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled
+    """Patches (origin ``O``, sides ``E1``, ``E2``, normal ``N``: (P, 3) in the camera frame) seen from the front
+    (or ``two_sided``) and not wholly behind the ``near`` plane: their indices and, per kept patch, the pixel box
+    x0, x1, y0, y1 (centres x0 <= k < x1), the nearest depth, whether the near plane cuts it, and its projected
+    area and width [px] (NaN when cut)."""
+    P = len(O)
+    idx = np.empty(P, np.int64)
+    box = np.empty((P, 4), np.int64)
+    zmin = np.empty(P)
+    crossing = np.empty(P, np.bool_)
+    area = np.empty(P)
+    width = np.empty(P)
+    C = np.empty((4, 3))
+    z = np.empty(4)
+    pu = np.empty(8)
+    pv = np.empty(8)
+    m = 0
+    for i in range(P):
+        # back-face test: a face is seen from the front when n·(o - camera) < 0, the camera being the origin
+        if not ((N[i, 0] * O[i, 0] + N[i, 1] * O[i, 1]) + N[i, 2] * O[i, 2] < 0 or two_sided[i]):
+            continue
+        # corners o, o + e1, o + e1 + e2, o + e2
+        for a in range(3):
+            C[0, a] = O[i, a]
+            C[1, a] = O[i, a] + E1[i, a]
+            C[2, a] = (O[i, a] + E1[i, a]) + E2[i, a]
+            C[3, a] = O[i, a] + E2[i, a]
+        for k in range(4):
+            z[k] = C[k, 2]
+        if not max(max(z[0], z[1]), max(z[2], z[3])) > near:
+            continue
+        zm = min(min(z[0], z[1]), min(z[2], z[3]))
+        cut = zm < near
+        n = 0
+        for k in range(4):
+            if z[k] >= near:
+                # u = fx x / z + cx, v = fy y / z + cy
+                pu[n] = fx * C[k, 0] / C[k, 2] + cx
+                pv[n] = fy * C[k, 1] / C[k, 2] + cy
+                n += 1
+        if cut:
+            # the polygon clipped at z = near: plus the edge crossings a + (near - z_a)/(z_b - z_a) (b - a)
+            for k in range(4):
+                j = (k + 1) % 4
+                if (z[k] - near) * (z[j] - near) < 0:
+                    f = (near - z[k]) / (z[j] - z[k])
+                    x = C[k, 0] + f * (C[j, 0] - C[k, 0])
+                    y = C[k, 1] + f * (C[j, 1] - C[k, 1])
+                    zz = C[k, 2] + f * (C[j, 2] - C[k, 2])
+                    pu[n] = fx * x / zz + cx
+                    pv[n] = fy * y / zz + cy
+                    n += 1
+        umin, umax, vmin, vmax = pu[0], pu[0], pv[0], pv[0]
+        for k in range(1, n):
+            umin, umax = min(umin, pu[k]), max(umax, pu[k])
+            vmin, vmax = min(vmin, pv[k]), max(vmax, pv[k])
+        # pixel centres k with umin <= k <= umax
+        box[m, 0] = np.int64(min(max(np.ceil(umin), 0.0), W))
+        box[m, 1] = np.int64(min(max(np.floor(umax) + 1.0, 0.0), W))
+        box[m, 2] = np.int64(min(max(np.ceil(vmin), 0.0), H))
+        box[m, 3] = np.int64(min(max(np.floor(vmax) + 1.0, 0.0), H))
+        idx[m], zmin[m], crossing[m] = i, zm, cut
+        if cut:
+            area[m] = width[m] = np.nan
+        else:
+            # projected area (shoelace) and width = area / longest side, of the four corners
+            s, longest = 0.0, 0.0
+            for k in range(4):
+                j = (k + 1) % 4
+                s += pu[k] * pv[j] - pu[j] * pv[k]
+                longest = max(longest, (pu[k] - pu[j]) ** 2 + (pv[k] - pv[j]) ** 2)
+            area[m] = 0.5 * abs(s)
+            width[m] = area[m] / np.sqrt(longest)
+        m += 1
+    return idx[:m], box[:m], zmin[:m], crossing[:m], area[:m], width[:m]
+
+
+@njit(cache=True, error_model="numpy")
+def inverse_rows(o, e1, e2, drawable, fx, fy, cx, cy):  # pragma: no cover - compiled
+    """Per patch (camera frame, (P, 3)) with ``drawable``: A = K [e1 e2 o] and the affine rows of a' = 2 s/Z - 1/Z,
+    b' = 2 t/Z - 1/Z, c = 1/Z from A^-1 = (a2 x a3, a3 x a1, a1 x a2) / det; patches whose A is singular are
+    dropped. Returns the kept indices and their rows ma, mb, mc (n, 3)."""
+    P = len(o)
+    sel = np.empty(P, np.int64)
+    ma = np.empty((P, 3))
+    mb = np.empty((P, 3))
+    mc = np.empty((P, 3))
+    m = 0
+    for i in range(P):
+        if not drawable[i]:
+            continue
+        a10, a11, a12 = fx * e1[i, 0] + cx * e1[i, 2], fy * e1[i, 1] + cy * e1[i, 2], e1[i, 2]
+        a20, a21, a22 = fx * e2[i, 0] + cx * e2[i, 2], fy * e2[i, 1] + cy * e2[i, 2], e2[i, 2]
+        a30, a31, a32 = fx * o[i, 0] + cx * o[i, 2], fy * o[i, 1] + cy * o[i, 2], o[i, 2]
+        r00, r01, r02 = _cross(a20, a21, a22, a30, a31, a32)
+        r10, r11, r12 = _cross(a30, a31, a32, a10, a11, a12)
+        r20, r21, r22 = _cross(a10, a11, a12, a20, a21, a22)
+        det = (a10 * r00 + a11 * r01) + a12 * r02
+        scale = np.sqrt(((a10 * a10 + a11 * a11) + a12 * a12) * ((a20 * a20 + a21 * a21) + a22 * a22)
+                        * ((a30 * a30 + a31 * a31) + a32 * a32))
+        if not abs(det) > 1e-9 * scale:
+            continue
+        m0 = (r00 / det, r01 / det, r02 / det)
+        m1 = (r10 / det, r11 / det, r12 / det)
+        m2 = (r20 / det, r21 / det, r22 / det)
+        for a in range(3):
+            ma[m, a] = 2 * m0[a] - m2[a]
+            mb[m, a] = 2 * m1[a] - m2[a]
+            mc[m, a] = m2[a]
+        sel[m] = i
+        m += 1
+    return sel[:m], ma[:m], mb[:m], mc[:m]
