@@ -71,3 +71,28 @@ def test_a_patch_behind_another_is_hidden_in_both_paths(monkeypatch, big_px):
     assert target.ids[60, 80] == 2
     assert tuple(target.image[60, 80]) == (100, 100, 100)
     assert target.inv_depth[60, 80] == pytest.approx(0.25, rel=1e-6)
+
+
+def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
+    h, w = CAM.height, CAM.width
+    target = RenderTarget(np.zeros((h, w, 3), np.uint8), np.full((h, w), np.inf, np.float32),
+                          np.zeros((h, w), np.int32))
+    b = PatchBuilder()
+    # a floor 1 m below the camera (camera y points down), x in [-1, 1], z from 1 m behind the camera to 5 m ahead
+    b.add(np.array([-1.0, 1.0, -1.0]), np.array([2.0, 0, 0]), np.array([0, 0, 6.0]), (200.0,) * 3, two_sided=True,
+          shade=False, obj_id=7)
+    # a one-sided wall facing away from the camera (its e1 x e2 along +z) is culled
+    b.add(np.array([-1.0, -1.0, 4.0]), np.array([2.0, 0, 0]), np.array([0, 0.5, 0]), (90.0,) * 3, obj_id=8)
+    rasterize(target, b.build(), CAM, Transform(np.eye(3), np.zeros(3)), [np.zeros((4, 4), np.uint8)],
+              np.array([0.0, 0.0, -1.0]))
+    u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # the ray through pixel (u, v) meets the floor y = 1 at Z = fy / (v - cy), X = (u - cx) Z / fx
+        z = np.where(v > CAM.cy, CAM.fy / (v - CAM.cy), np.inf)
+        x = (u - CAM.cx) * z / CAM.fx
+    expected = (z >= fragments.NEAR_M) & (z <= 5.0) & (np.abs(x) <= 1.0)
+    assert expected.sum() > 2000
+    assert (target.ids == 8).sum() == 0
+    # pixel centres exactly on the outline may go either way in floating point
+    assert ((target.ids == 7) != expected).sum() <= 0.01 * expected.sum()
+    np.testing.assert_allclose(target.depth[expected & (target.ids == 7)], z[expected & (target.ids == 7)], rtol=1e-5)
