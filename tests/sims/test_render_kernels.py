@@ -1,6 +1,9 @@
 """The rasteriser's two compiled paths (large patches one by one, small ones as fragments) draw the same picture:
 the same scene forced through one path and then the other gives the same image, ids, lamp map and silhouettes."""
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -96,3 +99,27 @@ def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
     # pixel centres exactly on the outline may go either way in floating point
     assert ((target.ids == 7) != expected).sum() <= 0.01 * expected.sum()
     np.testing.assert_allclose(target.depth[expected & (target.ids == 7)], z[expected & (target.ids == 7)], rtol=1e-5)
+
+
+WARM_CHECK = """
+from percept.sims import SimWorld, WorldConfig
+from percept.sims.render import cull, pixels, spans
+from percept.sims.render.raster import warm_up
+kernels = [k for m in (pixels, cull, spans) for k in vars(m).values() if hasattr(k, "signatures")]
+warm_up()
+before = [len(k.signatures) for k in kernels]
+world = SimWorld(WorldConfig("crossing", seed=1, condition="night", autopilot=True))
+for _ in range(6):
+    world.step()
+    world.observe()
+print(sum(before), [len(k.signatures) for k in kernels] == before)
+"""
+
+
+def test_after_the_warm_up_rendering_a_world_compiles_nothing():
+    # in a fresh process: this one has compiled kernels for the tests above already
+    out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    count, unchanged = out.stdout.split()
+    # a frame compiling a kernel for new argument types would pay seconds inside a timed step
+    assert int(count) >= 9 and unchanged == "True"

@@ -30,7 +30,7 @@ from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
 from .textures import TextureAtlas
 
 __all__ = ["ELLIPSE", "LOD_PX", "NEAR_M", "OUTLINES", "QUAD", "PatchBatch", "PatchBuilder", "RenderTarget",
-           "prepare", "rasterize"]
+           "prepare", "rasterize", "warm_up"]
 
 LOD_PX = 0.5
 """Scenery patches narrower than this on screen [px] are skipped."""
@@ -98,6 +98,37 @@ def rasterize(target: RenderTarget, batch: PatchBatch, cam: PinholeCamera, cam_f
     if prep is not None:
         rasterize_prepared(target, prep, atlas, silhouettes, antialias)
 
+
+
+_WARM: list[bool] = []
+
+
+def warm_up() -> None:
+    """Compile the rasteriser's kernels (numba: the first time after an install, about 15 s) or load them from
+    numba's disk cache (about 0.5 s), once per process, by drawing a small synthetic scene through every path the
+    renderer takes: large and small patches, textured and not, quads and discs, a lamp, a patch cut by the near
+    plane, into a left camera's targets (depth, ids, silhouettes) and a right one's. The renderer calls it when it
+    is built, so that no timed frame pays for it."""
+    if _WARM:
+        return
+    cam = PinholeCamera(150.0, 150.0, 80.0, 60.0, 160, 120)
+    b = PatchBuilder()
+    b.add(np.array([-3.0, -2.0, 4.0]), np.array([6.0, 0, 0]), np.array([0, 4.0, 0]), (180.0,) * 3, texture=0,
+          two_sided=True)
+    for k in range(4):
+        # untextured and textured quads and discs; the untextured disc unshaded (a lamp)
+        b.add(np.array([-1.0 + 0.5 * k, -0.2, 3.0]), np.array([0.1, 0, 0]), np.array([0, 0.1, 0]), (90.0,) * 3,
+              texture=k % 2 - 1, outline=k // 2, obj_id=k + 1, shade=k != 2, two_sided=True)
+    b.add(np.array([-1.0, 1.0, -1.0]), np.array([2.0, 0, 0]), np.array([0, 0, 6.0]), (120.0,) * 3, two_sided=True)
+    batch, atlas = b.build(), TextureAtlas([np.full((16, 16), 128, np.uint8)])
+    for left in (True, False):
+        h, w = cam.height, cam.width
+        target = RenderTarget(np.zeros((h, w, 3), np.uint8), np.full((h, w), np.inf, np.float32) if left else None,
+                              np.zeros((h, w), np.int32) if left else None, np.zeros((h, w), np.float32),
+                              emission=np.zeros((h, w), np.float32))
+        rasterize(target, batch, cam, Transform(np.eye(3), np.zeros(3)), atlas, np.array([0.0, 0.0, -1.0]),
+                  silhouettes=left)
+    _WARM.append(True)
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise cross product of (N, 3) arrays."""

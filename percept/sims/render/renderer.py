@@ -25,7 +25,7 @@ from .fragments import PreparedPatches, rasterize_prepared
 from .paint import GroundPaint, ground_paint
 from .patches import SUN_DIR, PatchBatch, PatchBuilder
 from .pedestrian import pedestrian_packed
-from .raster import LOD_PX, RenderTarget, prepare
+from .raster import LOD_PX, RenderTarget, prepare, warm_up
 from .scene import ObjectKind, ObjectState, Scene
 from .scenery import SceneryTextures, build_scenery
 from .signs import sign_patches
@@ -84,6 +84,7 @@ class StereoRenderer:
         # beyond f min(|e1|, |e2|) / LOD_PX a patch is narrower than LOD_PX on screen, so the rasteriser skips it
         self._scenery_reach = rig.camera.fx * np.minimum(l1, l2) / LOD_PX
         self._templates: dict[tuple, np.ndarray] = {}
+        warm_up()
 
     @property
     def atlas(self) -> TextureAtlas:
