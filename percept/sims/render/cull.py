@@ -10,12 +10,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .compiled import interruptible
+
 
 @njit(cache=True)
 def _cross(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
+@interruptible
 @njit(cache=True, error_model="numpy")
 def project_patches(O, E1, E2, N, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled
     """Patches (origin ``O``, sides ``E1``, ``E2``, normal ``N``: (P, 3) in the camera frame) seen from the front
@@ -94,6 +97,7 @@ def project_patches(O, E1, E2, N, two_sided, fx, fy, cx, cy, W, H, near):  # pra
     return idx[:m], box[:m], zmin[:m], crossing[:m], area[:m], width[:m]
 
 
+@interruptible
 @njit(cache=True, error_model="numpy")
 def inverse_rows(o, e1, e2, drawable, fx, fy, cx, cy):  # pragma: no cover - compiled
     """Per patch (camera frame, (P, 3)) with ``drawable``: A = K [e1 e2 o] and the affine rows of a' = 2 s/Z - 1/Z,

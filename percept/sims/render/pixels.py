@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .compiled import interruptible
+
 f32 = np.float32
 
 
@@ -26,6 +28,7 @@ def _push(buf, n, value):  # pragma: no cover - compiled
     return buf
 
 
+@interruptible
 @njit(cache=True)
 def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, ellipse, span_row, los, his,
                 obj_id, emissive, color_u8, defer, want_sil, inv_near):  # pragma: no cover - compiled
@@ -93,6 +96,7 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
     return held, sil_pix[:ns], sil_oid[:ns]
 
 
+@interruptible
 @njit(cache=True)
 def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # pragma: no cover - compiled
     """One fragment per pixel centre first..last of each span (patch rp, row v): its 1/Z is written to ``wflat``
@@ -154,6 +158,7 @@ def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # prag
     return wpix, wspan, wk, wc, sil_pix, sil_oid
 
 
+@interruptible
 @njit(cache=True)
 def texel_coords(wspan, wk, wc, rp, v, first, ma, mb, entry, texsize, rects):  # pragma: no cover - compiled
     """Atlas coordinates (x, y) float32 of the textured winners (-1 where a winner is untextured):
