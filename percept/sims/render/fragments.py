@@ -159,7 +159,7 @@ def _small_patches(target, p: PreparedPatches, atlas: TextureAtlas, rp, v, first
     _add_silhouettes(sil, sil_pix, sil_oid)
     tx, ty = texel_coords(wspan, wk, wc, rp, v, first, p.ma, p.mb, p.entry, p.texsize, atlas.rects)
     albedo = np.ones(len(wpix), np.float32)
-    t = np.flatnonzero(tx >= 0)
+    t = np.flatnonzero(p.entry[rp[wspan]] >= 0)
     if len(t):
         albedo[t] = _sample(atlas.image, tx[t], ty[t]) * np.float32(1.0 / 255.0)
     shade_winners(target.image.reshape(-1, 3), _NONE_I32.reshape(-1) if target.ids is None else target.ids.reshape(-1),

@@ -161,7 +161,7 @@ def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # prag
 @interruptible
 @njit(cache=True)
 def texel_coords(wspan, wk, wc, rp, v, first, ma, mb, entry, texsize, rects):  # pragma: no cover - compiled
-    """Atlas coordinates (x, y) float32 of the textured winners (-1 where a winner is untextured):
+    """Atlas coordinates (x, y) float32 of the textured winners (-1 where a winner is untextured, not read):
     s = (a'/c + 1)/2 times the texels across, wrapped into the entry's tile, plus the tile's origin."""
     n = len(wspan)
     tx = np.full(n, f32(-1.0))
