@@ -105,15 +105,14 @@ WARM_CHECK = """
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.render import cull, pixels, spans
 from percept.sims.render.raster import warm_up
-kernels = [getattr(k, "dispatcher", k) for m in (pixels, cull, spans) for k in vars(m).values()
-           if hasattr(getattr(k, "dispatcher", k), "signatures")]
+kernels = [k.dispatcher for m in (pixels, cull, spans) for k in vars(m).values() if hasattr(k, "dispatcher")]
 warm_up()
 before = [len(k.signatures) for k in kernels]
 world = SimWorld(WorldConfig("crossing", seed=1, condition="night", autopilot=True))
 for _ in range(6):
     world.step()
     world.observe()
-print(sum(before), [len(k.signatures) for k in kernels] == before)
+print(len(kernels), min(before), [len(k.signatures) for k in kernels] == before)
 """
 
 
@@ -121,9 +120,10 @@ def test_after_the_warm_up_rendering_a_world_compiles_nothing():
     # in a fresh process: this one has compiled kernels for the tests above already
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
-    count, unchanged = out.stdout.split()
-    # a frame compiling a kernel for new argument types would pay seconds inside a timed step
-    assert int(count) >= 9 and unchanged == "True"
+    count, least, unchanged = out.stdout.split()
+    # every kernel compiled (or loaded) by the warm-up; a frame compiling one for new argument types would pay
+    # seconds inside a timed step
+    assert int(count) >= 8 and int(least) >= 1 and unchanged == "True"
 
 
 CTRL_C = """

@@ -1,32 +1,40 @@
-"""What the renderer's compiled kernels (numba) need from Python around them."""
+"""The renderer's compiled kernels (numba): one decorator for every kernel Python calls, ``kernel``.
+
+A kernel is compiled the first time it is called with new argument types and cached on disk (``cache=True``),
+and it raises Ctrl-C as KeyboardInterrupt: a SIGINT that lands while a kernel runs is handled by Python's signal
+handler while numba boxes the kernel's results, which numba does not check, and CPython then reports the call as
+a chain of SystemErrors ("returned a result with an exception set") that ends in the KeyboardInterrupt, which the
+commands' Ctrl-C handling would not recognise. Functions only called from compiled code (helpers) are
+``numba.njit(cache=True)`` alone.
+"""
 
 from __future__ import annotations
 
 import functools
 from typing import Callable
 
+from numba import njit
 
-def interruptible(kernel: Callable) -> Callable:
-    """``kernel`` (a numba dispatcher that returns arrays), with Ctrl-C raised as KeyboardInterrupt.
 
-    A SIGINT that lands while a kernel runs is handled by Python's signal handler during the boxing of the
-    kernel's results, which numba does not check; CPython then reports the call as SystemError ("returned a result
-    with an exception set") caused, through more SystemErrors, by the KeyboardInterrupt, which the commands' Ctrl-C
-    handling would not recognise. Kernels that return nothing are not affected. The dispatcher itself is
-    ``.dispatcher``."""
+def kernel(**options) -> Callable[[Callable], Callable]:
+    """``@kernel(...)``: ``numba.njit(cache=True, **options)``, called through a wrapper that turns the SystemError
+    chain of an interrupted call back into KeyboardInterrupt. The dispatcher itself is ``.dispatcher``."""
 
-    @functools.wraps(kernel)
-    def call(*args):
-        try:
-            return kernel(*args)
-        except SystemError as e:
-            # the KeyboardInterrupt is at the end of a chain of SystemErrors (each layer of numba's boxing)
-            cause = e.__cause__
-            while isinstance(cause, SystemError):
-                cause = cause.__cause__
-            if isinstance(cause, KeyboardInterrupt):
-                raise KeyboardInterrupt from None
-            raise
+    def wrap(fn: Callable) -> Callable:
+        dispatcher = njit(cache=True, **options)(fn)
 
-    call.dispatcher = kernel
-    return call
+        @functools.wraps(fn)
+        def call(*args):
+            try:
+                return dispatcher(*args)
+            except SystemError as e:
+                cause = e.__cause__
+                while isinstance(cause, SystemError):
+                    cause = cause.__cause__
+                if isinstance(cause, KeyboardInterrupt):
+                    raise KeyboardInterrupt from None
+                raise
+
+        call.dispatcher = dispatcher
+        return call
+    return wrap

@@ -1,8 +1,9 @@
 """Compiled per-patch loops of ``raster.prepare`` (numba, cached on disk): culling and projecting each patch into
 one camera, and the affine rows of its inverse homography.
 
-Float64 throughout, with the operations in the order of the vectorised numpy version they replace (dot products
-summed left to right, as numpy sums rows of three or four), so the prepared patches are the same bit for bit.
+Float64 throughout, with the operations in the order of the vectorised numpy version they replace (cross and dot
+products are ``vec3``'s, compiled; rows of four summed left to right, as numpy sums them), so the prepared patches
+are the same bit for bit.
 """
 
 from __future__ import annotations
@@ -10,18 +11,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .compiled import interruptible
+from .compiled import kernel
+from .vec3 import cross, dot
+
+_cross = njit(cache=True)(cross)
+_dot = njit(cache=True)(dot)
 
 
-@njit(cache=True)
-def _cross(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-
-
-@interruptible
-@njit(cache=True, error_model="numpy")
-def project_patches(O, E1, E2, N, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled
-    """Patches (origin ``O``, sides ``E1``, ``E2``, normal ``N``: (P, 3) in the camera frame) seen from the front
+@kernel(error_model="numpy")
+def project_patches(O, E1, E2, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled
+    """Patches (origin ``O``, sides ``E1``, ``E2``: (P, 3) in the camera frame) seen from the front
     (or ``two_sided``) and not wholly behind the ``near`` plane: their indices and, per kept patch, the pixel box
     x0, x1, y0, y1 (centres x0 <= k < x1), the nearest depth, whether the near plane cuts it, and its projected
     area and width [px] (NaN when cut)."""
@@ -38,8 +37,9 @@ def project_patches(O, E1, E2, N, two_sided, fx, fy, cx, cy, W, H, near):  # pra
     pv = np.empty(8)
     m = 0
     for i in range(P):
-        # back-face test: a face is seen from the front when n·(o - camera) < 0, the camera being the origin
-        if not ((N[i, 0] * O[i, 0] + N[i, 1] * O[i, 1]) + N[i, 2] * O[i, 2] < 0 or two_sided[i]):
+        o, e1, e2 = (O[i, 0], O[i, 1], O[i, 2]), (E1[i, 0], E1[i, 1], E1[i, 2]), (E2[i, 0], E2[i, 1], E2[i, 2])
+        # back-face test: a face is seen from the front when n·(o - camera) < 0, n = e1 x e2, the camera the origin
+        if not (_dot(_cross(e1, e2), o) < 0 or two_sided[i]):
             continue
         # corners o, o + e1, o + e1 + e2, o + e2
         for a in range(3):
@@ -97,8 +97,7 @@ def project_patches(O, E1, E2, N, two_sided, fx, fy, cx, cy, W, H, near):  # pra
     return idx[:m], box[:m], zmin[:m], crossing[:m], area[:m], width[:m]
 
 
-@interruptible
-@njit(cache=True, error_model="numpy")
+@kernel(error_model="numpy")
 def inverse_rows(o, e1, e2, drawable, fx, fy, cx, cy):  # pragma: no cover - compiled
     """Per patch (camera frame, (P, 3)) with ``drawable``: A = K [e1 e2 o] and the affine rows of a' = 2 s/Z - 1/Z,
     b' = 2 t/Z - 1/Z, c = 1/Z from A^-1 = (a2 x a3, a3 x a1, a1 x a2) / det; patches whose A is singular are
@@ -112,24 +111,19 @@ def inverse_rows(o, e1, e2, drawable, fx, fy, cx, cy):  # pragma: no cover - com
     for i in range(P):
         if not drawable[i]:
             continue
-        a10, a11, a12 = fx * e1[i, 0] + cx * e1[i, 2], fy * e1[i, 1] + cy * e1[i, 2], e1[i, 2]
-        a20, a21, a22 = fx * e2[i, 0] + cx * e2[i, 2], fy * e2[i, 1] + cy * e2[i, 2], e2[i, 2]
-        a30, a31, a32 = fx * o[i, 0] + cx * o[i, 2], fy * o[i, 1] + cy * o[i, 2], o[i, 2]
-        r00, r01, r02 = _cross(a20, a21, a22, a30, a31, a32)
-        r10, r11, r12 = _cross(a30, a31, a32, a10, a11, a12)
-        r20, r21, r22 = _cross(a10, a11, a12, a20, a21, a22)
-        det = (a10 * r00 + a11 * r01) + a12 * r02
-        scale = np.sqrt(((a10 * a10 + a11 * a11) + a12 * a12) * ((a20 * a20 + a21 * a21) + a22 * a22)
-                        * ((a30 * a30 + a31 * a31) + a32 * a32))
+        a1 = (fx * e1[i, 0] + cx * e1[i, 2], fy * e1[i, 1] + cy * e1[i, 2], e1[i, 2])
+        a2 = (fx * e2[i, 0] + cx * e2[i, 2], fy * e2[i, 1] + cy * e2[i, 2], e2[i, 2])
+        a3 = (fx * o[i, 0] + cx * o[i, 2], fy * o[i, 1] + cy * o[i, 2], o[i, 2])
+        r0, r1, r2 = _cross(a2, a3), _cross(a3, a1), _cross(a1, a2)
+        det = _dot(a1, r0)
+        scale = np.sqrt(_dot(a1, a1) * _dot(a2, a2) * _dot(a3, a3))
         if not abs(det) > 1e-9 * scale:
             continue
-        m0 = (r00 / det, r01 / det, r02 / det)
-        m1 = (r10 / det, r11 / det, r12 / det)
-        m2 = (r20 / det, r21 / det, r22 / det)
         for a in range(3):
-            ma[m, a] = 2 * m0[a] - m2[a]
-            mb[m, a] = 2 * m1[a] - m2[a]
-            mc[m, a] = m2[a]
+            m0, m1, m2 = r0[a] / det, r1[a] / det, r2[a] / det
+            ma[m, a] = 2 * m0 - m2
+            mb[m, a] = 2 * m1 - m2
+            mc[m, a] = m2
         sel[m] = i
         m += 1
     return sel[:m], ma[:m], mb[:m], mc[:m]

@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 
 from .pixels import big_patches, shade_winners, small_fragments, texel_coords
-from .spans import pixel_spans, smooth_edges, span_bounds
+from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
 
 BIG_PX = 1500
@@ -73,8 +73,7 @@ def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouet
     small = np.flatnonzero(~big)
     # row spans of every patch in front of the near plane: the large ones first, in drawing order
     front = order[~p.crossing[order]]
-    rp, v, lo, hi = span_bounds(p, np.concatenate([front, small]))
-    first, last = pixel_spans(p, rp, lo, hi)
+    rp, v, lo, hi, first, last = span_bounds(p, np.concatenate([front, small]))
     nbig = int((p.y1[front] - p.y0[front]).sum())
     _big_patches(target, p, atlas, order, front, first[:nbig], last[:nbig], sil)
     if len(small):
@@ -132,7 +131,7 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
     held, sil_pix, sil_oid = big_patches(
         target.inv_depth, _NONE_I32 if target.ids is None else target.ids,
         _NONE_F32 if target.emission is None else target.emission, target.image, winner, order, p.x0, p.x1, p.y0,
-        p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive, p.color.astype(np.uint8),
+        p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive, p.color,
         textured, sil is not None, np.float32(INV_NEAR))
     _add_silhouettes(sil, sil_pix, sil_oid)
     # one 3-byte item per pixel, so that masked copies take a 2-D mask
@@ -157,11 +156,10 @@ def _small_patches(target, p: PreparedPatches, atlas: TextureAtlas, rp, v, first
     wpix, wspan, wk, wc, sil_pix, sil_oid = small_fragments(target.inv_depth.reshape(-1), W, rp, v, first, last,
                                                             p.mc, p.obj_id, sil is not None)
     _add_silhouettes(sil, sil_pix, sil_oid)
-    tx, ty = texel_coords(wspan, wk, wc, rp, v, first, p.ma, p.mb, p.entry, p.texsize, atlas.rects)
+    t, tx, ty = texel_coords(wspan, wk, wc, rp, v, first, p.ma, p.mb, p.entry, p.texsize, atlas.rects)
     albedo = np.ones(len(wpix), np.float32)
-    t = np.flatnonzero(p.entry[rp[wspan]] >= 0)
     if len(t):
-        albedo[t] = _sample(atlas.image, tx[t], ty[t]) * np.float32(1.0 / 255.0)
+        albedo[t] = _sample(atlas.image, tx, ty) * np.float32(1.0 / 255.0)
     shade_winners(target.image.reshape(-1, 3), _NONE_I32.reshape(-1) if target.ids is None else target.ids.reshape(-1),
                   _NONE_F32.reshape(-1) if target.emission is None else target.emission.reshape(-1), wpix, wspan, rp,
                   p.obj_id, p.emissive, p.color, albedo)

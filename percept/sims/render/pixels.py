@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .compiled import interruptible
+from .compiled import kernel
 
 f32 = np.float32
 
@@ -28,12 +28,12 @@ def _push(buf, n, value):  # pragma: no cover - compiled
     return buf
 
 
-@interruptible
-@njit(cache=True)
+@kernel()
 def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, ellipse, span_row, los, his,
-                obj_id, emissive, color_u8, defer, want_sil, inv_near):  # pragma: no cover - compiled
+                obj_id, emissive, color, defer, want_sil, inv_near):  # pragma: no cover - compiled
     """Patches ``order[k]`` one by one over their boxes, z-tested against ``wbuf`` (H, W) float32 and written to
-    it, to ``ids`` and ``em`` (empty arrays to skip) and to ``img`` (H, W, 3) uint8 in the colour ``color_u8``,
+    it, to ``ids`` and ``em`` (empty arrays to skip) and to ``img`` (H, W, 3) uint8 in the colour ``color``
+    (float32, truncated),
     except the patches with ``defer`` (textured), whose colour is written afterwards where ``winner`` (H, W),
     the order index k of the last patch that won each pixel, still names them. ``span_row[i]``: the patch's
     first row in ``los``, ``his`` (its inside columns per box row), or -1 for a patch crossing the near plane
@@ -92,12 +92,11 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
                 held[k] += 1
                 if not defer[i]:
                     for ch in range(3):
-                        img[y, x, ch] = color_u8[i, ch]
+                        img[y, x, ch] = np.uint8(color[i, ch])
     return held, sil_pix[:ns], sil_oid[:ns]
 
 
-@interruptible
-@njit(cache=True)
+@kernel()
 def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # pragma: no cover - compiled
     """One fragment per pixel centre first..last of each span (patch rp, row v): its 1/Z is written to ``wflat``
     where it is the largest (the z-buffer). Returns the winners (fragments whose 1/Z is the pixel's largest;
@@ -158,16 +157,20 @@ def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # prag
     return wpix, wspan, wk, wc, sil_pix, sil_oid
 
 
-@interruptible
-@njit(cache=True)
+@kernel()
 def texel_coords(wspan, wk, wc, rp, v, first, ma, mb, entry, texsize, rects):  # pragma: no cover - compiled
-    """Atlas coordinates (x, y) float32 of the textured winners (-1 where a winner is untextured, not read):
+    """The textured winners (indices into the winners) and their atlas coordinates (x, y) float32:
     s = (a'/c + 1)/2 times the texels across, wrapped into the entry's tile, plus the tile's origin."""
-    n = len(wspan)
-    tx = np.full(n, f32(-1.0))
-    ty = np.full(n, f32(-1.0))
+    n = 0
+    for w in range(len(wspan)):
+        if entry[rp[wspan[w]]] >= 0:
+            n += 1
+    t = np.empty(n, np.int64)
+    tx = np.empty(n, np.float32)
+    ty = np.empty(n, np.float32)
     one = f32(1.0)
-    for w in range(n):
+    j = 0
+    for w in range(len(wspan)):
         s = wspan[w]
         i = rp[s]
         e = entry[i]
@@ -184,11 +187,12 @@ def texel_coords(wspan, wk, wc, rp, v, first, ma, mb, entry, texsize, rects):  #
         y = (bp / wc[w] + one) * hy
         x -= f32(np.floor(x / ew)) * ew
         y -= f32(np.floor(y / eh)) * eh
-        tx[w], ty[w] = x + ex, y + ey
-    return tx, ty
+        t[j], tx[j], ty[j] = w, x + ex, y + ey
+        j += 1
+    return t, tx, ty
 
 
-@njit(cache=True)
+@kernel()
 def shade_winners(img, ids, em, wpix, wspan, rp, obj_id, emissive, color, albedo):  # pragma: no cover - compiled
     """Write each winner's object id, lamp flag and colour = shaded colour x albedo (float32, truncated), in
     order (the last of equal fragments wins); ``img`` (H W, 3), ``ids`` and ``em`` flat (empty to skip)."""

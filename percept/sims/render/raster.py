@@ -28,6 +28,7 @@ from .cull import inverse_rows, project_patches
 from .fragments import NEAR_M, PreparedPatches, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
 from .textures import TextureAtlas
+from .vec3 import cross, dot
 
 __all__ = ["ELLIPSE", "LOD_PX", "NEAR_M", "OUTLINES", "QUAD", "PatchBatch", "PatchBuilder", "RenderTarget",
            "prepare", "rasterize", "warm_up"]
@@ -130,16 +131,6 @@ def warm_up() -> None:
                   silhouettes=left)
     _WARM.append(True)
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross product of (N, 3) arrays."""
-    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
-    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-    return np.column_stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
-
 
 def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transform], atlas: TextureAtlas,
             sun_dir_world: np.ndarray, ambient: float = 0.55, lod_px: float = LOD_PX) -> list[PreparedPatches | None]:
@@ -153,16 +144,15 @@ def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transfo
     R = cams_from_world[0].R
     if not all(np.allclose(T.R, R) for T in cams_from_world):
         raise ValueError("prepare() needs cameras with one orientation (a rectified rig); render them one by one")
-    # shading in the world frame: ambient + diffuse |n·sun| (two-sided lighting)
-    nw = _cross(batch.e1, batch.e2)
-    lam = np.abs(nw @ sun_dir_world) / (np.sqrt(_dot(nw, nw)) + 1e-12)
+    # shading in the world frame: ambient + diffuse |n·sun| (two-sided lighting); vec3's formulas on the columns
+    nw = cross(batch.e1.T, batch.e2.T)
+    lam = np.abs(np.column_stack(nw) @ sun_dir_world) / (np.sqrt(dot(nw, nw)) + 1e-12)
     shade = np.where(batch.shade, ambient + (1.0 - ambient) * lam, 1.0)
     colors = np.clip(batch.color * shade[:, None], 0, 255).astype(np.float32)
     E1 = batch.e1 @ R.T
     E2 = batch.e2 @ R.T
-    N = _cross(E1, E2)
     O0 = batch.origin @ R.T
-    views = [_project(batch, cam, O0 + T.t, E1, E2, N) for T in cams_from_world]
+    views = [_project(batch, cam, O0 + T.t, E1, E2) for T in cams_from_world]
     # projected area and width per patch, from the first camera that sees it fully in front
     area = np.full(len(batch), np.nan)
     width = np.full(len(batch), np.nan)
@@ -176,12 +166,11 @@ def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transfo
     return [None if v is None else _finish(batch, cam, v, tiny, level, colors, atlas) for v in views]
 
 
-def _project(batch: PatchBatch, cam: PinholeCamera, O: np.ndarray, E1: np.ndarray, E2: np.ndarray,
-             N: np.ndarray) -> dict | None:
-    """Per camera (patches in its frame: O, E1, E2, normals N): back faces and patches behind the near plane
+def _project(batch: PatchBatch, cam: PinholeCamera, O: np.ndarray, E1: np.ndarray, E2: np.ndarray) -> dict | None:
+    """Per camera (patches in its frame: O, E1, E2): back faces and patches behind the near plane
     culled, the rest with their pixel box (x0, x1, y0, y1), nearest depth, crossing flag, area, width
     (``cull.project_patches``)."""
-    idx, box, zmin, crossing, area, width = project_patches(O, E1, E2, N, batch.two_sided, cam.fx, cam.fy, cam.cx,
+    idx, box, zmin, crossing, area, width = project_patches(O, E1, E2, batch.two_sided, cam.fx, cam.fy, cam.cx,
                                                             cam.cy, cam.width, cam.height, NEAR_M)
     if not len(idx):
         return None

@@ -15,78 +15,68 @@ vectorised numpy version used, so that the images are the same bit for bit.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .compiled import kernel
 
 EDGE_TOL = 2e-5
 """Relative 1/Z tolerance that tells "this pixel shows the patch" (float32 rounding is about 1e-7) from "it
 shows a surface behind it" (a tail light 1 cm in front of a car at 260 m is 4e-5 nearer)."""
 
 
-def span_bounds(p, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def span_bounds(p, idx: np.ndarray) -> tuple[np.ndarray, ...]:
     """Every box row of the patches ``idx`` (``PreparedPatches``, none crossing the near plane), in order:
-    patch, row v, and the real interval [lo, hi] of u inside the outline (lo > hi when the row has none)."""
-    h = p.y1[idx] - p.y0[idx]
-    rp = np.repeat(idx, h)
-    v = np.arange(len(rp)) - np.repeat(np.cumsum(h) - h, h) + np.repeat(p.y0[idx], h)
-    lo = np.empty(len(rp))
-    hi = np.empty(len(rp))
-    _bounds(rp, v, p.ma, p.mb, p.mc, p.ellipse, lo, hi)
-    return rp, v.astype(np.int64), lo, hi
+    patch, row v, the real interval [lo, hi] of u inside the outline (lo > hi when the row has none), and the
+    first and last pixel centre k with lo <= k <= hi, clipped to the patch's box (first > last: none)."""
+    n = int((p.y1[idx] - p.y0[idx]).sum())
+    rp, v, first, last = (np.empty(n, np.int64) for _ in range(4))
+    lo, hi = np.empty(n), np.empty(n)
+    _bounds(idx, p.x0, p.x1, p.y0, p.y1, p.ma, p.mb, p.mc, p.ellipse, rp, v, lo, hi, first, last)
+    return rp, v, lo, hi, first, last
 
 
-@njit(cache=True, error_model="numpy")
-def _bounds(rp, v, ma, mb, mc, ellipse, lo, hi):  # pragma: no cover - compiled
-    for r in range(len(rp)):
-        i = rp[r]
-        vv = np.float64(v[r])
-        if not ellipse[i]:
-            # quad: the half-planes c ± a' >= 0, c ± b' >= 0 are alpha u + delta >= 0 on row v; each bounds u
-            lq, hq = -np.inf, np.inf
-            for k in range(4):
-                m = ma if k < 2 else mb
-                if k % 2 == 0:
-                    alpha, d1, d2 = mc[i, 0] + m[i, 0], mc[i, 1] + m[i, 1], mc[i, 2] + m[i, 2]
-                else:
-                    alpha, d1, d2 = mc[i, 0] - m[i, 0], mc[i, 1] - m[i, 1], mc[i, 2] - m[i, 2]
-                delta = d1 * vv + d2
-                x = -delta / alpha
-                if alpha > 0:
-                    lq = max(lq, x)
-                elif alpha < 0:
-                    hq = min(hq, x)
-                elif delta < 0:
-                    # alpha = 0: the whole row is outside (delta < 0) or inside
-                    hq = -np.inf
-            lo[r], hi[r] = lq, hq
-        else:
-            # ellipse: (A1 u + A0)^2 + (B1 u + B0)^2 - (C1 u + C0)^2 <= 0, i.e. q2 u^2 + q1 u + q0 <= 0
-            ga, gb, gc = ma[i, 0], mb[i, 0], mc[i, 0]
-            fa, fb, fc = ma[i, 1] * vv + ma[i, 2], mb[i, 1] * vv + mb[i, 2], mc[i, 1] * vv + mc[i, 2]
-            q2 = (ga * ga + gb * gb) - gc * gc
-            q1 = (2.0 * (ga * fa) + 2.0 * (gb * fb)) - 2.0 * (gc * fc)
-            q0 = (fa * fa + fb * fb) - fc * fc
-            disc = q1 * q1 - 4.0 * q2 * q0
-            root = np.sqrt(max(disc, 0.0))
-            if disc < 0 or not q2 > 0:
-                lo[r], hi[r] = np.inf, -np.inf
+@kernel(error_model="numpy")
+def _bounds(idx, x0, x1, y0, y1, ma, mb, mc, ellipse, rp, v, lo, hi, first, last):  # pragma: no cover - compiled
+    r = 0
+    for i in idx:
+        for row in range(y0[i], y1[i]):
+            rp[r], v[r] = i, row
+            vv = np.float64(row)
+            if not ellipse[i]:
+                # quad: the half-planes c ± a' >= 0, c ± b' >= 0 are alpha u + delta >= 0 on row v; each bounds u
+                lq, hq = -np.inf, np.inf
+                for k in range(4):
+                    m = ma if k < 2 else mb
+                    if k % 2 == 0:
+                        alpha, d1, d2 = mc[i, 0] + m[i, 0], mc[i, 1] + m[i, 1], mc[i, 2] + m[i, 2]
+                    else:
+                        alpha, d1, d2 = mc[i, 0] - m[i, 0], mc[i, 1] - m[i, 1], mc[i, 2] - m[i, 2]
+                    delta = d1 * vv + d2
+                    x = -delta / alpha
+                    if alpha > 0:
+                        lq = max(lq, x)
+                    elif alpha < 0:
+                        hq = min(hq, x)
+                    elif delta < 0:
+                        # alpha = 0: the whole row is outside (delta < 0) or inside
+                        hq = -np.inf
+                lo[r], hi[r] = lq, hq
             else:
-                lo[r], hi[r] = (-q1 - root) / (2.0 * q2), (-q1 + root) / (2.0 * q2)
-
-
-@njit(cache=True, error_model="numpy")
-def _pixel_spans(x0, x1, rp, lo, hi, first, last):  # pragma: no cover - compiled
-    for r in range(len(rp)):
-        a, b = x0[rp[r]], x1[rp[r]]
-        first[r] = np.int64(min(max(np.ceil(lo[r]), a), b))
-        last[r] = np.int64(min(max(np.floor(hi[r]), a - 1), b - 1))
-
-
-def pixel_spans(p, rp: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The first and last pixel centre k with lo <= k <= hi, clipped to the patch's box (first > last: none)."""
-    first = np.empty(len(rp), np.int64)
-    last = np.empty(len(rp), np.int64)
-    _pixel_spans(p.x0, p.x1, rp, lo, hi, first, last)
-    return first, last
+                # ellipse: (A1 u + A0)^2 + (B1 u + B0)^2 - (C1 u + C0)^2 <= 0, i.e. q2 u^2 + q1 u + q0 <= 0
+                ga, gb, gc = ma[i, 0], mb[i, 0], mc[i, 0]
+                fa, fb, fc = ma[i, 1] * vv + ma[i, 2], mb[i, 1] * vv + mb[i, 2], mc[i, 1] * vv + mc[i, 2]
+                q2 = (ga * ga + gb * gb) - gc * gc
+                q1 = (2.0 * (ga * fa) + 2.0 * (gb * fb)) - 2.0 * (gc * fc)
+                q0 = (fa * fa + fb * fb) - fc * fc
+                disc = q1 * q1 - 4.0 * q2 * q0
+                root = np.sqrt(max(disc, 0.0))
+                if disc < 0 or not q2 > 0:
+                    lo[r], hi[r] = np.inf, -np.inf
+                else:
+                    lo[r], hi[r] = (-q1 - root) / (2.0 * q2), (-q1 + root) / (2.0 * q2)
+            # the pixel centres inside, clipped to the box
+            first[r] = np.int64(min(max(np.ceil(lo[r]), x0[i]), x1[i]))
+            last[r] = np.int64(min(max(np.floor(hi[r]), x0[i] - 1), x1[i] - 1))
+            r += 1
 
 
 def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: np.ndarray, lo_px: np.ndarray,
@@ -99,7 +89,7 @@ def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: n
     f < 1/2 pixel j is covered by 1/2 + f and shows the background for the rest. (The right edge mirrors it.)
     An edge is blended only where pixel j shows the patch (its 1/Z within EDGE_TOL of the patch's) and the
     neighbour shows something behind the patch's plane; an occluded edge belongs to its occluder. ``lo_px``,
-    ``hi_px``: the spans' first and last pixel centres (``pixel_spans``), as the rasteriser filled them."""
+    ``hi_px``: the spans' first and last pixel centres (``span_bounds``), as the rasteriser filled them."""
     H, W = target.inv_depth.shape
     img = target.image.reshape(-1, 3)
     em = target.emission
@@ -107,7 +97,7 @@ def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: n
             em is not None, W, p.mc, rp, v, lo, hi, lo_px, hi_px)
 
 
-@njit(cache=True, error_model="numpy")
+@kernel(error_model="numpy")
 def _smooth(img, inv, em, has_em, W, mc, rp, v, lo, hi, lo_px, hi_px):  # pragma: no cover - compiled
     n = len(rp)
     tgt = np.empty(2 * n, np.int64)
