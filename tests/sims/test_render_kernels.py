@@ -1,6 +1,7 @@
 """The rasteriser's two compiled paths (large patches one by one, small ones as fragments) draw the same picture:
 the same scene forced through one path and then the other gives the same image, ids, lamp map and silhouettes."""
 
+import os
 import subprocess
 import sys
 
@@ -103,10 +104,14 @@ def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
 
 WARM_CHECK = """
 from percept.sims import SimWorld, WorldConfig
-from percept.sims.render import cull, pixels, spans
-from percept.sims.render.raster import warm_up
-kernels = [k.dispatcher for m in (pixels, cull, spans) for k in vars(m).values() if hasattr(k, "dispatcher")]
-warm_up()
+from percept.sims.render import cull, pedestrian, pixels, spans
+from percept.sims.road_geometry import build_road_geometry
+from percept.sims.render import StereoRenderer
+from percept.sensors import StereoRig
+from highway_env.road.road import RoadNetwork
+modules = (pixels, cull, spans, pedestrian)
+kernels = [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
+StereoRenderer(StereoRig(), build_road_geometry(RoadNetwork.straight_road_network(2, length=100)), scenery=False)
 before = [len(k.signatures) for k in kernels]
 world = SimWorld(WorldConfig("crossing", seed=1, condition="night", autopilot=True))
 for _ in range(6):
@@ -123,7 +128,40 @@ def test_after_the_warm_up_rendering_a_world_compiles_nothing():
     count, least, unchanged = out.stdout.split()
     # every kernel compiled (or loaded) by the warm-up; a frame compiling one for new argument types would pay
     # seconds inside a timed step
-    assert int(count) >= 8 and int(least) >= 1 and unchanged == "True"
+    assert int(count) >= 9 and int(least) >= 1 and unchanged == "True"
+
+
+FIGURES = """
+import hashlib, math
+import numpy as np
+from percept.sensors import Pose2D
+from percept.sims.render import ObjectKind, ObjectState
+from percept.sims.render.pedestrian import pedestrian_packed
+rng = np.random.default_rng(11)
+m = hashlib.sha256()
+for i in range(300):
+    x, y = rng.uniform(-40, 40, 2)
+    obj = ObjectState(i + 1, ObjectKind.PEDESTRIAN, Pose2D(x, y, rng.uniform(-math.pi, math.pi)), 0.5, 0.5,
+                      rng.uniform(1.0, 2.1), style=int(rng.integers(0, 2**40)), speed_mps=float(rng.choice([0, 1.4])),
+                      gait_phase=rng.uniform(0, 12))
+    m.update(pedestrian_packed(obj, (rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(0.5, 2.0))).tobytes())
+# seen from straight above its base: the horizontal direction to the viewer is degenerate
+m.update(pedestrian_packed(ObjectState(1, ObjectKind.PEDESTRIAN, Pose2D(1.0, 2.0, 0.3), 0.5, 0.5, 1.7),
+                           (1.0, 2.0, 1.0)).tobytes())
+print(m.hexdigest())
+"""
+
+
+def test_the_compiled_figures_are_the_interpreted_ones():
+    # the pedestrians' figures are built by compiled code; with numba's compiler off the same functions run as
+    # Python, with Python's own arithmetic, math.hypot, min and max: the patches must be the same bytes
+    digests = []
+    for jit_off in ("0", "1"):
+        env = {**os.environ, "NUMBA_DISABLE_JIT": jit_off}
+        out = subprocess.run([sys.executable, "-c", FIGURES], capture_output=True, text=True, timeout=300, env=env)
+        assert out.returncode == 0, out.stderr[-2000:]
+        digests.append(out.stdout.strip())
+    assert len(digests[0]) == 64 and digests[0] == digests[1]
 
 
 CTRL_C = """

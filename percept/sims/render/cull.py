@@ -2,21 +2,15 @@
 one camera, and the affine rows of its inverse homography.
 
 Float64 throughout, with the operations in the order of the vectorised numpy version they replace (cross and dot
-products are ``vec3``'s, compiled; rows of four summed left to right, as numpy sums them), so the prepared patches
+products are ``vec3``'s; rows of four summed left to right, as numpy sums them), so the prepared patches
 are the same bit for bit.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
-
 from .compiled import kernel
 from .vec3 import cross, dot
-
-_cross = njit(cache=True)(cross)
-_dot = njit(cache=True)(dot)
-
 
 @kernel(error_model="numpy")
 def project_patches(O, E1, E2, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled
@@ -39,7 +33,7 @@ def project_patches(O, E1, E2, two_sided, fx, fy, cx, cy, W, H, near):  # pragma
     for i in range(P):
         o, e1, e2 = (O[i, 0], O[i, 1], O[i, 2]), (E1[i, 0], E1[i, 1], E1[i, 2]), (E2[i, 0], E2[i, 1], E2[i, 2])
         # back-face test: a face is seen from the front when n·(o - camera) < 0, n = e1 x e2, the camera the origin
-        if not (_dot(_cross(e1, e2), o) < 0 or two_sided[i]):
+        if not (dot(cross(e1, e2), o) < 0 or two_sided[i]):
             continue
         # corners o, o + e1, o + e1 + e2, o + e2
         for a in range(3):
@@ -114,9 +108,9 @@ def inverse_rows(o, e1, e2, drawable, fx, fy, cx, cy):  # pragma: no cover - com
         a1 = (fx * e1[i, 0] + cx * e1[i, 2], fy * e1[i, 1] + cy * e1[i, 2], e1[i, 2])
         a2 = (fx * e2[i, 0] + cx * e2[i, 2], fy * e2[i, 1] + cy * e2[i, 2], e2[i, 2])
         a3 = (fx * o[i, 0] + cx * o[i, 2], fy * o[i, 1] + cy * o[i, 2], o[i, 2])
-        r0, r1, r2 = _cross(a2, a3), _cross(a3, a1), _cross(a1, a2)
-        det = _dot(a1, r0)
-        scale = np.sqrt(_dot(a1, a1) * _dot(a2, a2) * _dot(a3, a3))
+        r0, r1, r2 = cross(a2, a3), cross(a3, a1), cross(a1, a2)
+        det = dot(a1, r0)
+        scale = np.sqrt(dot(a1, a1) * dot(a2, a2) * dot(a3, a3))
         if not abs(det) > 1e-9 * scale:
             continue
         for a in range(3):

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba.extending import register_jitable
 
 from .vec3 import Vec3, add, mul, sub, vec
 
@@ -72,10 +73,12 @@ class PatchBatch:
                           a[:, 17:19])
 
 
+@register_jitable
 def box_faces(c: Vec3, axes: tuple[Vec3, Vec3, Vec3], size: Vec3) -> list[tuple[Vec3, Vec3, Vec3]]:
     """(origin, e1, e2) of the front (+x), back, left (+y), right, top (+z) and bottom faces of the box centred at
-    ``c`` with unit ``axes`` x, y, z and ``size`` along them [m]; e1 x e2 points outwards (for back-face culling)."""
-    hx, hy, hz = (mul(size[k] / 2, axes[k]) for k in range(3))
+    ``c`` with unit ``axes`` x, y, z and ``size`` along them [m]; e1 x e2 points outwards (for back-face culling).
+    Compiled into the kernels that call it (the pedestrians' shoes)."""
+    hx, hy, hz = mul(size[0] / 2, axes[0]), mul(size[1] / 2, axes[1]), mul(size[2] / 2, axes[2])
     return [(sub(sub(add(c, hx), hy), hz), mul(2, hy), mul(2, hz)),
             (sub(add(sub(c, hx), hy), hz), mul(-2, hy), mul(2, hz)),
             (sub(add(add(c, hx), hy), hz), mul(-2, hx), mul(2, hz)),

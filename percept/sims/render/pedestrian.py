@@ -21,12 +21,15 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
-from .patches import SUN_DIR, box_faces
+from .compiled import kernel
+from .figure import ROW, box, disc, limb, packed, pymax, pymin
 from .scene import ObjectState
-from .vec3 import UP, Vec3, add, cross, dot, madd, mul, norm, sub, vec
+from .vec3 import UP, Vec3, add, dot, madd, mul, norm, vec
 
 # BGR colours. Clothing keeps some luminance or hue contrast against the grey asphalt (~100, 97, 95).
 SHIRTS = [(40, 40, 175), (95, 45, 20), (35, 90, 30), (28, 28, 30), (225, 225, 222), (205, 140, 80),
@@ -37,9 +40,6 @@ PANTS = [(120, 75, 40), (85, 55, 35), (30, 30, 32), (70, 105, 135), (50, 50, 55)
 SKINS = [(150, 180, 225), (125, 160, 210), (95, 130, 185), (70, 100, 150), (50, 70, 105)]
 HAIR = [(20, 20, 25), (25, 40, 65), (45, 75, 120), (80, 150, 190), (150, 150, 155), (30, 30, 90)]
 SHOES = [(25, 25, 28), (30, 50, 80), (215, 215, 215), (40, 40, 40)]
-
-SUN = vec(SUN_DIR)
-"""Light direction (world) for the lit/shadowed halves: the renderer's sun."""
 
 # Normal walking over one gait cycle (fraction 0 = heel strike of that leg), degrees; after Winter's
 # normative sagittal kinematics. HIP: thigh forwards of the vertical; KNEE: flexion; FOOT: shoe pitch
@@ -53,108 +53,7 @@ KNEE = np.array([2.0, 10.0, 15.0, 10.0, 8.0, 22.0, 36.0, 51.0, 38.0, 13.0, 2.0])
 FOOT = np.array([-10.0, 0.0, 0.0, 0.0, 5.0, 14.0, 34.0, 25.0, 5.0, -8.0, -10.0])
 
 
-class _Figure:
-    """Collects one pedestrian's patches, then drops them all so that the lowest point is at z = 0."""
-
-    def __init__(self, view: Vec3, oid: int):
-        self.view = view
-        self.oid = oid
-        self.rows: list[tuple] = []  # (origin, e1, e2, colour, outline, box-or-None)
-
-    def _toward_view(self, p: Vec3, bias: float) -> Vec3:
-        # p + bias d / |d|, d the horizontal direction from p to the viewer
-        if bias == 0.0:
-            return p
-        d = (self.view[0] - p[0], self.view[1] - p[1], 0.0)
-        n = norm(d) + 1e-12
-        return (p[0] + bias * d[0] / n, p[1] + bias * d[1] / n, p[2] + bias * d[2] / n)
-
-    def limb(self, p0, p1, r0: float, r1: float, color, bias: float = 0.0, caps: tuple = (True, True)) -> None:
-        """A tapered view-facing quad from p0 (half-width r0) to p1 (half-width r1) with round caps.
-
-        Each half (either side of the axis) is a rectangle plus a parallelogram for the taper; the half
-        facing the sun is a little brighter than the other.
-        """
-        p0 = self._toward_view(p0, bias)
-        p1 = self._toward_view(p1, bias)
-        axis = sub(p1, p0)
-        side = cross(axis, sub(self.view, ((p0[0] + p1[0]) / 2, (p0[1] + p1[1]) / 2, (p0[2] + p1[2]) / 2)))
-        n = norm(side)
-        if n < 1e-9:
-            return
-        side = (side[0] / n, side[1] / n, side[2] / n)
-        if r0 < r1:  # build from the wide end
-            p0, p1, r0, r1, axis, caps = p1, p0, r1, r0, (-axis[0], -axis[1], -axis[2]), caps[::-1]
-        if r0 > 1.9 * r1:  # too steep a taper for one rectangle + parallelogram per half: split it
-            rm = r0 / 1.8
-            pm = madd(p0, (r0 - rm) / (r0 - r1), axis)
-            self.limb(p0, pm, r0, rm, color, caps=(caps[0], False))
-            self.limb(pm, p1, rm, r1, color, caps=(False, caps[1]))
-            return
-        sun = dot(side, SUN)
-        lit = 1.0 if sun >= 0 else -1.0
-        for sgn in (lit, -lit):
-            s = mul(sgn, side)
-            k = 1.0 + (0.13 * abs(sun) + 0.04) * (1 if sgn == lit else -1)
-            col = tuple(min(255.0, c * k) for c in color)
-            # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
-            over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
-            near = self._toward_view(p0, nb)
-            self.rows.append((madd(near, -over, s), mul(r1 + over, s), axis, col, 0, None))
-            if r0 - r1 > 1e-6:
-                w = min(r0 - r1 + 0.1 * r1, r1)
-                e2 = madd(axis, r1 - r0, s)
-                self.rows.append((madd(near, r0, s), mul(-w, s), e2, col, 0, None))
-        for p, r, c in ((p0, r0, caps[0]), (p1, r1, caps[1])):
-            if c:
-                self.disc(p, r, r, color)
-
-    def disc(self, c, ry: float, rx: float, color, bias: float = 0.0) -> None:
-        """A view-facing ellipse centred at c: half-height ry, half-width rx."""
-        c = self._toward_view(c, bias)
-        d = sub(self.view, c)
-        n = norm(d) + 1e-12
-        d = (d[0] / n, d[1] / n, d[2] / n)
-        right = cross(UP, d)
-        n = norm(right) + 1e-12
-        right = (right[0] / n, right[1] / n, right[2] / n)
-        upv = cross(d, right)
-        self.rows.append((madd(madd(c, -rx, right), -ry, upv), mul(2 * rx, right), mul(2 * ry, upv), tuple(color),
-                          1, None))
-
-    def box(self, center: Vec3, axes: tuple[Vec3, Vec3, Vec3], size: Vec3, color) -> None:
-        """A box with its bottom (as PatchBuilder.box makes it): ``center``, ``axes`` (unit x, y, z of the box),
-        ``size`` along them [m]."""
-        self.rows.append((center, axes, size, color, -1, "box"))
-
-    def lowest_z(self) -> float:
-        """Lowest z [m] of everything collected so far."""
-        z = math.inf
-        for o, e1, e2, _, outline, kind in self.rows:
-            if kind == "box":
-                # the centre less the half extents' heights along each axis
-                z = min(z, o[2] - (abs(e2[0] / 2 * e1[0][2]) + abs(e2[1] / 2 * e1[1][2]) + abs(e2[2] / 2 * e1[2][2])))
-            elif outline == 1:
-                z = min(z, o[2] + 0.5 * (e1[2] + e2[2]) - 0.5 * math.hypot(e1[2], e2[2]))
-            else:
-                z = min(z, o[2] + min(0.0, e1[2]) + min(0.0, e2[2]))
-        return z
-
-    def packed(self) -> np.ndarray:
-        """The patches lowered onto the ground, packed as ``PatchBatch.pack`` packs them: (P, 19) float64."""
-        dz = -self.lowest_z()
-        rows = []
-        for o, e1, e2, color, outline, kind in self.rows:
-            if kind == "box":
-                # one-sided, shaded, untextured faces, outwards as PatchBuilder.box orients them
-                rows += [(*f, *a, *b, *color, -1, 0, self.oid, 0, 1, 1, 1)
-                         for f, a, b in box_faces((o[0] + 0.0, o[1] + 0.0, o[2] + dz), e1, e2)]
-            else:
-                # two-sided, shaded, untextured (-1), repeat (1, 1)
-                rows.append((o[0] + 0.0, o[1] + 0.0, o[2] + dz, *e1, *e2, *color, -1, outline, self.oid, 1, 1, 1, 1))
-        return np.array(rows, dtype=np.float64)
-
-
+@njit(cache=True)
 def _turn(a: float, u: Vec3, b: float, v: Vec3) -> Vec3:
     """a u + b v."""
     return (a * u[0] + b * v[0], a * u[1] + b * v[1], a * u[2] + b * v[2])
@@ -163,156 +62,213 @@ def _turn(a: float, u: Vec3, b: float, v: Vec3) -> Vec3:
 @functools.lru_cache(maxsize=256)
 def _style(style: int) -> tuple:
     """A figure's look drawn from its style seed, in a fixed order: shirt, trousers, skin, hair and shoe
-    colours (BGR), build, long sleeves, shorts, long hair, bulk (see ``_Body``)."""
+    colours (BGR, as floats), build, long sleeves, shorts, long hair, bulk (see ``Body``)."""
     rng = np.random.default_rng(style & 0xFFFFFFFF)
-    colours = tuple(palette[int(rng.integers(len(palette)))] for palette in (SHIRTS, PANTS, SKINS, HAIR, SHOES))
+    colours = tuple(vec(palette[int(rng.integers(len(palette)))]) for palette in (SHIRTS, PANTS, SKINS, HAIR, SHOES))
     build = float(rng.uniform(0.92, 1.12))
     flags = tuple(bool(rng.random() < q) for q in (0.5, 0.12, 0.3))
     return (*colours, build, *flags, float(rng.uniform(1.0, 1.3)))
 
 
-def _scaled(color, k: float) -> tuple:
-    return tuple(min(255.0, c * k) for c in color)
+@njit(cache=True)
+def _scaled(color: Vec3, k: float) -> Vec3:
+    return (pymin(255.0, color[0] * k), pymin(255.0, color[1] * k), pymin(255.0, color[2] * k))
 
 
-class _Body:
-    """One pedestrian's frame, style and how it is seen: stature ``h`` [m]; ``fwd``, ``left`` (3,) unit vectors
-    of the walking direction at ``base`` (the pose on the ground) [world]; ``vdir`` the horizontal direction to
-    the viewer; ``cf`` = 1 seen from the front or back, 0 from the side (``cs`` the other way); the gait cycle
-    fraction ``c`` of the left leg (0 = heel strike). ``obj.style`` seeds the colours (BGR), build (a width
-    factor), sleeves, shorts, long hair and bulk (upper-body clothing, from a shirt to a padded jacket; the
-    hips get half of it), drawn in a fixed order so that a seed always dresses the same figure."""
+class Body(NamedTuple):
+    """One pedestrian's frame, look and gait as seen from ``viewer`` (the rig centre) [m, world]: stature ``h``
+    [m]; ``fwd``, ``left`` unit vectors of the walking direction at ``base`` (the pose on the ground); ``vdir`` the
+    horizontal direction to the viewer; ``cf`` = 1 seen from the front or back, 0 from the side (``cs`` the other
+    way); ``lean`` of the trunk [rad]; ``gait`` per leg (left, right) its side (+1, -1) and hip, knee and shoe
+    angles [rad]; ``trunk_w`` the half-widths [m] of the trunk parts' ends as seen (pelvis, belly, chest,
+    shoulders). Colours are BGR; ``build`` is a width factor, ``hips`` the hips' share of the clothing's bulk."""
 
-    def __init__(self, obj: ObjectState, view: Vec3):
-        (self.shirt, self.pants, self.skin, self.hair, self.shoes, self.build, self.long_sleeves, self.shorts,
-         self.long_hair, self.bulk) = _style(int(obj.style))
-        self.hips = 1.0 + 0.5 * (self.bulk - 1.0)
-        p = obj.pose
-        self.h = obj.height_m
-        self.fwd = (math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0)
-        self.left = (-self.fwd[1], self.fwd[0], 0.0)
-        self.base = (float(p.x_m), float(p.y_m), 0.0)
-        self.walking = obj.speed_mps > 0.05
-        self.c = (obj.gait_phase / (2 * math.pi)) % 1.0
-        vdir = (view[0] - self.base[0], view[1] - self.base[1], 0.0)
-        n = norm(vdir) + 1e-12
-        self.vdir = (vdir[0] / n, vdir[1] / n, vdir[2] / n)
-        self.cf = abs(dot(self.vdir, self.fwd))
-        self.cs = math.sqrt(max(0.0, 1.0 - self.cf * self.cf))
-        self.lean = 0.06 if self.walking else 0.0  # trunk leans forwards a little when walking [rad]
-
-    @property
-    def sides(self) -> tuple:
-        """(side, gait cycle fraction) of the left (+1) and right (-1) limbs: half a cycle apart."""
-        return (+1, self.c), (-1, (self.c + 0.5) % 1.0)
-
-    def pt(self, x, y, z) -> Vec3:
-        """The world point x forwards, y left, z up [m] of the figure's base."""
-        return madd(madd(madd(self.base, x, self.fwd), y, self.left), z, UP)
-
-    def seg(self, ang) -> Vec3:
-        """Unit vector at angle ``ang`` from straight down, rotated forwards (sagittal plane)."""
-        return _turn(math.sin(ang), self.fwd, -math.cos(ang), UP)
-
-    def across(self, w, d, bk=None) -> float:
-        """How wide a trunk part looks [m]: an elliptic cross-section of width w (across) and depth d (front to
-        back), fractions of h; the clothing adds ``bk`` (default the upper body's bulk) to the depth."""
-        bk = self.bulk if bk is None else bk
-        return math.hypot(w * self.cf, d * self.cs * bk) * self.h * self.build
-
-    def trunk(self, z, x=0.0) -> Vec3:
-        """A point on the trunk's mid-line at height z [fraction of h], leaning forwards about the hips."""
-        h = self.h
-        return self.pt(x * h + (z - 0.53) * h * math.sin(self.lean), 0.0, z * h)
+    viewer: Vec3
+    oid: int
+    h: float
+    base: Vec3
+    fwd: Vec3
+    left: Vec3
+    vdir: Vec3
+    cf: float
+    cs: float
+    lean: float
+    walking: bool
+    gait: tuple[tuple[float, float, float, float], tuple[float, float, float, float]]
+    trunk_w: tuple[float, float, float, float, float, float, float, float]
+    shirt: Vec3
+    pants: Vec3
+    skin: Vec3
+    hair: Vec3
+    shoes: Vec3
+    build: float
+    hips: float
+    long_sleeves: bool
+    shorts: bool
+    long_hair: bool
 
 
-def _legs(fig: _Figure, body: _Body) -> None:
+def _body(obj: ObjectState, view: Vec3) -> Body:
+    """``obj``'s Body. ``obj.style`` seeds the colours, build, sleeves, shorts, long hair and bulk (upper-body
+    clothing, from a shirt to a padded jacket; the hips get half of it), drawn in a fixed order so that a seed
+    always dresses the same figure; the gait cycle fraction of the left leg is ``obj.gait_phase`` / 2π (0 = heel
+    strike), the right leg half a cycle on."""
+    shirt, pants, skin, hair, shoes, build, long_sleeves, shorts, long_hair, bulk = _style(int(obj.style))
+    hips = 1.0 + 0.5 * (bulk - 1.0)
+    p = obj.pose
+    h = float(obj.height_m)
+    fwd = (math.cos(p.yaw_rad), math.sin(p.yaw_rad), 0.0)
+    base = (float(p.x_m), float(p.y_m), 0.0)
+    walking = obj.speed_mps > 0.05
+    c = (obj.gait_phase / (2 * math.pi)) % 1.0
+    vdir = (view[0] - base[0], view[1] - base[1], 0.0)
+    n = norm(vdir) + 1e-12
+    vdir = (vdir[0] / n, vdir[1] / n, vdir[2] / n)
+    cf = abs(dot(vdir, fwd))
+    cs = math.sqrt(max(0.0, 1.0 - cf * cf))
+    gait = []
+    for sgn, cl in ((+1, c), (-1, (c + 0.5) % 1.0)):
+        if walking:
+            angles = tuple(math.radians(float(np.interp(cl, GAIT_C, t))) for t in (HIP, KNEE, FOOT))
+        else:
+            angles = (0.02 * sgn, 0.03, 0.0)
+        gait.append((float(sgn), *angles))
+
+    def across(w, d, bk):
+        # how wide a trunk part looks [m]: an elliptic cross-section of width w (across) and depth d (front to back),
+        # fractions of h, the clothing adding bk to the depth. math.hypot here, CPython's: see figure.py
+        return math.hypot(w * cf, d * cs * bk) * h * build
+
+    trunk_w = (across(0.098, 0.086, hips), across(0.086, 0.079, hips), across(0.09, 0.082, hips),
+               across(0.086, 0.082, hips), across(0.087, 0.084, bulk), across(0.104, 0.09, bulk),
+               across(0.125, 0.086, bulk), across(0.055, 0.058, bulk))
+    # the trunk leans forwards a little when walking [rad]
+    return Body(view, int(obj.obj_id), h, base, fwd, (-fwd[1], fwd[0], 0.0), vdir, cf, cs, 0.06 if walking else 0.0,
+                walking, tuple(gait), trunk_w, shirt, pants, skin, hair, shoes, build, hips, long_sleeves, shorts,
+                long_hair)
+
+
+@njit(cache=True)
+def _pt(body: Body, x: float, y: float, z: float) -> Vec3:
+    """The world point x forwards, y left, z up [m] of the figure's base."""
+    return madd(madd(madd(body.base, x, body.fwd), y, body.left), z, UP)
+
+
+@njit(cache=True)
+def _seg(body: Body, ang: float) -> Vec3:
+    """Unit vector at angle ``ang`` from straight down, rotated forwards (sagittal plane)."""
+    return _turn(math.sin(ang), body.fwd, -math.cos(ang), UP)
+
+
+@njit(cache=True)
+def _trunk_pt(body: Body, z: float, x: float = 0.0) -> Vec3:
+    """A point on the trunk's mid-line at height z [fraction of h], leaning forwards about the hips."""
+    h = body.h
+    return _pt(body, x * h + (z - 0.53) * h * math.sin(body.lean), 0.0, z * h)
+
+
+@njit(cache=True)
+def _legs(rows, n: int, body: Body) -> int:
     """Thigh, shank (trousers, or shorts and skin) and a shoe pitched by the gait, per leg."""
-    h, fwd, left, seg, build = body.h, body.fwd, body.left, body.seg, body.build
+    h, fwd, left, build, view = body.h, body.fwd, body.left, body.build, body.viewer
     hip_z, thigh, shank = 0.53 * h, 0.245 * h, 0.246 * h
     foot_l, ankle_h = 0.155 * h, 0.039 * h
-    for sgn, cl in body.sides:
-        if body.walking:
-            a, knee_flex, toe_down = (math.radians(float(np.interp(cl, GAIT_C, t))) for t in (HIP, KNEE, FOOT))
-            stance_y = 0.05 * h
-        else:
-            a, knee_flex, toe_down, stance_y = 0.02 * sgn, 0.03, 0.0, 0.055 * h
+    stance_y = 0.05 * h if body.walking else 0.055 * h
+    for sgn, a, knee_flex, toe_down in body.gait:
         b_ang = a - knee_flex
-        hip = body.pt(0.0, sgn * stance_y, hip_z)
-        knee = madd(hip, thigh, seg(a))
-        ankle = madd(knee, shank, seg(b_ang))
+        hip = _pt(body, 0.0, sgn * stance_y, hip_z)
+        knee = madd(hip, thigh, _seg(body, a))
+        ankle = madd(knee, shank, _seg(body, b_ang))
         if body.shorts:
-            mid = madd(hip, 0.55 * thigh, seg(a))
-            fig.limb(hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, bias=0.005)
-            fig.limb(mid, knee, 0.036 * h * build, 0.03 * h * build, body.skin, bias=0.004, caps=(False, True))
-            fig.limb(knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, bias=0.005)
+            mid = madd(hip, 0.55 * thigh, _seg(body, a))
+            n = limb(rows, n, view, hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, 0.005)
+            n = limb(rows, n, view, mid, knee, 0.036 * h * build, 0.03 * h * build, body.skin, 0.004, False, True)
+            n = limb(rows, n, view, knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, 0.005)
         else:
-            fig.limb(hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, bias=0.005)
-            fig.limb(knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, bias=0.005)
+            n = limb(rows, n, view, hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, 0.005)
+            n = limb(rows, n, view, knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, 0.005)
         # the shoe, pitched toe-down at heel-off and toe-up at heel strike
         f_dir = _turn(math.cos(toe_down), fwd, -math.sin(toe_down), UP)
         f_up = _turn(math.sin(toe_down), fwd, math.cos(toe_down), UP)
         shoe_h = 0.06 * h
         centre = madd(madd(ankle, 0.28 * foot_l, f_dir), shoe_h / 2 - ankle_h, f_up)
-        fig.box(centre, (f_dir, left, f_up), (foot_l, 0.058 * h * build, shoe_h), body.shoes)
+        n = box(rows, n, centre, (f_dir, left, f_up), (foot_l, 0.058 * h * build, shoe_h), body.shoes)
+    return n
 
 
-def _trunk(fig: _Figure, body: _Body) -> None:
+@njit(cache=True)
+def _trunk(rows, n: int, body: Body) -> int:
     """Pelvis (trousers), torso (shirt) with a lighter chest, shoulders sloping to the neck."""
-    trunk, across, hips, shirt = body.trunk, body.across, body.hips, body.shirt
-    fig.limb(trunk(0.465, -0.004), trunk(0.6), across(0.098, 0.086, hips), across(0.086, 0.079, hips),
-             body.pants, caps=(False, False))
-    fig.limb(trunk(0.54), trunk(0.67, 0.006), across(0.09, 0.082, hips), across(0.086, 0.082, hips),
-             _scaled(shirt, 0.95), bias=0.01, caps=(False, False))
-    fig.limb(trunk(0.665, 0.006), trunk(0.785, 0.004), across(0.087, 0.084), across(0.104, 0.09),
-             shirt, bias=0.01, caps=(False, False))
-    fig.limb(trunk(0.78, 0.004), trunk(0.845), across(0.125, 0.086), across(0.055, 0.058),
-             shirt, bias=0.011, caps=(False, False))
+    w, shirt, view = body.trunk_w, body.shirt, body.viewer
+    n = limb(rows, n, view, _trunk_pt(body, 0.465, -0.004), _trunk_pt(body, 0.6), w[0], w[1], body.pants, 0.0,
+             False, False)
+    n = limb(rows, n, view, _trunk_pt(body, 0.54), _trunk_pt(body, 0.67, 0.006), w[2], w[3], _scaled(shirt, 0.95),
+             0.01, False, False)
+    n = limb(rows, n, view, _trunk_pt(body, 0.665, 0.006), _trunk_pt(body, 0.785, 0.004), w[4], w[5], shirt, 0.01,
+             False, False)
+    return limb(rows, n, view, _trunk_pt(body, 0.78, 0.004), _trunk_pt(body, 0.845), w[6], w[7], shirt, 0.011,
+                False, False)
 
 
-def _head(fig: _Figure, body: _Body) -> None:
+@njit(cache=True)
+def _head(rows, n: int, body: Body) -> int:
     """Neck and head: face, hair cap, hair at the back, eyes when seen from the front, long hair."""
-    h, fwd, left, cf, cs = body.h, body.fwd, body.left, body.cf, body.cs
+    h, fwd, left, cf, cs, view = body.h, body.fwd, body.left, body.cf, body.cs, body.viewer
     skin, hair = body.skin, body.hair
-    fig.limb(body.trunk(0.82, 0.005), body.trunk(0.885, 0.01), 0.028 * h, 0.028 * h, _scaled(skin, 0.9),
-             bias=0.0, caps=(False, False))
-    head_c = body.trunk(0.935, 0.012)
+    n = limb(rows, n, view, _trunk_pt(body, 0.82, 0.005), _trunk_pt(body, 0.885, 0.01), 0.028 * h, 0.028 * h,
+             _scaled(skin, 0.9), 0.0, False, False)
+    head_c = _trunk_pt(body, 0.935, 0.012)
     head_w = (0.048 * cf + 0.055 * cs) * h
     front = dot(body.vdir, fwd)
     face_bias, hair_bias = (0.02, 0.015) if front > -0.3 else (0.012, 0.02)
-    fig.disc(head_c, 0.065 * h, head_w, skin, bias=face_bias)
-    fig.disc(madd(madd(head_c, 0.022 * h, UP), -0.012 * h, fwd), 0.046 * h, head_w * 1.08, hair, bias=hair_bias)
-    fig.disc(madd(madd(head_c, 0.006 * h, UP), -0.02 * h, fwd), 0.058 * h, head_w * 1.02, hair,
-             bias=hair_bias - 0.004)
+    n = disc(rows, n, view, head_c, 0.065 * h, head_w, skin, face_bias)
+    n = disc(rows, n, view, madd(madd(head_c, 0.022 * h, UP), -0.012 * h, fwd), 0.046 * h, head_w * 1.08, hair,
+             hair_bias)
+    n = disc(rows, n, view, madd(madd(head_c, 0.006 * h, UP), -0.02 * h, fwd), 0.058 * h, head_w * 1.02, hair,
+             hair_bias - 0.004)
     if front > -0.2:  # eyes on the front of the head; hidden by the face or hair from behind
         for s in (+1, -1):
             eye = madd(madd(madd(head_c, 0.046 * h, fwd), 0.018 * h * s, left), 0.004 * h, UP)
-            fig.disc(eye, 0.0055 * h, 0.008 * h, (40, 35, 35), bias=0.01)
+            n = disc(rows, n, view, eye, 0.0055 * h, 0.008 * h, (40.0, 35.0, 35.0), 0.01)
     if body.long_hair:
-        fig.limb(madd(head_c, -0.025 * h, fwd), madd(madd(head_c, -0.03 * h, fwd), -0.13 * h, UP), 0.05 * h,
-                 0.045 * h, hair, bias=0.012 * cs, caps=(True, False))
+        n = limb(rows, n, view, madd(head_c, -0.025 * h, fwd), madd(madd(head_c, -0.03 * h, fwd), -0.13 * h, UP),
+                 0.05 * h, 0.045 * h, hair, 0.012 * cs, True, False)
+    return n
 
 
-def _arms(fig: _Figure, body: _Body) -> None:
+@njit(cache=True)
+def _arms(rows, n: int, body: Body) -> int:
     """Arms swinging against the legs: upper arm (sleeve), forearm (sleeve or skin), hand."""
-    h, left, seg = body.h, body.left, body.seg
+    h, left, view = body.h, body.left, body.viewer
     build, hips, skin = body.build, body.hips, body.skin
     sleeve = _scaled(body.shirt, 0.93)
-    for sgn, cl in body.sides:
+    fore = sleeve if body.long_sleeves else skin
+    for sgn, hip_a, _, _ in body.gait:
         if body.walking:
-            hip_a = math.radians(float(np.interp(cl, GAIT_C, HIP)))
             a = -0.8 * (hip_a - math.radians(9.0))
-            a2 = a + 0.3 + 0.8 * max(0.0, a)
+            a2 = a + 0.3 + 0.8 * pymax(0.0, a)
         else:
             a, a2 = 0.0, 0.12
-        sh = madd(body.trunk(0.795), sgn * 0.113 * h * build, left)
+        sh = madd(_trunk_pt(body, 0.795), sgn * 0.113 * h * build, left)
         out = mul(0.07 * sgn, left)  # slight abduction so that the arm hangs clear of the waist
-        elbow = madd(sh, 0.186 * h, add(seg(a), out))
-        wrist = madd(elbow, 0.146 * h, madd(seg(a2), 0.5, out))
-        fore = sleeve if body.long_sleeves else skin
-        fig.limb(sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, bias=0.025)
-        fig.limb(elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, bias=0.025, caps=(False, True))
-        fig.disc(madd(wrist, 0.045 * h, seg(a2)), 0.042 * h, 0.024 * h, skin, bias=0.03)
+        elbow = madd(sh, 0.186 * h, add(_seg(body, a), out))
+        wrist = madd(elbow, 0.146 * h, madd(_seg(body, a2), 0.5, out))
+        n = limb(rows, n, view, sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, 0.025)
+        n = limb(rows, n, view, elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, 0.025, False, True)
+        n = disc(rows, n, view, madd(wrist, 0.045 * h, _seg(body, a2)), 0.042 * h, 0.024 * h, skin, 0.03)
+    return n
+
+
+@kernel()
+def _figure(body: Body) -> np.ndarray:
+    """The body's patches, lowered onto the ground and packed: (P, 19)."""
+    rows = np.empty((160, ROW))
+    # the parts in the order they have always been added (legs, trunk, head, arms): it is part of the output
+    n = _legs(rows, 0, body)
+    n = _trunk(rows, n, body)
+    n = _head(rows, n, body)
+    n = _arms(rows, n, body)
+    return packed(rows, n, body.oid)
 
 
 def pedestrian_packed(obj: ObjectState, view_world) -> np.ndarray:
@@ -321,10 +277,4 @@ def pedestrian_packed(obj: ObjectState, view_world) -> np.ndarray:
     ``obj.style`` seeds clothing, skin, hair and build; ``obj.gait_phase`` [rad] the walking cycle (0 = left heel
     strike), used when ``obj.speed_mps`` > 0.05. The lowest shoe point touches the ground (z = 0) at the pose
     position; every patch carries ``obj.obj_id``."""
-    view = vec(view_world)
-    body = _Body(obj, view)
-    fig = _Figure(view, obj.obj_id)
-    # the patches in the order they have always been added (legs, trunk, head, arms): it is part of the output
-    for part in (_legs, _trunk, _head, _arms):
-        part(fig, body)
-    return fig.packed()
+    return _figure(_body(obj, vec(view_world)))
