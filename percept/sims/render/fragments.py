@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .pixels import big_patches, shade_winners, small_fragments, texel_coords
+from .pixels import big_patches, held_ends, put_albedo, shade_winners, small_fragments, texel_coords
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
 
@@ -134,18 +134,20 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
         p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive, p.color,
         textured, sil is not None, np.float32(INV_NEAR))
     _add_silhouettes(sil, sil_pix, sil_oid)
-    # one 3-byte item per pixel, so that masked copies take a 2-D mask
-    image = target.image.view(np.dtype("V3"))[..., 0]
     ks = np.flatnonzero(textured[order] & (held > 0))
-    for k, (tiled, H) in zip(ks.tolist(), _texture_maps(p, atlas, order[ks])):
-        i = order[k]
-        x0, x1, y0, y1 = int(p.x0[i]), int(p.x1[i]), int(p.y0[i]), int(p.y1[i])
-        alb = cv2.warpPerspective(tiled, H, (x1 - x0, y1 - y0), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                                  borderMode=cv2.BORDER_CONSTANT)
-        # colour * albedo / 255, per channel, as a 256-entry colour map of the albedo
-        lut = (_ALBEDO * p.color[i]).astype(np.uint8)
-        col = cv2.applyColorMap(alb, lut).view(np.dtype("V3"))[..., 0]
-        np.copyto(image[y0:y1, x0:x1], col, where=winner[y0:y1, x0:x1] == k)
+    if not len(ks):
+        return
+    idx = order[ks]
+    x0s, x1s, y0s = p.x0[idx].tolist(), p.x1[idx].tolist(), p.y0[idx].tolist()
+    # each warp stops after the last row its patch still holds: OpenCV warps each row on its own, so the rows above
+    # come out the same (a box cut on the right would not: its last columns leave the vector loop differently)
+    ends = held_ends(winner, ks, p.x0[idx], p.x1[idx], p.y0[idx], p.y1[idx]).tolist()
+    # colour * albedo / 255, per channel, as a 256-entry colour map of the albedo
+    luts = (_ALBEDO * p.color[idx][:, None, None, :]).astype(np.uint8)
+    for j, (tiled, H) in enumerate(_texture_maps(p, atlas, idx)):
+        alb = cv2.warpPerspective(tiled, H, (x1s[j] - x0s[j], ends[j] - y0s[j]),
+                                  flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_CONSTANT)
+        put_albedo(target.image, alb, luts[j], winner, int(ks[j]), x0s[j], y0s[j])
 
 
 def _small_patches(target, p: PreparedPatches, atlas: TextureAtlas, rp, v, first, last, sil) -> None:

@@ -96,6 +96,32 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
     return held, sil_pix[:ns], sil_oid[:ns]
 
 
+
+@kernel()
+def held_ends(winner, ks, x0, x1, y0, y1):  # pragma: no cover - compiled
+    """Per patch j (order index ``ks[j]``, box ``x0[j]..x1[j]`` × ``y0[j]..y1[j]``, holding at least one pixel):
+    the row after the last one in which ``winner`` still names it."""
+    ends = np.empty(len(ks), np.int64)
+    for j in range(len(ks)):
+        ends[j] = y0[j]
+        for y in range(y1[j] - 1, y0[j] - 1, -1):
+            if (winner[y, x0[j]:x1[j]] == ks[j]).any():
+                ends[j] = y + 1
+                break
+    return ends
+
+
+@kernel()
+def put_albedo(img, alb, lut, winner, k, x0, y0):  # pragma: no cover - compiled
+    """``img`` (H, W, 3) uint8 = ``lut[alb]`` (the colour map (256, 1, 3) uint8 of the albedo ``alb`` (h, w) uint8
+    warped over the box from (x0, y0)) wherever ``winner`` names patch k."""
+    for r in range(alb.shape[0]):
+        for c in range(alb.shape[1]):
+            if winner[y0 + r, x0 + c] == k:
+                a = alb[r, c]
+                for ch in range(3):
+                    img[y0 + r, x0 + c, ch] = lut[a, 0, ch]
+
 @kernel()
 def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # pragma: no cover - compiled
     """One fragment per pixel centre first..last of each span (patch rp, row v): its 1/Z is written to ``wflat``
