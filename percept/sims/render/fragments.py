@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .pixels import big_patches, held_ends, put_albedo, shade_winners, small_fragments, texel_coords
+from .pixels import big_patches, put_albedo, shade_winners, small_fragments, texel_coords
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
 
@@ -128,7 +128,7 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
     span_row[front] = np.cumsum(h) - h
     textured = p.entry >= 0
     winner = np.full(target.inv_depth.shape, -1, np.int32)
-    held, sil_pix, sil_oid = big_patches(
+    held, ends, sil_pix, sil_oid = big_patches(
         target.inv_depth, _NONE_I32 if target.ids is None else target.ids,
         _NONE_F32 if target.emission is None else target.emission, target.image, winner, order, p.x0, p.x1, p.y0,
         p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive, p.color,
@@ -138,10 +138,10 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
     if not len(ks):
         return
     idx = order[ks]
-    x0s, x1s, y0s = p.x0[idx].tolist(), p.x1[idx].tolist(), p.y0[idx].tolist()
-    # each warp stops after the last row its patch still holds: OpenCV warps each row on its own, so the rows above
-    # come out the same (a box cut on the right would not: its last columns leave the vector loop differently)
-    ends = held_ends(winner, ks, p.x0[idx], p.x1[idx], p.y0[idx], p.y1[idx]).tolist()
+    x0s, x1s, y0s, ends = p.x0[idx].tolist(), p.x1[idx].tolist(), p.y0[idx].tolist(), ends[ks].tolist()
+    # each warp stops after the last row in which its patch won a pixel: OpenCV warps each row on its own, so the
+    # rows above come out the same (a box cut on the right would not: its last columns leave the vector loop
+    # differently)
     # colour * albedo / 255, per channel, as a 256-entry colour map of the albedo
     luts = (_ALBEDO * p.color[idx][:, None, None, :]).astype(np.uint8)
     for j, (tiled, H) in enumerate(_texture_maps(p, atlas, idx)):

@@ -22,6 +22,7 @@ import numpy as np
 from percept.sensors import Pose2D, Side, StereoRig
 
 from ..road_geometry import RoadGeometry
+from .compiled import kernel
 from .paint import GroundPaint, RoadIndex, ground_paint
 from .textures import ground_tile, mip_chain
 
@@ -156,6 +157,7 @@ class GroundLayer:
         self._haze_keep = (256 - A)[:, None, None]
         haze = np.asarray(self.palette.haze, np.uint16)[None, None, :]
         self._haze_add = (A[:, None, None] * haze + 128).astype(np.uint16)
+        _haze(np.zeros((H, 1, 3), np.uint8), self._haze_keep, self._haze_add, h0)  # compiled or loaded now
 
     def grain(self, pose: Pose2D) -> np.ndarray:
         """World-locked 7-bit ground albedo (H - first_row, W) uint8 for the vehicle at ``pose``."""
@@ -219,6 +221,17 @@ class GroundLayer:
             cv2.fillPoly(img, polys, color, lineType=cv2.LINE_AA, shift=4)
         h0, h1 = self.haze_rows
         if h1 > h0:
-            rows = img[h0:h1].astype(np.uint16)
-            img[h0:h1] = ((rows * self._haze_keep + self._haze_add) >> 8).astype(np.uint8)
+            _haze(img, self._haze_keep, self._haze_add, h0)
         return img, self.ground_depth.copy() if depth else None
+
+
+@kernel()
+def _haze(img, keep, add, h0):  # pragma: no cover - compiled
+    """Haze on rows h0.. of ``img`` (H, W, 3) uint8, one per row of ``keep`` (n, 1, 1) and ``add`` (n, 1, 3):
+    out = (img keep + add) >> 8 (``_init_haze``'s fixed point; at most 65408, so uint16 arithmetic would not
+    overflow either)."""
+    for r in range(keep.shape[0]):
+        k = np.int64(keep[r, 0, 0])
+        for x in range(img.shape[1]):
+            for ch in range(3):
+                img[h0 + r, x, ch] = (np.int64(img[h0 + r, x, ch]) * k + np.int64(add[r, 0, ch])) >> 8

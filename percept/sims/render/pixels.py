@@ -37,11 +37,13 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
     except the patches with ``defer`` (textured), whose colour is written afterwards where ``winner`` (H, W),
     the order index k of the last patch that won each pixel, still names them. ``span_row[i]``: the patch's
     first row in ``los``, ``his`` (its inside columns per box row), or -1 for a patch crossing the near plane
-    (the exact test per pixel, c < ``inv_near``). Returns the pixels each k holds at the end and, when
-    ``want_sil``, every inside pixel (flat index) of the patches with an object id > 0 and that id."""
+    (the exact test per pixel, c < ``inv_near``). Returns the pixels each k holds at the end, the row after the
+    last one in which it won a pixel (so below it, it holds none) and, when ``want_sil``, every inside pixel (flat
+    index) of the patches with an object id > 0 and that id."""
     H, W = wbuf.shape
     has_ids, has_em = ids.size > 0, em.size > 0
     held = np.zeros(len(order), np.int64)
+    ends = np.zeros(len(order), np.int64)
     sil_pix = np.empty(0, np.int32)
     sil_oid = np.empty(0, np.int32)
     ns = 0
@@ -59,11 +61,14 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
             cy = mc1 * fy + mc2
             ay = ma1 * fy + ma2
             by = mb1 * fy + mb2
-            for x in range(x0[i], x1[i]):
+            xa, xb = x0[i], x1[i]
+            if r >= 0:  # only the row's span can be inside
+                xa, xb = max(xa, los[r + y - y0[i]]), min(xb, his[r + y - y0[i]] + 1)
+            for x in range(xa, xb):
                 fx = f32(x)
                 c = mc0 * fx + cy
                 if r >= 0:
-                    inside = los[r + y - y0[i]] <= x <= his[r + y - y0[i]]
+                    inside = True
                 else:
                     # crossing the near plane: the exact test per pixel, with c < 1/near
                     ap = ma0 * fx + ay
@@ -90,25 +95,12 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
                     held[winner[y, x]] -= 1
                 winner[y, x] = k
                 held[k] += 1
+                ends[k] = y + 1
                 if not defer[i]:
                     for ch in range(3):
                         img[y, x, ch] = np.uint8(color[i, ch])
-    return held, sil_pix[:ns], sil_oid[:ns]
+    return held, ends, sil_pix[:ns], sil_oid[:ns]
 
-
-
-@kernel()
-def held_ends(winner, ks, x0, x1, y0, y1):  # pragma: no cover - compiled
-    """Per patch j (order index ``ks[j]``, box ``x0[j]..x1[j]`` × ``y0[j]..y1[j]``, holding at least one pixel):
-    the row after the last one in which ``winner`` still names it."""
-    ends = np.empty(len(ks), np.int64)
-    for j in range(len(ks)):
-        ends[j] = y0[j]
-        for y in range(y1[j] - 1, y0[j] - 1, -1):
-            if (winner[y, x0[j]:x1[j]] == ks[j]).any():
-                ends[j] = y + 1
-                break
-    return ends
 
 
 @kernel()
