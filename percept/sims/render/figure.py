@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 
 from .patches import SUN_DIR, box_faces
 from .vec3 import UP, cross, dot, madd, mul, norm, sub, vec
@@ -29,6 +29,11 @@ QUAD, ELLIPSE, BOX = 0, 1, 2
 ROW = 19
 SUN = vec(SUN_DIR)
 """Light direction (world) for the lit and shadowed halves of a limb: the renderer's sun."""
+
+# Explicit signatures for the functions called with constants (kinds, caps): numba would otherwise compile one
+# version per combination of those constants' values, which doubled the figure's first compile
+_V3, _F, _I, _B = types.UniTuple(types.float64, 3), types.float64, types.int64, types.boolean
+_ROWS = types.float64[:, ::1]
 
 @njit(cache=True)
 def pymin(a: float, b: float) -> float:
@@ -53,7 +58,7 @@ def toward_view(view, p, bias: float):
     return (p[0] + bias * d[0] / n, p[1] + bias * d[1] / n, p[2] + bias * d[2] / n)
 
 
-@njit(cache=True)
+@njit(_I(_ROWS, _I, _I, _V3, _V3, _V3, _V3), cache=True)
 def _put(rows, n: int, kind: int, a, b, c, colour) -> int:
     """Row ``n`` = (kind, a, b, c, colour), each a 3-tuple; returns n + 1."""
     if n >= rows.shape[0]:
@@ -67,9 +72,59 @@ def _put(rows, n: int, kind: int, a, b, c, colour) -> int:
     return n + 1
 
 
+@njit(_I(_ROWS, _I, _V3, _V3, _F, _F, _V3, _F), cache=True)
+def disc(rows, n: int, view, c, ry: float, rx: float, colour, bias: float) -> int:
+    """A view-facing ellipse centred at c (moved ``bias`` towards the viewer): half-height ry, half-width rx."""
+    c = toward_view(view, c, bias)
+    d = sub(view, c)
+    nd = norm(d) + 1e-12
+    d = (d[0] / nd, d[1] / nd, d[2] / nd)
+    right = cross(UP, d)
+    nr = norm(right) + 1e-12
+    right = (right[0] / nr, right[1] / nr, right[2] / nr)
+    upv = cross(d, right)
+    return _put(rows, n, ELLIPSE, madd(madd(c, -rx, right), -ry, upv), mul(2 * rx, right), mul(2 * ry, upv),
+                colour)
+
+
 @njit(cache=True)
-def limb(rows, n: int, view, p0, p1, r0: float, r1: float, colour, bias: float = 0.0, cap0: bool = True,
-         cap1: bool = True) -> int:
+def _frame(view, p0, p1):
+    """A limb's axis p1 - p0, the unit vector across it facing ``view``, and whether that exists."""
+    axis = sub(p1, p0)
+    side = cross(axis, sub(view, ((p0[0] + p1[0]) / 2, (p0[1] + p1[1]) / 2, (p0[2] + p1[2]) / 2)))
+    ns = norm(side)
+    if ns < 1e-9:
+        return axis, side, False
+    return axis, (side[0] / ns, side[1] / ns, side[2] / ns), True
+
+
+@njit(_I(_ROWS, _I, _V3, _V3, _V3, _F, _F, _V3, _V3, _V3, _B, _B), cache=True)
+def _halves(rows, n: int, view, p0, p1, r0: float, r1: float, axis, side, colour, cap0: bool, cap1: bool) -> int:
+    """A limb wider at p0 (r0 >= r1): each half (either side of the axis) a rectangle plus a parallelogram for the
+    taper, the half facing the sun a little brighter than the other; then the caps."""
+    sun = dot(side, SUN)
+    lit = 1.0 if sun >= 0 else -1.0
+    for sgn in (lit, -lit):
+        s = mul(sgn, side)
+        k = 1.0 + (0.13 * abs(sun) + 0.04) * (1 if sgn == lit else -1)
+        col = (pymin(255.0, colour[0] * k), pymin(255.0, colour[1] * k), pymin(255.0, colour[2] * k))
+        # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
+        over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
+        near = toward_view(view, p0, nb)
+        n = _put(rows, n, QUAD, madd(near, -over, s), mul(r1 + over, s), axis, col)
+        if r0 - r1 > 1e-6:
+            w = pymin(r0 - r1 + 0.1 * r1, r1)
+            e2 = madd(axis, r1 - r0, s)
+            n = _put(rows, n, QUAD, madd(near, r0, s), mul(-w, s), e2, col)
+    if cap0:
+        n = disc(rows, n, view, p0, r0, r0, colour, 0.0)
+    if cap1:
+        n = disc(rows, n, view, p1, r1, r1, colour, 0.0)
+    return n
+
+
+@njit(_I(_ROWS, _I, _V3, _V3, _V3, _F, _F, _V3, _F, _B, _B), cache=True)
+def limb(rows, n: int, view, p0, p1, r0: float, r1: float, colour, bias: float, cap0: bool, cap1: bool) -> int:
     """A tapered view-facing quad from p0 (half-width r0) to p1 (half-width r1) with round caps where asked; both
     ends first moved ``bias`` towards the viewer. Returns the next free row."""
     p0 = toward_view(view, p0, bias)
@@ -89,57 +144,6 @@ def limb(rows, n: int, view, p0, p1, r0: float, r1: float, colour, bias: float =
         if ok:
             n = _halves(rows, n, view, p0, pm, r0, rm, axis_w, side_w, colour, cap0, False)
         p0, r0, cap0 = pm, rm, False
-
-
-@njit(cache=True)
-def _frame(view, p0, p1):
-    """A limb's axis p1 - p0, the unit vector across it facing ``view``, and whether that exists."""
-    axis = sub(p1, p0)
-    side = cross(axis, sub(view, ((p0[0] + p1[0]) / 2, (p0[1] + p1[1]) / 2, (p0[2] + p1[2]) / 2)))
-    ns = norm(side)
-    if ns < 1e-9:
-        return axis, side, False
-    return axis, (side[0] / ns, side[1] / ns, side[2] / ns), True
-
-
-@njit(cache=True)
-def _halves(rows, n: int, view, p0, p1, r0: float, r1: float, axis, side, colour, cap0: bool, cap1: bool) -> int:
-    """A limb wider at p0 (r0 >= r1): each half (either side of the axis) a rectangle plus a parallelogram for the
-    taper, the half facing the sun a little brighter than the other; then the caps."""
-    sun = dot(side, SUN)
-    lit = 1.0 if sun >= 0 else -1.0
-    for sgn in (lit, -lit):
-        s = mul(sgn, side)
-        k = 1.0 + (0.13 * abs(sun) + 0.04) * (1 if sgn == lit else -1)
-        col = (pymin(255.0, colour[0] * k), pymin(255.0, colour[1] * k), pymin(255.0, colour[2] * k))
-        # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
-        over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
-        near = toward_view(view, p0, nb)
-        n = _put(rows, n, QUAD, madd(near, -over, s), mul(r1 + over, s), axis, col)
-        if r0 - r1 > 1e-6:
-            w = pymin(r0 - r1 + 0.1 * r1, r1)
-            e2 = madd(axis, r1 - r0, s)
-            n = _put(rows, n, QUAD, madd(near, r0, s), mul(-w, s), e2, col)
-    if cap0:
-        n = disc(rows, n, view, p0, r0, r0, colour)
-    if cap1:
-        n = disc(rows, n, view, p1, r1, r1, colour)
-    return n
-
-
-@njit(cache=True)
-def disc(rows, n: int, view, c, ry: float, rx: float, colour, bias: float = 0.0) -> int:
-    """A view-facing ellipse centred at c (moved ``bias`` towards the viewer): half-height ry, half-width rx."""
-    c = toward_view(view, c, bias)
-    d = sub(view, c)
-    nd = norm(d) + 1e-12
-    d = (d[0] / nd, d[1] / nd, d[2] / nd)
-    right = cross(UP, d)
-    nr = norm(right) + 1e-12
-    right = (right[0] / nr, right[1] / nr, right[2] / nr)
-    upv = cross(d, right)
-    return _put(rows, n, ELLIPSE, madd(madd(c, -rx, right), -ry, upv), mul(2 * rx, right), mul(2 * ry, upv),
-                colour)
 
 
 @njit(cache=True)

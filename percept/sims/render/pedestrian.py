@@ -181,12 +181,12 @@ def _legs(rows, n: int, body: Body) -> int:
         ankle = madd(knee, shank, _seg(body, b_ang))
         if body.shorts:
             mid = madd(hip, 0.55 * thigh, _seg(body, a))
-            n = limb(rows, n, view, hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, 0.005)
+            n = limb(rows, n, view, hip, mid, 0.05 * h * build, 0.043 * h * build, body.pants, 0.005, True, True)
             n = limb(rows, n, view, mid, knee, 0.036 * h * build, 0.03 * h * build, body.skin, 0.004, False, True)
-            n = limb(rows, n, view, knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, 0.005)
+            n = limb(rows, n, view, knee, ankle, 0.033 * h * build, 0.02 * h * build, body.skin, 0.005, True, True)
         else:
-            n = limb(rows, n, view, hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, 0.005)
-            n = limb(rows, n, view, knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, 0.005)
+            n = limb(rows, n, view, hip, knee, 0.05 * h * build, 0.034 * h * build, body.pants, 0.005, True, True)
+            n = limb(rows, n, view, knee, ankle, 0.035 * h * build, 0.026 * h * build, body.pants, 0.005, True, True)
         # the shoe, pitched toe-down at heel-off and toe-up at heel strike
         f_dir = _turn(math.cos(toe_down), fwd, -math.sin(toe_down), UP)
         f_up = _turn(math.sin(toe_down), fwd, math.cos(toe_down), UP)
@@ -253,7 +253,7 @@ def _arms(rows, n: int, body: Body) -> int:
         out = mul(0.07 * sgn, left)  # slight abduction so that the arm hangs clear of the waist
         elbow = madd(sh, 0.186 * h, add(_seg(body, a), out))
         wrist = madd(elbow, 0.146 * h, madd(_seg(body, a2), 0.5, out))
-        n = limb(rows, n, view, sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, 0.025)
+        n = limb(rows, n, view, sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, 0.025, True, True)
         n = limb(rows, n, view, elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, 0.025, False, True)
         n = disc(rows, n, view, madd(wrist, 0.045 * h, _seg(body, a2)), 0.042 * h, 0.024 * h, skin, 0.03)
     return n
