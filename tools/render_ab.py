@@ -40,17 +40,19 @@ def other_render(checkout: Path):
     return importlib.import_module("othersims.render")
 
 
+def convert(other, scene):
+    """``scene`` in the other checkout's own classes (its renderer tells kinds apart by identity)."""
+    def fields(o):
+        return {f.name: other.ObjectKind[o.kind.name] if f.name == "kind" else getattr(o, f.name)
+                for f in dataclasses.fields(o)}
+    return other.Scene(scene.ego, tuple(other.ObjectState(**fields(o)) for o in scene.objects))
+
+
 def main() -> None:
     if len(sys.argv) < 2:
         sys.exit(__doc__)
     other = other_render(Path(sys.argv[1]))
     reps = int(os.environ.get("REPS", "5"))
-
-    def convert(scene):
-        # the other checkout's own classes (its renderer tests kinds by identity)
-        objs = tuple(other.ObjectState(**{f.name: other.ObjectKind[o.kind.name] if f.name == "kind" else getattr(o, f.name)
-                                          for f in dataclasses.fields(o)}) for o in scene.objects)
-        return other.Scene(scene.ego, objs)
 
     for scen in sys.argv[2:] or ["highway", "crossing", "loop", "curves"]:
         world = SimWorld(WorldConfig(scen, seed=0, autopilot=True))
@@ -62,7 +64,7 @@ def main() -> None:
         for _ in range(FRAMES):
             world.step()
             scenes.append(scene_from_road(world.env.road, world.ego, world.ids))
-        pairs = [(s, convert(s)) for s in scenes]
+        pairs = [(s, convert(other, s)) for s in scenes]
         for s, t in pairs[::10]:
             a, b = ours.render(s), theirs.render(t)
             same = all(np.array_equal(x, y) for x, y in ((a.left, b.left), (a.right, b.right), (a.depth_m, b.depth_m),

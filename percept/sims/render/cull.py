@@ -9,8 +9,10 @@ are the same bit for bit.
 from __future__ import annotations
 
 import numpy as np
+
 from .compiled import kernel
 from .vec3 import cross, dot
+
 
 @kernel(error_model="numpy")
 def project_patches(O, E1, E2, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled

@@ -138,14 +138,14 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
     if not len(ks):
         return
     idx = order[ks]
-    x0s, x1s, y0s, ends = p.x0[idx].tolist(), p.x1[idx].tolist(), p.y0[idx].tolist(), ends[ks].tolist()
-    # each warp stops after the last row in which its patch won a pixel: OpenCV warps each row on its own, so the
-    # rows above come out the same (a box cut on the right would not: its last columns leave the vector loop
-    # differently)
+    x0s, x1s, y0s, y_ends = p.x0[idx].tolist(), p.x1[idx].tolist(), p.y0[idx].tolist(), ends[ks].tolist()
     # colour * albedo / 255, per channel, as a 256-entry colour map of the albedo
     luts = (_ALBEDO * p.color[idx][:, None, None, :]).astype(np.uint8)
     for j, (tiled, H) in enumerate(_texture_maps(p, atlas, idx)):
-        alb = cv2.warpPerspective(tiled, H, (x1s[j] - x0s[j], ends[j] - y0s[j]),
+        # the warp stops after the last row in which the patch won a pixel: OpenCV warps each row on its own, so the
+        # rows above come out the same (a box cut on the right would not: its last columns leave the vector loop
+        # differently)
+        alb = cv2.warpPerspective(tiled, H, (x1s[j] - x0s[j], y_ends[j] - y0s[j]),
                                   flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_CONSTANT)
         put_albedo(target.image, alb, luts[j], winner, int(ks[j]), x0s[j], y0s[j])
 

@@ -253,7 +253,8 @@ def _arms(rows, n: int, body: Body) -> int:
         out = mul(0.07 * sgn, left)  # slight abduction so that the arm hangs clear of the waist
         elbow = madd(sh, 0.186 * h, add(_seg(body, a), out))
         wrist = madd(elbow, 0.146 * h, madd(_seg(body, a2), 0.5, out))
-        n = limb(rows, n, view, sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, 0.025, True, True)
+        n = limb(rows, n, view, sh, elbow, 0.035 * h * build * hips, 0.028 * h * build * hips, sleeve, 0.025, True,
+                 True)
         n = limb(rows, n, view, elbow, wrist, 0.028 * h * build * hips, 0.021 * h * build, fore, 0.025, False, True)
         n = disc(rows, n, view, madd(wrist, 0.045 * h, _seg(body, a2)), 0.042 * h, 0.024 * h, skin, 0.03)
     return n

@@ -62,14 +62,12 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
             ay = ma1 * fy + ma2
             by = mb1 * fy + mb2
             xa, xb = x0[i], x1[i]
-            if r >= 0:  # only the row's span can be inside
+            if r >= 0:  # the row's span: every pixel in it is inside
                 xa, xb = max(xa, los[r + y - y0[i]]), min(xb, his[r + y - y0[i]] + 1)
             for x in range(xa, xb):
                 fx = f32(x)
                 c = mc0 * fx + cy
-                if r >= 0:
-                    inside = True
-                else:
+                if r < 0:
                     # crossing the near plane: the exact test per pixel, with c < 1/near
                     ap = ma0 * fx + ay
                     bp = mb0 * fx + by
@@ -77,9 +75,8 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
                         inside = ap * ap + bp * bp <= c * c
                     else:
                         inside = max(abs(ap), abs(bp)) <= c
-                    inside = inside and c < inv_near and c > 0
-                if not inside:
-                    continue
+                    if not (inside and c < inv_near and c > 0):
+                        continue
                 if sil:
                     sil_pix = _push(sil_pix, ns, y * W + x)
                     sil_oid = _push(sil_oid, ns, oid)
@@ -102,7 +99,6 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
     return held, ends, sil_pix[:ns], sil_oid[:ns]
 
 
-
 @kernel()
 def put_albedo(img, alb, lut, winner, k, x0, y0):  # pragma: no cover - compiled
     """``img`` (H, W, 3) uint8 = ``lut[alb]`` (the colour map (256, 1, 3) uint8 of the albedo ``alb`` (h, w) uint8
@@ -113,6 +109,7 @@ def put_albedo(img, alb, lut, winner, k, x0, y0):  # pragma: no cover - compiled
                 a = alb[r, c]
                 for ch in range(3):
                     img[y0 + r, x0 + c, ch] = lut[a, 0, ch]
+
 
 @kernel()
 def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # pragma: no cover - compiled
