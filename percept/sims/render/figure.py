@@ -6,7 +6,7 @@ stereo pair. These are the same functions compiled, with the same float64 operat
 ``vec3``'s tuple functions, Python's ``min``/``max`` (which keep the first of equal arguments; ``pymin``,
 ``pymax``), and no ``math.hypot`` of two non-zero numbers (the C library's, which numba calls, differs from
 CPython's in the last bit for about 0.6% of arguments; see ``pedestrian._body``). So a figure is the same to the
-bit; ``tests/sims/test_pedestrian_look.py`` builds figures with and without the compiler and compares them.
+bit; ``tests/sims/test_render_kernels.py`` builds figures with and without the compiler and compares them.
 
 A buffer row (``ROW`` float64 columns): ``[kind, ...]``; kind 0 or 1 is a patch (quad or ellipse outline)
 ``origin (3), e1 (3), e2 (3), colour (3)``; kind 2 a box ``centre (3), unit axes x, y, z (3 × 3), size (3),
@@ -34,6 +34,7 @@ SUN = vec(SUN_DIR)
 # version per combination of those constants' values, which doubled the figure's first compile
 _V3, _F, _I, _B = types.UniTuple(types.float64, 3), types.float64, types.int64, types.boolean
 _ROWS = types.float64[:, ::1]
+
 
 @njit(cache=True)
 def pymin(a: float, b: float) -> float:
