@@ -5,6 +5,10 @@ chunks within reach. Far lane paint is filtered like a texture: lines thinner th
 to one pixel with their contrast scaled down by the same factor, and from 40 m to 90 m the dashes
 stretch over their period while fading to the period's mean (dash/period) — the far field shows the
 average paint instead of sub-pixel dashes that alias and shimmer as the car moves.
+
+The per-sample and per-piece selection is compiled (numba, ``_surface_samples`` and ``_marking_pieces``) with the
+arithmetic of the numpy version it replaced, in its order (tests/sims/test_paint_reference.py holds it to that
+version bit for bit).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ import numpy as np
 from percept.sensors import Pose2D, StereoRig
 
 from ..road_geometry import DASH_GAP_M, DASH_LENGTH_M, MARKING_WIDTH_M, YELLOW, RoadGeometry
+from .compiled import kernel
 from .raster import NEAR_M
 
 SURFACE_FAR_M = 400.0
@@ -130,40 +135,67 @@ def _surface_polygons(index: RoadIndex, pose: Pose2D, near_x_m: float) -> list[l
     """Paved-surface polygons, vehicle frame [m], one list per strip."""
     if not len(index.lo):
         return []
-    cv = pose.to_vehicle_xy(index.centre)
-    r = index.radius
-    sel = np.flatnonzero((cv[:, 0] > near_x_m - r) & (cv[:, 0] < SURFACE_FAR_M + r)
-                         & (np.abs(cv[:, 1]) < SURFACE_FAR_M + r))
-    if not len(sel):
-        return []
-    # samples covered by the selected chunks: +1 at each chunk start, -1 after its end, running sum > 0
-    mark = np.zeros(len(index.left) + 1, np.int32)
-    np.add.at(mark, index.lo[sel], 1)
-    np.add.at(mark, index.hi[sel] + 1, -1)
-    idx = np.flatnonzero(np.cumsum(mark)[:-1] > 0)
-    lv = pose.to_vehicle_xy(index.left[idx])
-    rv = pose.to_vehicle_xy(index.right[idx])
-    ok = (lv[:, 0] > near_x_m) & (rv[:, 0] > near_x_m) & (lv[:, 0] < SURFACE_FAR_M) & (np.abs(lv[:, 1]) < SURFACE_FAR_M)
-    keep = np.flatnonzero(ok)
-    if len(keep) < 2:
-        return []
-    gi = idx[keep]
-    strip = index.strip[gi]
-    # contiguous runs of visible samples of one strip, one polygon each
-    brk = (np.diff(gi) > 1) | (np.diff(strip) != 0)
-    first, last = np.r_[True, brk], np.r_[brk, True]
-    # level of detail: every sample up to 60 m, every 4th up to 150 m, every 16th beyond (plus run ends)
-    x = lv[keep, 0]
-    step = np.where(x < 60.0, 1, np.where(x < 150.0, 4, 16))
-    dec = np.flatnonzero((gi % step == 0) | first | last)
-    keep, gi, strip, first = keep[dec], gi[dec], strip[dec], first[dec]
-    lv, rv = lv[keep], rv[keep]
+    lv, rv, strip, first = _surface_samples(index.left, index.right, index.strip, index.lo, index.hi, index.centre,
+                                            index.radius, pose.x_m, pose.y_m, math.cos(pose.yaw_rad),
+                                            math.sin(pose.yaw_rad), near_x_m, SURFACE_FAR_M)
     starts = np.flatnonzero(first)
     groups: dict[int, list[np.ndarray]] = {}
-    for a, b in zip(starts, np.r_[starts[1:], len(keep)]):
+    for a, b in zip(starts, np.r_[starts[1:], len(first)]):
         if b - a >= 2:
             groups.setdefault(int(strip[a]), []).append(np.concatenate([lv[a:b], rv[a:b][::-1]]))
     return [groups[k] for k in sorted(groups)]
+
+
+@kernel()
+def _surface_samples(left, right, strip_of, lo, hi, centre, radius, px, py, c, s, near, far):  # pragma: no cover
+    """The road's samples that outline its visible surface, vehicle frame: left and right edge points (M, 2) [m],
+    their strip and whether each starts a run (a polygon). A sample is visible when a chunk within reach holds it
+    and both its edge points are past ``near`` and within ``far``; runs are contiguous visible samples of one
+    strip, thinned by distance (every sample up to 60 m, every 4th up to 150 m, every 16th beyond, plus each run's
+    ends). The vehicle pose is (px, py) [m] with c, s the cosine and sine of its yaw. Empty when fewer than two
+    samples are visible."""
+    n = len(left)
+    mark = np.zeros(n + 1, np.int64)
+    for k in range(len(lo)):
+        # [x_v, y_v] = R(-yaw) (p - t), as Pose2D.to_vehicle_xy computes it
+        dx, dy = centre[k, 0] - px, centre[k, 1] - py
+        x, y = c * dx + s * dy, -s * dx + c * dy
+        r = radius[k]
+        if x > near - r and x < far + r and abs(y) < far + r:
+            mark[lo[k]] += 1
+            mark[hi[k] + 1] -= 1
+    gi = np.empty(n, np.int64)
+    pts = np.empty((n, 4))
+    m, run = 0, 0
+    for i in range(n):
+        run += mark[i]
+        if run <= 0:
+            continue
+        dx, dy = left[i, 0] - px, left[i, 1] - py
+        lx, ly = c * dx + s * dy, -s * dx + c * dy
+        dx, dy = right[i, 0] - px, right[i, 1] - py
+        rx, ry = c * dx + s * dy, -s * dx + c * dy
+        if lx > near and rx > near and lx < far and abs(ly) < far:
+            gi[m] = i
+            pts[m, 0], pts[m, 1], pts[m, 2], pts[m, 3] = lx, ly, rx, ry
+            m += 1
+    if m < 2:
+        m = 0
+    lv, rv = np.empty((m, 2)), np.empty((m, 2))
+    strip, first = np.empty(m, np.int64), np.empty(m, np.bool_)
+    kept = 0
+    for j in range(m):
+        g, st = gi[j], strip_of[gi[j]]
+        # a run starts after a gap in the samples or at a new strip, and ends before one
+        starts = j == 0 or gi[j] - gi[j - 1] > 1 or st != strip_of[gi[j - 1]]
+        ends = j == m - 1 or gi[j + 1] - g > 1 or strip_of[gi[j + 1]] != st
+        x = pts[j, 0]
+        step = 1 if x < 60.0 else 4 if x < 150.0 else 16
+        if g % step == 0 or starts or ends:
+            lv[kept, 0], lv[kept, 1], rv[kept, 0], rv[kept, 1] = pts[j, 0], pts[j, 1], pts[j, 2], pts[j, 3]
+            strip[kept], first[kept] = st, starts
+            kept += 1
+    return lv[:kept], rv[:kept], strip[:kept], first[:kept]
 
 
 def _marking_quads(index: RoadIndex, pose: Pose2D, rig: StereoRig, palette) -> list[tuple[np.ndarray, tuple]]:
@@ -171,33 +203,11 @@ def _marking_quads(index: RoadIndex, pose: Pose2D, rig: StereoRig, palette) -> l
     q = index.quads
     if not len(q):
         return []
-    near = rig.mount_x_m + NEAR_M
-    c = pose.to_vehicle_xy(index.quad_centre)
-    close = np.flatnonzero((c[:, 0] > near) & (c[:, 0] < MARKING_FAR_M) & (np.abs(c[:, 1]) < MARKING_FAR_M))
-    qv = pose.to_vehicle_xy(q[close])
-    ok = (qv[..., 0].min(axis=1) > near) & (qv[..., 0].max(axis=1) < MARKING_FAR_M)
-    qv, sel = qv[ok], close[ok]
+    qv, color, level = _marking_pieces(q, index.quad_centre, index.dashed, index.quad_color, pose.x_m, pose.y_m,
+                                       math.cos(pose.yaw_rad), math.sin(pose.yaw_rad), rig.mount_x_m + NEAR_M,
+                                       MARKING_FAR_M, rig.mount_x_m, rig.camera.fx)
     if not len(qv):
         return []
-    dashed, color = index.dashed[sel], index.quad_color[sel]
-    # distance along the ground and camera depth of each piece's centre
-    cen = qv.mean(axis=1)
-    dist = np.hypot(cen[:, 0], cen[:, 1])
-    depth = np.maximum(cen[:, 0] - rig.mount_x_m, NEAR_M)
-    # dashes stretch over the period from FADE_M[0] to FADE_M[1]: length L' = L + r (period - L), alpha L / L'
-    r = np.where(dashed, np.clip((dist - FADE_M[0]) / (FADE_M[1] - FADE_M[0]), 0, 1), 0.0)
-    ext = 1.0 + r * (DASH_GAP_M / DASH_LENGTH_M)
-    qv[:, 1] = qv[:, 0] + (qv[:, 1] - qv[:, 0]) * ext[:, None]
-    qv[:, 2] = qv[:, 3] + (qv[:, 2] - qv[:, 3]) * ext[:, None]
-    # lines narrower than MIN_WIDTH_PX are widened by k = MIN_WIDTH_PX / width_px about their centre line
-    width_px = rig.camera.fx * MARKING_WIDTH_M / depth
-    k = np.maximum(1.0, MIN_WIDTH_PX / width_px)
-    for i, j in ((0, 3), (1, 2)):
-        m = (qv[:, i] + qv[:, j]) / 2
-        h = (qv[:, i] - qv[:, j]) / 2 * k[:, None]
-        qv[:, i], qv[:, j] = m + h, m - h
-    # coverage-preserving contrast: alpha = (L / L') / k, quantised to ALPHA_STEPS levels
-    level = np.clip(np.round(ALPHA_STEPS / (ext * k)), 1, ALPHA_STEPS).astype(int)
     asphalt = np.asarray(palette.asphalt, np.float64)
     key = color.astype(int) * (ALPHA_STEPS + 1) + level
     order = np.argsort(-key, kind="stable")
@@ -211,3 +221,60 @@ def _marking_quads(index: RoadIndex, pose: Pose2D, rig: StereoRig, palette) -> l
         bgr = asphalt + (lv / ALPHA_STEPS) * (paint - asphalt)
         out.append((qv[a:b], tuple(float(math.floor(x + 0.5)) for x in bgr)))
     return out
+
+
+@kernel()
+def _marking_pieces(quads, centres, dashed, colors, px, py, c, s, near, far, mount_x, fx):  # pragma: no cover
+    """The paint pieces wholly between ``near`` and ``far`` ahead, in the vehicle frame (pose (px, py), c and s the
+    cosine and sine of its yaw), filtered for distance: (M, 4, 2) corners [m], their colour ids and alpha levels
+    (1..ALPHA_STEPS)."""
+    sel = np.empty(len(quads), np.int64)
+    m = 0
+    for i in range(len(quads)):
+        # [x_v, y_v] = R(-yaw) (p - t), as Pose2D.to_vehicle_xy computes it; the centre first, then every corner
+        dx, dy = centres[i, 0] - px, centres[i, 1] - py
+        if c * dx + s * dy > near and c * dx + s * dy < far and abs(-s * dx + c * dy) < far:
+            sel[m] = i
+            m += 1
+    qv = np.empty((m, 4, 2))
+    keep = np.empty(m, np.int64)
+    n = 0
+    for j in range(m):
+        inside = True
+        for k in range(4):
+            dx, dy = quads[sel[j], k, 0] - px, quads[sel[j], k, 1] - py
+            qv[n, k, 0], qv[n, k, 1] = c * dx + s * dy, -s * dx + c * dy
+            inside = inside and near < qv[n, k, 0] < far
+        if inside:
+            keep[n] = sel[j]
+            n += 1
+    qv = qv[:n]
+    level = np.empty(n, np.int64)
+    for j in range(n):
+        # distance along the ground and camera depth of the piece's centre (the corners summed in order, as numpy's
+        # mean over them)
+        cx = (((qv[j, 0, 0] + qv[j, 1, 0]) + qv[j, 2, 0]) + qv[j, 3, 0]) / 4
+        cy = (((qv[j, 0, 1] + qv[j, 1, 1]) + qv[j, 2, 1]) + qv[j, 3, 1]) / 4
+        dist = math.hypot(cx, cy)
+        depth = max(cx - mount_x, NEAR_M)
+        # dashes stretch over the period from FADE_M[0] to FADE_M[1]: length L' = L + r (period - L), alpha L / L'
+        r = min(max((dist - FADE_M[0]) / (FADE_M[1] - FADE_M[0]), 0.0), 1.0) if dashed[keep[j]] else 0.0
+        ext = 1.0 + r * (DASH_GAP_M / DASH_LENGTH_M)
+        for a in range(2):
+            qv[j, 1, a] = qv[j, 0, a] + (qv[j, 1, a] - qv[j, 0, a]) * ext
+            qv[j, 2, a] = qv[j, 3, a] + (qv[j, 2, a] - qv[j, 3, a]) * ext
+        # lines narrower than MIN_WIDTH_PX are widened by k = MIN_WIDTH_PX / width_px about their centre line
+        width_px = fx * MARKING_WIDTH_M / depth
+        k = max(1.0, MIN_WIDTH_PX / width_px)
+        for i0, i1 in ((0, 3), (1, 2)):
+            for a in range(2):
+                mid = (qv[j, i0, a] + qv[j, i1, a]) / 2
+                h = (qv[j, i0, a] - qv[j, i1, a]) / 2 * k
+                qv[j, i0, a], qv[j, i1, a] = mid + h, mid - h
+        # coverage-preserving contrast: alpha = (L / L') / k, quantised to ALPHA_STEPS levels (rounded half to even)
+        level[j] = int(min(max(np.rint(ALPHA_STEPS / (ext * k)), 1.0), float(ALPHA_STEPS)))
+    colors_out = np.empty(n, colors.dtype)
+    for j in range(n):
+        colors_out[j] = colors[keep[j]]
+    return qv, colors_out, level
+
