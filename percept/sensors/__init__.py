@@ -7,7 +7,7 @@ from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, 
                       list_images, open_video, read_image)
 from .frame import Frame, ImuSample
 from .records import BrakingRequest, EgoPath, LandmarkMap, LaneEstimate, Lead, ObjectKind, PoseEstimate, Source
-from .poses import Pose2D, Transform, rot_z, wrap_angle
+from .poses import Pose2D, Transform, rot_z, rotate_to_vehicle, wrap_angle
 from .rig import Side, StereoRig
 
 __all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "ObjectKind", "PoseEstimate", "Source",
@@ -15,4 +15,4 @@ __all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "
            "list_images", "open_video", "read_image",
            "CameraCalibration", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform",
            "calibrate_chessboards", "check_boxes", "chessboard_images", "iou", "iou_matrix", "parse_pattern", "rot_z",
-           "wrap_angle"]
+           "rotate_to_vehicle", "wrap_angle"]

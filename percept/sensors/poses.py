@@ -12,6 +12,13 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def rotate_to_vehicle(dx, dy, c, s):
+    """The vehicle-frame (x, y) of a ground offset (dx, dy) = p - t from the vehicle at t, world frame, with
+    c, s = cos, sin of its yaw: [x_v, y_v] = R(-yaw) (dx, dy). Scalars or arrays alike (and compiled kernels:
+    ``sims/render/paint.py`` registers it with numba)."""
+    return c * dx + s * dy, -s * dx + c * dy
+
+
 def rot_z(yaw_rad: float) -> np.ndarray:
     """3x3 rotation about +z by ``yaw_rad`` (counter-clockwise seen from above)."""
     c, s = math.cos(yaw_rad), math.sin(yaw_rad)
@@ -67,5 +74,4 @@ class Pose2D:
         """World points (N, 2) -> vehicle frame (N, 2), both on the ground plane."""
         c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
         d = np.asarray(xy_world, dtype=np.float64) - np.array([self.x_m, self.y_m])
-        # [x_v, y_v] = R(-yaw) (p - t)
-        return np.stack([c * d[..., 0] + s * d[..., 1], -s * d[..., 0] + c * d[..., 1]], axis=-1)
+        return np.stack(rotate_to_vehicle(d[..., 0], d[..., 1], c, s), axis=-1)

@@ -1,5 +1,8 @@
-"""The rasteriser's two compiled paths (large patches one by one, small ones as fragments) draw the same picture:
-the same scene forced through one path and then the other gives the same image, ids, lamp map and silhouettes."""
+"""The renderer's compiled kernels (numba). The rasteriser's two paths (large patches one by one, small ones as
+fragments) draw the same picture: the same scene forced through one path and then the other gives the same image,
+ids, lamp map and silhouettes; a patch cut by the near plane is drawn where its rays land. A renderer, once built,
+compiles nothing in a world's frames; Ctrl-C during a kernel is a KeyboardInterrupt; the pedestrians' figures
+built by compiled code are the interpreted ones to the byte."""
 
 import os
 import subprocess

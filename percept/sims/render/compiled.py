@@ -13,7 +13,14 @@ from __future__ import annotations
 import functools
 from typing import Callable
 
+import numpy as np
 from numba import njit
+
+
+def optional(a: np.ndarray | None, dtype, ndim: int = 2) -> np.ndarray:
+    """``a``, or an empty array of that dtype and rank when it is None: how a kernel is told a map (ids, lamp map)
+    is absent (it tests ``.size > 0``), since numba types None apart from an array."""
+    return np.zeros((0,) * ndim, dtype) if a is None else a
 
 
 def kernel(**options) -> Callable[[Callable], Callable]:

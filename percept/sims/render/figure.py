@@ -23,7 +23,7 @@ from numba import njit, types
 from .patches import SUN_DIR, box_faces
 from .vec3 import UP, cross, dot, madd, mul, norm, sub, vec
 
-__all__ = ["BOX", "ELLIPSE", "QUAD", "ROW", "box", "disc", "limb", "packed", "pymax", "pymin", "toward_view"]
+__all__ = ["BOX", "ELLIPSE", "QUAD", "ROW", "box", "disc", "limb", "packed", "pymax", "pymin", "scaled", "toward_view"]
 
 QUAD, ELLIPSE, BOX = 0, 1, 2
 ROW = 19
@@ -46,6 +46,12 @@ def pymin(a: float, b: float) -> float:
 def pymax(a: float, b: float) -> float:
     """Python's ``max(a, b)``: ``a`` unless ``b`` is larger."""
     return b if b > a else a
+
+
+@njit(cache=True)
+def scaled(colour, k: float):
+    """``colour`` (BGR) times k, each channel at most 255."""
+    return (pymin(255.0, colour[0] * k), pymin(255.0, colour[1] * k), pymin(255.0, colour[2] * k))
 
 
 @njit(cache=True)
@@ -108,7 +114,7 @@ def _halves(rows, n: int, view, p0, p1, r0: float, r1: float, axis, side, colour
     for sgn in (lit, -lit):
         s = mul(sgn, side)
         k = 1.0 + (0.13 * abs(sun) + 0.04) * (1 if sgn == lit else -1)
-        col = (pymin(255.0, colour[0] * k), pymin(255.0, colour[1] * k), pymin(255.0, colour[2] * k))
+        col = scaled(colour, k)
         # the lit half overlaps the centre line by a little and sits 2 mm nearer, so it wins there
         over, nb = (0.15 * r1, 0.002) if sgn == lit else (0.0, 0.0)
         near = toward_view(view, p0, nb)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .compiled import optional
 from .pixels import big_patches, put_albedo, shade_winners, small_fragments, texel_coords
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
@@ -85,10 +86,6 @@ def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouet
         np.divide(np.float32(1.0), target.inv_depth, out=target.depth, where=target.inv_depth != target.base_inv_depth)
 
 
-_NONE_F32 = np.zeros((0, 0), np.float32)
-_NONE_I32 = np.zeros((0, 0), np.int32)
-
-
 def _add_silhouettes(sil: dict[int, list[np.ndarray]] | None, pix: np.ndarray, oid: np.ndarray) -> None:
     """Append flat pixel indices ``pix`` to the silhouette of their objects ``oid`` (order within an object kept)."""
     if sil is None or not len(pix):
@@ -129,10 +126,9 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
     textured = p.entry >= 0
     winner = np.full(target.inv_depth.shape, -1, np.int32)
     held, ends, sil_pix, sil_oid = big_patches(
-        target.inv_depth, _NONE_I32 if target.ids is None else target.ids,
-        _NONE_F32 if target.emission is None else target.emission, target.image, winner, order, p.x0, p.x1, p.y0,
-        p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive, p.color,
-        textured, sil is not None, np.float32(INV_NEAR))
+        target.inv_depth, optional(target.ids, np.int32), optional(target.emission, np.float32), target.image,
+        winner, order, p.x0, p.x1, p.y0, p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive,
+        p.color, textured, sil is not None, np.float32(INV_NEAR))
     _add_silhouettes(sil, sil_pix, sil_oid)
     ks = np.flatnonzero(textured[order] & (held > 0))
     if not len(ks):
@@ -162,9 +158,9 @@ def _small_patches(target, p: PreparedPatches, atlas: TextureAtlas, rp, v, first
     albedo = np.ones(len(wpix), np.float32)
     if len(t):
         albedo[t] = _sample(atlas.image, tx, ty) * np.float32(1.0 / 255.0)
-    shade_winners(target.image.reshape(-1, 3), _NONE_I32.reshape(-1) if target.ids is None else target.ids.reshape(-1),
-                  _NONE_F32.reshape(-1) if target.emission is None else target.emission.reshape(-1), wpix, wspan, rp,
-                  p.obj_id, p.emissive, p.color, albedo)
+    shade_winners(target.image.reshape(-1, 3), optional(target.ids, np.int32).reshape(-1),
+                  optional(target.emission, np.float32).reshape(-1), wpix, wspan, rp, p.obj_id, p.emissive, p.color,
+                  albedo)
 
 
 def _sample(image: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -157,7 +157,6 @@ class GroundLayer:
         self._haze_keep = (256 - A)[:, None, None]
         haze = np.asarray(self.palette.haze, np.uint16)[None, None, :]
         self._haze_add = (A[:, None, None] * haze + 128).astype(np.uint16)
-        _haze(np.zeros((H, 1, 3), np.uint8), self._haze_keep, self._haze_add, h0)  # compiled or loaded now
 
     def grain(self, pose: Pose2D) -> np.ndarray:
         """World-locked 7-bit ground albedo (H - first_row, W) uint8 for the vehicle at ``pose``."""

@@ -18,7 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from percept.sensors import Pose2D, StereoRig
+from numba.extending import register_jitable
+
+from percept.sensors import Pose2D, StereoRig, rotate_to_vehicle
 
 from ..road_geometry import DASH_GAP_M, DASH_LENGTH_M, MARKING_WIDTH_M, YELLOW, RoadGeometry
 from .compiled import kernel
@@ -32,6 +34,8 @@ CHUNK = 32
 FADE_M = (40.0, 90.0)
 MIN_WIDTH_PX = 1.0
 ALPHA_STEPS = 8
+
+register_jitable(rotate_to_vehicle)  # the kernels below convert world points to the vehicle frame with it
 
 
 class RoadIndex:
@@ -157,9 +161,7 @@ def _surface_samples(left, right, strip_of, lo, hi, centre, radius, px, py, c, s
     n = len(left)
     mark = np.zeros(n + 1, np.int64)
     for k in range(len(lo)):
-        # [x_v, y_v] = R(-yaw) (p - t), as Pose2D.to_vehicle_xy computes it
-        dx, dy = centre[k, 0] - px, centre[k, 1] - py
-        x, y = c * dx + s * dy, -s * dx + c * dy
+        x, y = rotate_to_vehicle(centre[k, 0] - px, centre[k, 1] - py, c, s)
         r = radius[k]
         if x > near - r and x < far + r and abs(y) < far + r:
             mark[lo[k]] += 1
@@ -171,10 +173,8 @@ def _surface_samples(left, right, strip_of, lo, hi, centre, radius, px, py, c, s
         run += mark[i]
         if run <= 0:
             continue
-        dx, dy = left[i, 0] - px, left[i, 1] - py
-        lx, ly = c * dx + s * dy, -s * dx + c * dy
-        dx, dy = right[i, 0] - px, right[i, 1] - py
-        rx, ry = c * dx + s * dy, -s * dx + c * dy
+        lx, ly = rotate_to_vehicle(left[i, 0] - px, left[i, 1] - py, c, s)
+        rx, ry = rotate_to_vehicle(right[i, 0] - px, right[i, 1] - py, c, s)
         if lx > near and rx > near and lx < far and abs(ly) < far:
             gi[m] = i
             pts[m, 0], pts[m, 1], pts[m, 2], pts[m, 3] = lx, ly, rx, ry
@@ -231,9 +231,9 @@ def _marking_pieces(quads, centres, dashed, colors, px, py, c, s, near, far, mou
     sel = np.empty(len(quads), np.int64)
     m = 0
     for i in range(len(quads)):
-        # [x_v, y_v] = R(-yaw) (p - t), as Pose2D.to_vehicle_xy computes it; the centre first, then every corner
-        dx, dy = centres[i, 0] - px, centres[i, 1] - py
-        if c * dx + s * dy > near and c * dx + s * dy < far and abs(-s * dx + c * dy) < far:
+        # the centre first, then every corner
+        x, y = rotate_to_vehicle(centres[i, 0] - px, centres[i, 1] - py, c, s)
+        if near < x < far and abs(y) < far:
             sel[m] = i
             m += 1
     qv = np.empty((m, 4, 2))
@@ -242,8 +242,7 @@ def _marking_pieces(quads, centres, dashed, colors, px, py, c, s, near, far, mou
     for j in range(m):
         inside = True
         for k in range(4):
-            dx, dy = quads[sel[j], k, 0] - px, quads[sel[j], k, 1] - py
-            qv[n, k, 0], qv[n, k, 1] = c * dx + s * dy, -s * dx + c * dy
+            qv[n, k, 0], qv[n, k, 1] = rotate_to_vehicle(quads[sel[j], k, 0] - px, quads[sel[j], k, 1] - py, c, s)
             inside = inside and near < qv[n, k, 0] < far
         if inside:
             keep[n] = sel[j]

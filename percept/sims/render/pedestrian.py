@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from .compiled import kernel
-from .figure import ROW, box, disc, limb, packed, pymax, pymin
+from .figure import ROW, box, disc, limb, packed, pymax, scaled
 from .scene import ObjectState
 from .vec3 import UP, Vec3, add, dot, madd, mul, norm, vec
 
@@ -68,11 +68,6 @@ def _style(style: int) -> tuple:
     build = float(rng.uniform(0.92, 1.12))
     flags = tuple(bool(rng.random() < q) for q in (0.5, 0.12, 0.3))
     return (*colours, build, *flags, float(rng.uniform(1.0, 1.3)))
-
-
-@njit(cache=True)
-def _scaled(color: Vec3, k: float) -> Vec3:
-    return (pymin(255.0, color[0] * k), pymin(255.0, color[1] * k), pymin(255.0, color[2] * k))
 
 
 class Body(NamedTuple):
@@ -126,13 +121,12 @@ def _body(obj: ObjectState, view: Vec3) -> Body:
     vdir = (vdir[0] / n, vdir[1] / n, vdir[2] / n)
     cf = abs(dot(vdir, fwd))
     cs = math.sqrt(max(0.0, 1.0 - cf * cf))
-    gait = []
-    for sgn, cl in ((+1, c), (-1, (c + 0.5) % 1.0)):
-        if walking:
-            angles = tuple(math.radians(float(np.interp(cl, GAIT_C, t))) for t in (HIP, KNEE, FOOT))
-        else:
-            angles = (0.02 * sgn, 0.03, 0.0)
-        gait.append((float(sgn), *angles))
+    if walking:
+        # hip, knee and shoe angles of both legs, half a cycle apart
+        hip, knee, foot = (np.radians(np.interp((c, (c + 0.5) % 1.0), GAIT_C, t)).tolist() for t in (HIP, KNEE, FOOT))
+        gait = tuple((sgn, hip[k], knee[k], foot[k]) for k, sgn in enumerate((1.0, -1.0)))
+    else:
+        gait = tuple((sgn, 0.02 * sgn, 0.03, 0.0) for sgn in (1.0, -1.0))
 
     def across(w, d, bk):
         # how wide a trunk part looks [m]: an elliptic cross-section of width w (across) and depth d (front to back),
@@ -144,7 +138,7 @@ def _body(obj: ObjectState, view: Vec3) -> Body:
                across(0.125, 0.086, bulk), across(0.055, 0.058, bulk))
     # the trunk leans forwards a little when walking [rad]
     return Body(view, int(obj.obj_id), h, base, fwd, (-fwd[1], fwd[0], 0.0), vdir, cf, cs, 0.06 if walking else 0.0,
-                walking, tuple(gait), trunk_w, shirt, pants, skin, hair, shoes, build, hips, long_sleeves, shorts,
+                walking, gait, trunk_w, shirt, pants, skin, hair, shoes, build, hips, long_sleeves, shorts,
                 long_hair)
 
 
@@ -202,7 +196,7 @@ def _trunk(rows, n: int, body: Body) -> int:
     w, shirt, view = body.trunk_w, body.shirt, body.viewer
     n = limb(rows, n, view, _trunk_pt(body, 0.465, -0.004), _trunk_pt(body, 0.6), w[0], w[1], body.pants, 0.0,
              False, False)
-    n = limb(rows, n, view, _trunk_pt(body, 0.54), _trunk_pt(body, 0.67, 0.006), w[2], w[3], _scaled(shirt, 0.95),
+    n = limb(rows, n, view, _trunk_pt(body, 0.54), _trunk_pt(body, 0.67, 0.006), w[2], w[3], scaled(shirt, 0.95),
              0.01, False, False)
     n = limb(rows, n, view, _trunk_pt(body, 0.665, 0.006), _trunk_pt(body, 0.785, 0.004), w[4], w[5], shirt, 0.01,
              False, False)
@@ -216,7 +210,7 @@ def _head(rows, n: int, body: Body) -> int:
     h, fwd, left, cf, cs, view = body.h, body.fwd, body.left, body.cf, body.cs, body.viewer
     skin, hair = body.skin, body.hair
     n = limb(rows, n, view, _trunk_pt(body, 0.82, 0.005), _trunk_pt(body, 0.885, 0.01), 0.028 * h, 0.028 * h,
-             _scaled(skin, 0.9), 0.0, False, False)
+             scaled(skin, 0.9), 0.0, False, False)
     head_c = _trunk_pt(body, 0.935, 0.012)
     head_w = (0.048 * cf + 0.055 * cs) * h
     front = dot(body.vdir, fwd)
@@ -241,7 +235,7 @@ def _arms(rows, n: int, body: Body) -> int:
     """Arms swinging against the legs: upper arm (sleeve), forearm (sleeve or skin), hand."""
     h, left, view = body.h, body.left, body.viewer
     build, hips, skin = body.build, body.hips, body.skin
-    sleeve = _scaled(body.shirt, 0.93)
+    sleeve = scaled(body.shirt, 0.93)
     fore = sleeve if body.long_sleeves else skin
     for sgn, hip_a, _, _ in body.gait:
         if body.walking:

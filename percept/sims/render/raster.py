@@ -100,16 +100,15 @@ def rasterize(target: RenderTarget, batch: PatchBatch, cam: PinholeCamera, cam_f
         rasterize_prepared(target, prep, atlas, silhouettes, antialias)
 
 
-
 _WARM: list[bool] = []
 
 
 def warm_up() -> None:
-    """Compile the rasteriser's kernels (numba: the first time after an install, about 15 s) or load them from
-    numba's disk cache (about 0.5 s), once per process, by drawing a small synthetic scene through every path the
-    renderer takes: large and small patches, textured and not, quads and discs, a lamp, a patch cut by the near
-    plane, into a left camera's targets (depth, ids, silhouettes) and a right one's. The renderer calls it when it
-    is built, so that no timed frame pays for it."""
+    """Compile the rasteriser's kernels (numba: the first time after an install) or load them from numba's disk
+    cache (about 0.5 s with the renderer's other kernels), once per process, by drawing a small synthetic scene
+    through every path the renderer takes: large and small patches, textured and not, quads and discs, a lamp, a
+    patch cut by the near plane, into a left camera's targets (depth, ids, silhouettes) and a right one's. The
+    renderer calls it when it is built, so that no timed frame pays for it."""
     if _WARM:
         return
     cam = PinholeCamera(150.0, 150.0, 80.0, 60.0, 160, 120)

@@ -84,11 +84,12 @@ class StereoRenderer:
         # beyond f min(|e1|, |e2|) / LOD_PX a patch is narrower than LOD_PX on screen, so the rasteriser skips it
         self._scenery_reach = rig.camera.fx * np.minimum(l1, l2) / LOD_PX
         self._templates: dict[tuple, np.ndarray] = {}
-        # the compiled kernels (rasteriser, road paint, pedestrians' figures) loaded or compiled now, not in a timed
-        # frame
+        # the compiled kernels loaded (or compiled, once after an install) now, not in a timed frame: every path of
+        # the rasteriser on a synthetic scene, then one frame of this road with a person on it (the road paint, the
+        # haze, the figure)
         warm_up()
-        ground_paint(self.road_index, Pose2D(0.0, 0.0, 0.0), rig, self.layers[Side.LEFT].palette)
-        pedestrian_packed(ObjectState(1, ObjectKind.PEDESTRIAN, Pose2D(5.0, 0.0, 0.0), 0.5, 0.5, 1.7), (0.0, 0.0, 1.5))
+        self.render(Scene(Pose2D(0.0, 0.0, 0.0),
+                          (ObjectState(1, ObjectKind.PEDESTRIAN, Pose2D(5.0, 0.0, 0.0), 0.5, 0.5, 1.7),)))
 
     @property
     def atlas(self) -> TextureAtlas:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import kernel
+from .compiled import kernel, optional
 
 EDGE_TOL = 2e-5
 """Relative 1/Z tolerance that tells "this pixel shows the patch" (float32 rounding is about 1e-7) from "it
@@ -90,15 +90,13 @@ def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: n
     An edge is blended only where pixel j shows the patch (its 1/Z within EDGE_TOL of the patch's) and the
     neighbour shows something behind the patch's plane; an occluded edge belongs to its occluder. ``lo_px``,
     ``hi_px``: the spans' first and last pixel centres (``span_bounds``), as the rasteriser filled them."""
-    H, W = target.inv_depth.shape
-    img = target.image.reshape(-1, 3)
-    em = target.emission
-    _smooth(img, target.inv_depth.reshape(-1), em.reshape(-1) if em is not None else np.zeros(0, np.float32),
-            em is not None, W, p.mc, rp, v, lo, hi, lo_px, hi_px)
+    _smooth(target.image.reshape(-1, 3), target.inv_depth.reshape(-1),
+            optional(target.emission, np.float32).reshape(-1), target.inv_depth.shape[1], p.mc, rp, v, lo, hi, lo_px,
+            hi_px)
 
 
 @kernel(error_model="numpy")
-def _smooth(img, inv, em, has_em, W, mc, rp, v, lo, hi, lo_px, hi_px):  # pragma: no cover - compiled
+def _smooth(img, inv, em, W, mc, rp, v, lo, hi, lo_px, hi_px):  # pragma: no cover - compiled
     n = len(rp)
     tgt = np.empty(2 * n, np.int64)
     src = np.empty(2 * n, np.int64)
@@ -136,7 +134,7 @@ def _smooth(img, inv, em, has_em, W, mc, rp, v, lo, hi, lo_px, hi_px):  # pragma
         a = alpha[k]
         for ch in range(3):
             mixed[k, ch] = np.uint8(np.rint((1.0 - a) * img[tgt[k], ch] + a * img[src[k], ch]))
-    if has_em:
+    if em.size > 0:
         blend = np.empty(m, np.float32)
         for k in range(m):
             blend[k] = (1.0 - alpha[k]) * em[tgt[k]] + alpha[k] * em[src[k]]
