@@ -23,6 +23,8 @@ import rerun as rr
 from percept.sensors import StereoRig
 from percept.sensors.vehicle import EGO_LENGTH_M
 
+from .series import ColumnBuffer
+
 TIMELINE = "sim_time"
 EGO = "world/ego"
 CAMERA = "world/ego/camera/left"
@@ -56,13 +58,16 @@ class RecordOptions:
 @dataclass(frozen=True)
 class PartContext:
     """task: the task's name (root of its entities); rig: the stereo rig; image: this frame stores a left image;
-    image_scale: stored pixels per camera pixel; memory: the part's own state across frames (a dict it may fill)."""
+    image_scale: stored pixels per camera pixel; memory: the part's own state across frames (a dict it may fill);
+    buffer: the recorder's rows sent as columns (``scalars``, clears, one-point trails; it sets each frame's time
+    and sends them)."""
 
     task: str
     rig: StereoRig
     image: bool = False
     image_scale: float = 1.0
     memory: dict = field(default_factory=dict)
+    buffer: ColumnBuffer = field(default_factory=lambda: ColumnBuffer(TIMELINE))
 
     def px(self, uv_px) -> np.ndarray:
         """Camera pixels (N, 2) (u, v) -> stored-image pixels."""
@@ -74,14 +79,11 @@ class PartContext:
     def around_ego(self, name: str) -> str:
         return f"{EGO}/{self.task}/{name}"
 
-    def scalars(self, rec: rr.RecordingStream, key: str, **series: float | None) -> None:
-        """Log ``<task>/<key>/<name>`` for each series; None (or not finite) breaks the line there."""
+    def scalars(self, key: str, **series: float | None) -> None:
+        """Log ``<task>/<key>/<name>`` for each series (through ``buffer``); None (or not finite) breaks the line
+        there."""
         for name, value in series.items():
-            path = f"{self.task}/{key}/{name}"
-            if value is None or not math.isfinite(value):
-                rec.log(path, rr.Clear(recursive=False))
-            else:
-                rec.log(path, rr.Scalars(float(value)))
+            self.buffer.scalar(f"{self.task}/{key}/{name}", value)
 
     def camera_x_m(self) -> float:
         """Vehicle-frame x of the left camera [m] (ranges in the records are measured from it)."""

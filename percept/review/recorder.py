@@ -30,6 +30,7 @@ from percept.sensors.vehicle import EGO_LENGTH_M, EGO_WIDTH_M
 from . import parts
 from .blueprint import TRAJECTORY, blueprint
 from .context import CAMERA, EGO, TIMELINE, Part, PartContext, RecordOptions
+from .series import ColumnBuffer
 
 OBJECTS = f"{EGO}/objects"
 KIND_CLASSES = {ObjectKind.VEHICLE: (1, (70, 130, 230)), ObjectKind.PEDESTRIAN: (2, (240, 80, 60)),
@@ -41,6 +42,9 @@ EGO_HEIGHT_M = 1.5
 BATCHING = dict(flush_tick=timedelta(seconds=5), flush_num_bytes=8 << 20)
 """Few, large chunks: each chunk carries its own schema (about 2 KB), which the default batching (a chunk per
 entity every 200 ms of wall time) would repeat thousands of times in a file."""
+COLUMNS_FLUSH_S = 10.0
+"""Simulated time the per-frame rows (scalars, clears, the ego's transform, trail points) are held before they are
+sent as columns (``series.ColumnBuffer``: a chunk per entity)."""
 
 
 def resolve_part(spec):
@@ -83,7 +87,10 @@ class RunRecorder:
         if any(name == "control" for name, _ in self.parts):
             raise ValueError("a task may not be named 'control': the control part records under that name")
         self.parts.append(("control", parts.control))
-        self.contexts = {name: PartContext(name, rig, image_scale=options.image_scale) for name, _ in self.parts}
+        self.buffer = ColumnBuffer(TIMELINE)
+        self._buffer_since_s: float | None = None
+        self.contexts = {name: PartContext(name, rig, image_scale=options.image_scale, buffer=self.buffer)
+                         for name, _ in self.parts}
         self.rig = rig
         self.closed_as: Path | None = None
         self._bucket: int | None = None
@@ -123,13 +130,17 @@ class RunRecorder:
         """One frame: ``frame`` (Frame), ``truth`` (StepTruth), ``step`` (AgentStep)."""
         rec = self.rec
         rec.set_time(TIMELINE, duration=frame.timestamp_s)
+        if self._buffer_since_s is None or frame.timestamp_s - self._buffer_since_s >= COLUMNS_FLUSH_S:
+            self.buffer.flush(rec)
+            self._buffer_since_s = frame.timestamp_s
+        self.buffer.set_time(frame.timestamp_s)
         gt = truth.truth
         e = gt.ego
-        rec.log(EGO, rr.Transform3D(translation=[e.x_m, e.y_m, 0.0],
-                                    rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=e.yaw_rad)))
+        self.buffer.add(EGO, rr.Transform3D, translation=[[e.x_m, e.y_m, 0.0]],
+                        rotation_axis_angle=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=e.yaw_rad)])
         image = self._log_image(frame)
         self._log_objects(gt.objects, image)
-        rec.log(TRAJECTORY, rr.Points3D([[e.x_m, e.y_m, 0.05]]))
+        self.buffer.add(TRAJECTORY, rr.Points3D, positions=[[e.x_m, e.y_m, 0.05]])
         for name, part in self.parts:
             ctx = replace(self.contexts[name], image=image)
             if name == "control":
@@ -162,7 +173,7 @@ class RunRecorder:
                 rotation_axis_angles=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=o.yaw_rad) for o in objects],
                 class_ids=[KIND_CLASSES[o.kind][0] for o in objects], show_labels=False))
         else:
-            rec.log(OBJECTS, rr.Clear(recursive=False))
+            self.buffer.clear(OBJECTS)
         if not image:
             return
         seen = [o for o in objects if o.box_px is not None]
@@ -172,7 +183,7 @@ class RunRecorder:
                 array_format=rr.Box2DFormat.XYXY, class_ids=[KIND_CLASSES[o.kind][0] for o in seen],
                 show_labels=False))
         else:
-            rec.log(f"{CAMERA}/objects", rr.Clear(recursive=False))
+            self.buffer.clear(f"{CAMERA}/objects")
 
     def close(self, complete: bool = True) -> Path:
         """Flush and move the recording into place: ``path`` when ``complete``, else ``RUN.partial.rrd`` beside it
@@ -182,6 +193,7 @@ class RunRecorder:
             return self.closed_as
         target = self.path if complete else partial_path(self.path)
         try:
+            self.buffer.flush(self.rec)
             self.rec.flush()
         except BaseException:  # Ctrl-C or a full disk while flushing: the file may lack its end, it is partial
             target = partial_path(self.path)

@@ -24,14 +24,14 @@ def limits(control: dict) -> tuple[str, str]:
 
 def draw(rec: rr.RecordingStream, ctx: PartContext, step, control: dict, truth) -> None:
     """``step``: the AgentStep; ``control``: its laws' debug records by law name."""
-    ctx.scalars(rec, "speed_mps", truth=truth.truth.speed_mps)
+    ctx.scalars("speed_mps", truth=truth.truth.speed_mps)
     following, braking = control.get("following"), control.get("emergency_braking")
     terms = dict(getattr(braking, "terms", None) or {})
     terms.pop("follow", None)  # the following law's output: shown as its own two terms
     terms["cruise"] = getattr(following, "cruise_mps2", None)
     terms["follow"] = getattr(following, "follow_mps2", None)
-    ctx.scalars(rec, "accel_mps2", command=step.accel_mps2, **{k: terms.get(k) for k in TERM_RGB})
-    ctx.scalars(rec, "steering_rad", command=step.steering_rad)
+    ctx.scalars("accel_mps2", command=step.accel_mps2, **{k: terms.get(k) for k in TERM_RGB})
+    ctx.scalars("steering_rad", command=step.steering_rad)
     accel, steering = limits(control)
     log_on_change(rec, ctx, LOG, (accel, steering), f"acceleration limited by {accel}; steering: {steering}")
 

@@ -25,8 +25,8 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, path, debug, truth) -> None:
     """``path``: EgoPath or None; ``debug``: LaneDebug (vision) or None."""
     lane = path.lane if path is not None and path.follows_lane else None
     for key in KEYS:
-        ctx.scalars(rec, key, truth=getattr(truth.truth.lane, key), estimate=getattr(lane, key, None))
-    ctx.scalars(rec, "confidence", estimate=path.lane.confidence if path is not None and path.lane else None)
+        ctx.scalars(key, truth=getattr(truth.truth.lane, key), estimate=getattr(lane, key, None))
+    ctx.scalars("confidence", estimate=path.lane.confidence if path is not None and path.lane else None)
     _draw_path(rec, ctx, path, lane)
     if ctx.image:
         _draw_on_image(rec, ctx, lane, debug)
@@ -35,7 +35,7 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, path, debug, truth) -> None:
 def _draw_path(rec: rr.RecordingStream, ctx: PartContext, path, lane) -> None:
     """The centre of the path (green) and the lane boundaries (left yellow, right blue) on the ground."""
     if path is None:
-        rec.log(ctx.around_ego("path"), rr.Clear(recursive=False))
+        ctx.buffer.clear(ctx.around_ego("path"))
         return
     x = np.linspace(*DRAW_M, POINTS)
     strips = [np.column_stack([x, path.centre_y(x), np.zeros_like(x)])]
@@ -53,11 +53,11 @@ def _draw_on_image(rec: rr.RecordingStream, ctx: PartContext, lane, debug) -> No
         rec.log(ctx.on_image("boundaries"), rr.LineStrips2D([ctx.px(px["left"]), ctx.px(px["right"])],
                                                             colors=[SIDE_RGB[1], SIDE_RGB[-1]], radii=1.5))
     else:
-        rec.log(ctx.on_image("boundaries"), rr.Clear(recursive=False))
+        ctx.buffer.clear(ctx.on_image("boundaries"))
     evidence = getattr(debug, "evidence", None)
     if evidence is None or not len(evidence.uv_px):
         if debug is not None:
-            rec.log(ctx.on_image("evidence"), rr.Clear(recursive=False))
+            ctx.buffer.clear(ctx.on_image("evidence"))
         return
     fit = getattr(debug, "fit", None)
     side = fit.side if fit is not None else np.zeros(len(evidence.uv_px), int)

@@ -35,23 +35,23 @@ def label(lead) -> str:
 def draw(rec: rr.RecordingStream, ctx: PartContext, lead, debug, truth) -> None:
     """``lead``: Lead or None."""
     t_range, t_rate, t_ttc = true_lead(ctx, truth)
-    ctx.scalars(rec, "range_m", truth=t_range, estimate=lead.range_m if lead else None)
-    ctx.scalars(rec, "range_rate_mps", truth=t_rate, estimate=lead.range_rate_mps if lead else None)
+    ctx.scalars("range_m", truth=t_range, estimate=lead.range_m if lead else None)
+    ctx.scalars("range_rate_mps", truth=t_rate, estimate=lead.range_rate_mps if lead else None)
     if hasattr(debug, "expansion"):  # the vision slot's cues, each before fusion
         contact, expansion = debug.contact, debug.expansion
-        ctx.scalars(rec, "range_m", stereo=debug.measured_m, contact=contact.range_m if contact else None)
-        ctx.scalars(rec, "range_rate_mps",
+        ctx.scalars("range_m", stereo=debug.measured_m, contact=contact.range_m if contact else None)
+        ctx.scalars("range_rate_mps",
                     flow=expansion.range_rate_mps(lead.range_m) if expansion is not None and lead else None)
-    ctx.scalars(rec, "ttc_s", truth=t_ttc, estimate=_shown(lead.ttc_s) if lead else None)
+    ctx.scalars("ttc_s", truth=t_ttc, estimate=_shown(lead.ttc_s) if lead else None)
     if lead is None:
-        rec.log(ctx.around_ego("lead"), rr.Clear(recursive=False))
+        ctx.buffer.clear(ctx.around_ego("lead"))
     else:
         rec.log(ctx.around_ego("lead"), rr.LineStrips3D([cross_line(ctx.camera_x_m() + lead.range_m)],
                                                         colors=[LEAD_RGB], radii=0.15, labels=[label(lead)]))
     if not ctx.image:
         return
     if lead is None or lead.box_px is None:
-        rec.log(ctx.on_image("lead"), rr.Clear(recursive=False))
+        ctx.buffer.clear(ctx.on_image("lead"))
         return
     (u0, v0), (u1, v1) = ctx.px([lead.box_px[:2], lead.box_px[2:]])
     rec.log(ctx.on_image("lead"), rr.Boxes2D(array=[u0, v0, u1, v1], array_format=rr.Box2DFormat.XYXY,

@@ -35,14 +35,14 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, estimate, debug, truth) -> N
     pose = estimate.pose if valid else None
     # 3 sigma of the position along its worst direction: 3 sqrt(largest eigenvalue of the xy covariance)
     bound = 3.0 * math.sqrt(max(np.linalg.eigvalsh(estimate.covariance[:2, :2])[-1], 0.0)) if valid else None
-    ctx.scalars(rec, "position_error_m", error=_error(pose, gt) if valid else None, bound_3sigma=bound,
+    ctx.scalars("position_error_m", error=_error(pose, gt) if valid else None, bound_3sigma=bound,
                 **{name: _error(getattr(debug, attr), gt) if debug is not None else None
                    for attr, name in (("fused_pose", "fused"), ("vo_pose", "vo"), ("dead_reckoning_pose", "dr"))})
-    ctx.scalars(rec, "speed_mps", truth=gt.speed_mps, estimate=estimate.speed_mps if estimate is not None else None)
+    ctx.scalars("speed_mps", truth=gt.speed_mps, estimate=estimate.speed_mps if estimate is not None else None)
     if pose is None:
-        rec.log(POSE, rr.Clear(recursive=False))
+        ctx.buffer.clear(POSE)
         return
-    rec.log(TRAIL, rr.Points3D([[pose.x_m, pose.y_m, 0.15]], colors=[ESTIMATE_RGB], radii=0.15))
+    ctx.buffer.add(TRAIL, rr.Points3D, positions=[[pose.x_m, pose.y_m, 0.15]], colors=[ESTIMATE_RGB], radii=[0.15])
     heading = [ARROW_M * math.cos(pose.yaw_rad), ARROW_M * math.sin(pose.yaw_rad), 0.0]
     rec.log(POSE, rr.Arrows3D(origins=[[pose.x_m, pose.y_m, 0.3]], vectors=[heading], colors=[ESTIMATE_RGB],
                               radii=0.12))
@@ -53,11 +53,11 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, estimate, debug, truth) -> N
 def _draw_vision(rec: rr.RecordingStream, ctx: PartContext, pose, debug) -> None:
     for attr, path, rgb in OTHERS:
         p = getattr(debug, attr)
-        rec.log(path, rr.Points3D([[p.x_m, p.y_m, 0.1]], colors=[rgb], radii=0.1))
+        ctx.buffer.add(path, rr.Points3D, positions=[[p.x_m, p.y_m, 0.1]], colors=[rgb], radii=[0.1])
     if not debug.sightings:
-        rec.log(FIXES, rr.Clear(recursive=False))
+        ctx.buffer.clear(FIXES)
         if ctx.image:
-            rec.log(ctx.on_image("signs"), rr.Clear(recursive=False))
+            ctx.buffer.clear(ctx.on_image("signs"))
         return
     world = pose.world_from_vehicle()
     ends = [world.apply(s.position_v_m) for s in debug.sightings]

@@ -45,12 +45,12 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, request, debug, truth) -> No
     obstacle = truth.in_path
     true_m = (ctx.range_from_gap_m(obstacle.gap_m)
               if obstacle is not None and obstacle.kind is ObjectKind.PEDESTRIAN else None)
-    ctx.scalars(rec, "stop_before_m", truth=true_m, estimate=request.stop_before_m if request else None)
+    ctx.scalars("stop_before_m", truth=true_m, estimate=request.stop_before_m if request else None)
     if request is None:
         log_on_change(rec, ctx, LOG, None, "braking request ended")
-        rec.log(ctx.around_ego("stop"), rr.Clear(recursive=False))
+        ctx.buffer.clear(ctx.around_ego("stop"))
         if ctx.image:
-            rec.log(ctx.on_image("stop"), rr.Clear(recursive=False))
+            ctx.buffer.clear(ctx.on_image("stop"))
         return
     text = f"{request.reason}: stop before {request.stop_before_m:.1f} m"
     log_on_change(rec, ctx, LOG, request.reason, text, level=rr.TextLogLevel.WARN)
@@ -62,7 +62,7 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, request, debug, truth) -> No
             rec.log(ctx.on_image("stop"), rr.LineStrips2D([ctx.px(uv[z > 0.1])], colors=[STOP_RGB], radii=2.0,
                                                           labels=[text]))
         else:
-            rec.log(ctx.on_image("stop"), rr.Clear(recursive=False))
+            ctx.buffer.clear(ctx.on_image("stop"))
 
 
 PART = Part(draw, plots=(Plot("stop_before_m", "stop before [m]"),), texts=(LOG,))

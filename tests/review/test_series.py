@@ -1,0 +1,94 @@
+"""Rows held and sent as columns make the same recording as logging them frame by frame (checked with the rerun
+CLI: `rrd optimize` compacts both, `rrd compare --unordered` compares their data but for log_time)."""
+
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rerun as rr
+
+from percept.cli.view_cmd import rerun_executable
+from percept.review.series import ColumnBuffer
+
+from .test_recorder import ENV
+
+FRAMES = 40
+TIMELINE = "sim_time"
+
+
+def values(frame: int, nudge: float = 0.0) -> dict:
+    """One frame's rows: a series with gaps (NaN and None clear it), a one-point trail, a transform, a clear."""
+    x = 0.1 * frame + nudge
+    gap = frame % 7 == 3
+    return {"speed": float("nan") if frame % 11 == 5 else None if gap else np.sin(x), "x": x,
+            "yaw": 0.01 * frame, "clear": gap}
+
+
+def by_frame(path: Path, nudge: float = 0.0) -> None:
+    rec = rr.RecordingStream("series-test", recording_id="same")
+    rec.save(str(path))
+    for f in range(FRAMES):
+        v = values(f, nudge)
+        rec.set_time(TIMELINE, duration=f / 15)
+        if v["speed"] is None or not np.isfinite(v["speed"]):
+            rec.log("plot/speed", rr.Clear(recursive=False))
+        else:
+            rec.log("plot/speed", rr.Scalars(v["speed"]))
+        rec.log("world/trail", rr.Points3D([[v["x"], 1.0, 0.1]], colors=[(255, 150, 30)], radii=0.15))
+        rec.log("world/ego", rr.Transform3D(translation=[v["x"], 0.0, 0.0],
+                                            rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=v["yaw"])))
+        if v["clear"]:
+            rec.log("world/stop", rr.Clear(recursive=False))
+    rec.flush()
+    rec.disconnect()
+
+
+def by_columns(path: Path, flush_every: int) -> None:
+    rec = rr.RecordingStream("series-test", recording_id="same")
+    rec.save(str(path))
+    buf = ColumnBuffer(TIMELINE)
+    held = 0
+    for f in range(FRAMES):
+        v = values(f)
+        buf.set_time(f / 15)
+        buf.scalar("plot/speed", v["speed"])
+        buf.add("world/trail", rr.Points3D, positions=[[v["x"], 1.0, 0.1]], colors=[(255, 150, 30)], radii=[0.15])
+        buf.add("world/ego", rr.Transform3D, translation=[[v["x"], 0.0, 0.0]],
+                rotation_axis_angle=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=v["yaw"])])
+        if v["clear"]:
+            buf.clear("world/stop")
+        held += 4 if v["clear"] else 3
+        assert len(buf) == held
+        if f % flush_every == flush_every - 1:
+            buf.flush(rec)
+            held = 0
+            assert len(buf) == 0
+    buf.flush(rec)
+    rec.flush()
+    rec.disconnect()
+
+
+def rrd(*args: str, stdout=subprocess.PIPE) -> int:
+    return subprocess.run([rerun_executable(), "rrd", *args], env=ENV, stdout=stdout, stderr=subprocess.PIPE,
+                          timeout=120).returncode
+
+
+def same_data(a: Path, b: Path) -> bool:
+    for p in (a, b):
+        with open(p.with_suffix(".opt.rrd"), "wb") as out:
+            assert rrd("optimize", str(p), stdout=out) == 0
+    return rrd("compare", "--unordered", str(a.with_suffix(".opt.rrd")), str(b.with_suffix(".opt.rrd"))) == 0
+
+
+@pytest.mark.parametrize("flush_every", [1, 15, 100])
+def test_rows_sent_as_columns_are_the_rows_logged_frame_by_frame(tmp_path, flush_every):
+    by_frame(tmp_path / "frames.rrd")
+    by_columns(tmp_path / "columns.rrd", flush_every)
+    assert same_data(tmp_path / "frames.rrd", tmp_path / "columns.rrd")
+
+
+def test_the_comparison_sees_a_changed_value(tmp_path):
+    by_frame(tmp_path / "frames.rrd", nudge=1e-9)
+    by_columns(tmp_path / "columns.rrd", 15)
+    assert not same_data(tmp_path / "frames.rrd", tmp_path / "columns.rrd")
