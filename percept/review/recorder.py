@@ -168,10 +168,12 @@ class RunRecorder:
         """True boxes: 3D in the vehicle frame (under the ego's transform) and, with an image, 2D on it."""
         rec = self.rec
         if objects:
-            rec.log(OBJECTS, rr.Boxes3D(
-                centers=[o.position_m for o in objects], sizes=[o.size_m for o in objects],
-                rotation_axis_angles=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=o.yaw_rad) for o in objects],
-                class_ids=[KIND_CLASSES[o.kind][0] for o in objects], show_labels=False))
+            # Boxes3D(sizes=s) logs half sizes: float32 s / 2
+            self.buffer.add(OBJECTS, rr.Boxes3D, centers=[o.position_m for o in objects],
+                            half_sizes=np.asarray([o.size_m for o in objects], np.float32) / 2.0,
+                            rotation_axis_angles=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=o.yaw_rad)
+                                                  for o in objects],
+                            class_ids=[KIND_CLASSES[o.kind][0] for o in objects], show_labels=[False])
         else:
             self.buffer.clear(OBJECTS)
         if not image:

@@ -38,8 +38,9 @@ class ColumnBuffer:
         self._ns = round(1e9 * float(seconds))
 
     def add(self, path: str, archetype: type, **components) -> None:
-        """One row of ``archetype`` at ``path`` at the current time: each component a batch of one element (what
-        ``archetype(...)`` would log, e.g. ``positions=[[x, y, z]], colors=[rgb], radii=[r]``)."""
+        """One row of ``archetype`` at ``path`` at the current time: each component the batch ``archetype(...)``
+        would log, as a list or array of elements (e.g. ``positions=[[x, y, z]], colors=[rgb], radii=[r]``; a
+        single element applies to all, as in ``rr.log``)."""
         times, log_times, batches = self._rows[(path, archetype)]
         times.append(self._ns)
         log_times.append(time.time_ns())
@@ -66,7 +67,11 @@ class ColumnBuffer:
         for (path, archetype), (times, log_times, batches) in self._rows.items():
             indexes = [rr.TimeColumn(self.timeline, duration=np.asarray(times, np.int64).astype("timedelta64[ns]")),
                        rr.TimeColumn("log_time", timestamp=np.asarray(log_times, np.int64).astype("datetime64[ns]"))]
-            # one element per row and component: the columns' default partition
-            columns = {name: [item for batch in rows for item in batch] for name, rows in batches.items()}
-            rec.send_columns(path, indexes=indexes, columns=archetype.columns(**columns))
+            columns = []
+            for name, rows in batches.items():
+                # every row's elements in one column, cut back into the rows' batches
+                flat = np.concatenate(rows) if all(isinstance(b, np.ndarray) for b in rows) else [
+                    item for batch in rows for item in batch]
+                columns += archetype.columns(**{name: flat}).partition([len(b) for b in rows])
+            rec.send_columns(path, indexes=indexes, columns=columns)
         self._rows.clear()

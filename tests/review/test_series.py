@@ -18,11 +18,26 @@ TIMELINE = "sim_time"
 
 
 def values(frame: int, nudge: float = 0.0) -> dict:
-    """One frame's rows: a series with gaps (NaN and None clear it), a one-point trail, a transform, a clear."""
+    """One frame's single rows: a series with gaps (NaN and None clear it), a one-point trail, a transform, a
+    clear (with ``strips`` and ``people``, rows of several elements and of none)."""
     x = 0.1 * frame + nudge
     gap = frame % 7 == 3
     return {"speed": float("nan") if frame % 11 == 5 else None if gap else np.sin(x), "x": x,
             "yaw": 0.01 * frame, "clear": gap}
+
+
+STRIP_RGB = [(120, 220, 120), (255, 220, 0), (60, 140, 255)]
+
+
+def strips(frame: int) -> list[np.ndarray]:
+    """One to three strips of 2 to 12 points (a path alone, or with its two boundaries)."""
+    return [np.column_stack([np.arange(2 + (frame + k) % 11), np.full(2 + (frame + k) % 11, k), np.zeros(
+        2 + (frame + k) % 11)]) for k in range(1 + frame % 3)]
+
+
+def people(frame: int) -> np.ndarray:
+    """Zero to three points (an empty batch clears the points shown)."""
+    return np.arange(3 * (frame % 4), dtype=float).reshape(-1, 3)
 
 
 def by_frame(path: Path, nudge: float = 0.0) -> None:
@@ -40,6 +55,9 @@ def by_frame(path: Path, nudge: float = 0.0) -> None:
                                             rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=v["yaw"])))
         if v["clear"]:
             rec.log("world/stop", rr.Clear(recursive=False))
+        rec.log("world/path", rr.LineStrips3D(strips(f), colors=STRIP_RGB[:len(strips(f))], radii=0.1))
+        rec.log("world/people", rr.Points3D(people(f), colors=[(60, 220, 255)], radii=0.3,
+                                            labels=[f"#{i}" for i in range(len(people(f)))]))
     rec.flush()
     rec.disconnect()
 
@@ -58,7 +76,10 @@ def by_columns(path: Path, flush_every: int) -> None:
                 rotation_axis_angle=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=v["yaw"])])
         if v["clear"]:
             buf.clear("world/stop")
-        held += 4 if v["clear"] else 3
+        buf.add("world/path", rr.LineStrips3D, strips=strips(f), colors=STRIP_RGB[:len(strips(f))], radii=[0.1])
+        buf.add("world/people", rr.Points3D, positions=people(f), colors=[(60, 220, 255)], radii=[0.3],
+                labels=[f"#{i}" for i in range(len(people(f)))])
+        held += 6 if v["clear"] else 5
         assert len(buf) == held
         if f % flush_every == flush_every - 1:
             buf.flush(rec)

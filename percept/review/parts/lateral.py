@@ -44,7 +44,7 @@ def _draw_path(rec: rr.RecordingStream, ctx: PartContext, path, lane) -> None:
         ground = lane.boundary_points_m(*DRAW_M, n=POINTS)
         strips += [ground["left"], ground["right"]]
         colors += [SIDE_RGB[1], SIDE_RGB[-1]]
-    rec.log(ctx.around_ego("path"), rr.LineStrips3D(strips, colors=colors, radii=0.1))
+    ctx.buffer.add(ctx.around_ego("path"), rr.LineStrips3D, strips=strips, colors=colors, radii=[0.1])
 
 
 def _draw_on_image(rec: rr.RecordingStream, ctx: PartContext, lane, debug) -> None:

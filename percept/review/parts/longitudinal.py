@@ -46,8 +46,8 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, lead, debug, truth) -> None:
     if lead is None:
         ctx.buffer.clear(ctx.around_ego("lead"))
     else:
-        rec.log(ctx.around_ego("lead"), rr.LineStrips3D([cross_line(ctx.camera_x_m() + lead.range_m)],
-                                                        colors=[LEAD_RGB], radii=0.15, labels=[label(lead)]))
+        ctx.buffer.add(ctx.around_ego("lead"), rr.LineStrips3D, strips=[cross_line(ctx.camera_x_m() + lead.range_m)],
+                       colors=[LEAD_RGB], radii=[0.15], labels=[label(lead)])
     if not ctx.image:
         return
     if lead is None or lead.box_px is None:

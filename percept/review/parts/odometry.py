@@ -44,8 +44,8 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, estimate, debug, truth) -> N
         return
     ctx.buffer.add(TRAIL, rr.Points3D, positions=[[pose.x_m, pose.y_m, 0.15]], colors=[ESTIMATE_RGB], radii=[0.15])
     heading = [ARROW_M * math.cos(pose.yaw_rad), ARROW_M * math.sin(pose.yaw_rad), 0.0]
-    rec.log(POSE, rr.Arrows3D(origins=[[pose.x_m, pose.y_m, 0.3]], vectors=[heading], colors=[ESTIMATE_RGB],
-                              radii=0.12))
+    ctx.buffer.add(POSE, rr.Arrows3D, origins=[[pose.x_m, pose.y_m, 0.3]], vectors=[heading], colors=[ESTIMATE_RGB],
+                   radii=[0.12])
     if debug is not None:
         _draw_vision(rec, ctx, pose, debug)
 

@@ -26,7 +26,8 @@ def draw_people(rec: rr.RecordingStream, ctx: PartContext, debug) -> None:
     pts = [[t.position_m[0], t.position_m[1], 0.0] for t in tracks]
     labels = [f"#{t.track_id} {t.position_m[0] - ctx.camera_x_m():.1f} m, {t.velocity_mps[1]:+.1f} m/s"
               for t in tracks]
-    rec.log(ctx.around_ego("people"), rr.Points3D(pts, colors=[TRACK_RGB], radii=0.3, labels=labels))
+    ctx.buffer.add(ctx.around_ego("people"), rr.Points3D, positions=pts, colors=[TRACK_RGB], radii=[0.3],
+                   labels=labels)
     if not ctx.image:
         return
     dets = [person_box(d.box_px) for d in debug.detections]
