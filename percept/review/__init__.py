@@ -3,5 +3,6 @@
 from .blueprint import blueprint
 from .context import Part, PartContext, Plot, RecordOptions
 from .recorder import RunRecorder, partial_path
+from .series import ColumnBuffer
 
-__all__ = ["Part", "PartContext", "Plot", "RecordOptions", "RunRecorder", "blueprint", "partial_path"]
+__all__ = ["ColumnBuffer", "Part", "PartContext", "Plot", "RecordOptions", "RunRecorder", "blueprint", "partial_path"]

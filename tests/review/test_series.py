@@ -9,7 +9,7 @@ import pytest
 import rerun as rr
 
 from percept.cli.view_cmd import rerun_executable
-from percept.review.series import ColumnBuffer
+from percept.review import ColumnBuffer
 
 from .test_recorder import ENV
 
