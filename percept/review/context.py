@@ -61,8 +61,8 @@ class RecordOptions:
 class PartContext:
     """task: the task's name (root of its entities); rig: the stereo rig; image: this frame stores a left image;
     image_scale: stored pixels per camera pixel; memory: the part's own state across frames (a dict it may fill);
-    buffer: the recorder's rows sent as columns (``scalars``, clears, one-point trails; it sets each frame's time
-    and sends them)."""
+    buffer: the recorder's rows sent as columns (what is drawn every frame: ``scalars``, clears, trails, what is
+    around the car; the recorder sets each frame's time and sends them)."""
 
     task: str
     rig: StereoRig

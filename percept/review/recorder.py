@@ -43,8 +43,8 @@ BATCHING = dict(flush_tick=timedelta(seconds=5), flush_num_bytes=8 << 20)
 """Few, large chunks: each chunk carries its own schema (about 2 KB), which the default batching (a chunk per
 entity every 200 ms of wall time) would repeat thousands of times in a file."""
 COLUMNS_FLUSH_S = 10.0
-"""Simulated time the per-frame rows (scalars, clears, the ego's transform, trail points) are held before they are
-sent as columns (``series.ColumnBuffer``: a chunk per entity)."""
+"""Simulated time the per-frame rows (scalars, clears, the ego's transform, trail points, what the parts draw around
+the car) are held before they are sent as columns (``series.ColumnBuffer``: a chunk per entity)."""
 
 
 def resolve_part(spec):

@@ -1,14 +1,14 @@
 """Per-frame rows held per entity and sent as columns.
 
 Each frame a run logs about 34 scalars (every task's truth, estimate and command series), the ego's transform, one
-point of each trail and a few clears. One ``rr.log`` call costs 40-230 us (the archetype's conversion to Arrow,
-then the SDK's batcher), about 3 ms a frame in all; one ``rr.send_columns`` call per entity over many frames costs
-a small fraction of that. The recording holds the same data: each row at its frame's time (nanoseconds, rounded
-as ``RecordingStream.set_time`` rounds them) and at the wall-clock time it was added (``log_time``, which
-``rr.log`` adds), with the same components; ``rerun rrd compare --unordered`` finds a recording made this way and
-one logged frame by frame identical once both are compacted (``rerun rrd optimize``). Holding a few seconds of
-rows loses nothing the SDK would have kept: its batcher holds chunks for 5 s too, and the recorder flushes this
-buffer before it closes (also when a run fails or is interrupted).
+point of each trail, what the parts draw around the car and a few clears. One ``rr.log`` call costs 40-230 us (the
+archetype's conversion to Arrow, then the SDK's batcher), 3 ms a frame in all (5 with building the archetypes); one
+``rr.send_columns`` call per entity over many frames costs a small fraction of that. The recording holds the same
+data: each row at its frame's time (nanoseconds, rounded as ``RecordingStream.set_time`` rounds them) and at the
+wall-clock time it was added (``log_time``, which ``rr.log`` adds), with the same components; ``rerun rrd compare
+--unordered`` finds a recording made this way and one logged frame by frame identical once both are compacted
+(``rerun rrd optimize``). The recorder holds 10 simulated seconds (3-5 s of wall time at the loop's speed; the SDK's
+batcher holds its chunks for 5 s) and sends what it holds before it closes, also when a run fails or is interrupted.
 """
 
 from __future__ import annotations

@@ -182,7 +182,10 @@ def test_a_run_interrupted_midway_keeps_what_was_recorded(tmp_path):
         run_drive(DriveConfig(WorldConfig("highway", 0), 1.0), recorder_factory=factory, render=True)
     kept = holder["r"].close(complete=False)
     verify(kept)
-    assert columns_by_entity(kept)["/world/trajectory"]["Points3D:positions"] == 5
+    # the rows held as columns (trail, scalars) are sent when the recorder closes
+    cols = columns_by_entity(kept)
+    assert cols["/world/trajectory"]["Points3D:positions"] == 5
+    assert cols["/control/speed_mps/truth"]["Scalars:scalars"] == 5
     assert sorted(os.listdir(tmp_path)) == ["W.partial.rrd"]
 
 
