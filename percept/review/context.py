@@ -59,17 +59,18 @@ class RecordOptions:
 
 @dataclass(frozen=True)
 class PartContext:
-    """task: the task's name (root of its entities); rig: the stereo rig; image: this frame stores a left image;
-    image_scale: stored pixels per camera pixel; memory: the part's own state across frames (a dict it may fill);
-    buffer: the recorder's rows sent as columns (what is drawn every frame: ``scalars``, clears, trails, what is
-    around the car; the recorder sets each frame's time and sends them)."""
+    """task: the task's name (root of its entities); rig: the stereo rig; buffer: the recorder's rows sent as
+    columns (what is drawn every frame: ``scalars``, clears, trails, what is around the car; the recorder sets each
+    frame's time and sends them, so a part never holds a buffer of its own that nobody sends); image: this frame
+    stores a left image; image_scale: stored pixels per camera pixel; memory: the part's own state across frames
+    (a dict it may fill)."""
 
     task: str
     rig: StereoRig
+    buffer: ColumnBuffer
     image: bool = False
     image_scale: float = 1.0
     memory: dict = field(default_factory=dict)
-    buffer: ColumnBuffer = field(default_factory=lambda: ColumnBuffer(TIMELINE))
 
     def px(self, uv_px) -> np.ndarray:
         """Camera pixels (N, 2) (u, v) -> stored-image pixels."""

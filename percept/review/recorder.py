@@ -88,8 +88,7 @@ class RunRecorder:
             raise ValueError("a task may not be named 'control': the control part records under that name")
         self.parts.append(("control", parts.control))
         self.buffer = ColumnBuffer(TIMELINE)
-        self._buffer_since_s: float | None = None
-        self.contexts = {name: PartContext(name, rig, image_scale=options.image_scale, buffer=self.buffer)
+        self.contexts = {name: PartContext(name, rig, self.buffer, image_scale=options.image_scale)
                          for name, _ in self.parts}
         self.rig = rig
         self.closed_as: Path | None = None
@@ -130,10 +129,9 @@ class RunRecorder:
         """One frame: ``frame`` (Frame), ``truth`` (StepTruth), ``step`` (AgentStep)."""
         rec = self.rec
         rec.set_time(TIMELINE, duration=frame.timestamp_s)
-        if self._buffer_since_s is None or frame.timestamp_s - self._buffer_since_s >= COLUMNS_FLUSH_S:
-            self.buffer.flush(rec)
-            self._buffer_since_s = frame.timestamp_s
         self.buffer.set_time(frame.timestamp_s)
+        if self.buffer.held_s() >= COLUMNS_FLUSH_S:
+            self.buffer.flush(rec)
         gt = truth.truth
         e = gt.ego
         self.buffer.add(EGO, rr.Transform3D, translation=[[e.x_m, e.y_m, 0.0]],

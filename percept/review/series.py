@@ -62,6 +62,10 @@ class ColumnBuffer:
         """Rows held."""
         return sum(len(times) for times, _, _ in self._rows.values())
 
+    def held_s(self) -> float:
+        """How long before the current time the oldest row held was added [s] (0 when none is held)."""
+        return (self._ns - min(times[0] for times, _, _ in self._rows.values())) / 1e9 if self._rows else 0.0
+
     def flush(self, rec: rr.RecordingStream) -> None:
         """Send every row held to ``rec`` and forget them."""
         for (path, archetype), (times, log_times, batches) in self._rows.items():

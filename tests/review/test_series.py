@@ -80,11 +80,11 @@ def by_columns(path: Path, flush_every: int) -> None:
         buf.add("world/people", rr.Points3D, positions=people(f), colors=[(60, 220, 255)], radii=[0.3],
                 labels=[f"#{i}" for i in range(len(people(f)))])
         held += 6 if v["clear"] else 5
-        assert len(buf) == held
+        assert len(buf) == held and buf.held_s() == pytest.approx((f % flush_every) / 15)
         if f % flush_every == flush_every - 1:
             buf.flush(rec)
             held = 0
-            assert len(buf) == 0
+            assert len(buf) == 0 and buf.held_s() == 0
     buf.flush(rec)
     rec.flush()
     rec.disconnect()
