@@ -170,6 +170,8 @@ def test_the_compiled_figures_are_the_interpreted_ones():
 CTRL_C = """
 import os, signal, threading, time
 import numpy as np
+# Python's own handler, also when the test runs where SIGINT is ignored (a background job: nohup cmd &)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from percept.sims.render.cull import inverse_rows
 n = 5000
 o = np.random.default_rng(0).normal(size=(n, 3))
