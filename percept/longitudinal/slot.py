@@ -7,8 +7,10 @@ the expansion of its image (``flow``: dZ/dt = -Z (s - 1) / dt). A Kalman filter 
 and range acceleration (constant acceleration, white jerk noise) takes each with its own noise, each gated. Two
 stereo ranges in a row beyond the gate are a new lead when the obstacle's box moved (a cut-in, the lead changing
 lanes), else the same lead manoeuvring (braking hard): the filter's uncertainty is opened up. A track is confirmed
-by hits on an obstacle that stays in place in the image, reported once confirmed, kept through short misses and
-dropped frames, with a confidence that falls while it is only predicted.
+by hits on an obstacle that stays in place in the image, reported once confirmed, kept through short misses,
+dropped frames and frames whose range does not refine, with a confidence that falls while it is only predicted.
+Nothing in the ego's path drives backwards towards it, so the range rate is held at or above minus the ego's wheel
+speed (a state constraint).
 """
 
 from __future__ import annotations
@@ -49,7 +51,9 @@ class LeadConfig:
     outliers; two in a row are a new lead when its box overlaps the last one by less than same_object_iou (IoU), else
     the same one manoeuvring: the filter's rate and acceleration variances grow by manoeuvre_rate_mps² and
     manoeuvre_accel_mps2² and it takes the measurement; confirm: hits before a track is reported; hold_s: how long a
-    track is predicted without measurements [s]; obstacles, contact, flow: the cues' own settings."""
+    track is predicted without measurements [s]; reverse_mps: how fast a lead may come towards the ego, beyond the
+    ego's own speed (estimation noise: leads do not reverse on a road) [m/s]; obstacles, contact, flow: the cues' own
+    settings."""
 
     face_m: tuple[float, float] = (0.4, 0.9)
     sigma_d_px: float = 0.05
@@ -62,6 +66,7 @@ class LeadConfig:
     manoeuvre_accel_mps2: float = 6.0
     confirm: int = 3
     hold_s: float = 0.6
+    reverse_mps: float = 1.0
     obstacles: ObstacleConfig = ObstacleConfig()
     contact: ContactConfig = ContactConfig()
     flow: FlowConfig = FlowConfig()
@@ -100,6 +105,7 @@ class LongitudinalSlot:
     def reset(self) -> None:
         """A new run: no track, and the road plane back to the rig's."""
         self.finder.reset()
+        self._ego_mps = float("nan")
         self._drop_track()
 
     def _drop_track(self) -> None:
@@ -110,6 +116,7 @@ class LongitudinalSlot:
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
         path = upstream.get("lateral") or EgoPath.straight(frame.wheel_speed_mps)
+        self._ego_mps = frame.wheel_speed_mps
         self._predict()
         ob = ref = z = contact = expansion = None
         used: tuple[str, ...] = ()
@@ -125,7 +132,10 @@ class LongitudinalSlot:
                 expansion = self.flow.measure(left, ob.box_px, frame.timestamp_s) if used else None
                 if expansion is not None and self._update_rate(expansion):
                     used += ("flow",)
-        if not used:
+        if not used or ref is None:
+            # a frame without a refined stereo range is a miss for the track's life, though its unrefined range and
+            # the ground contact still update the filter: a far box that never refines (the road's end at night,
+            # where contact edges jump between rows metres apart) is not followed for longer than hold_s
             self._miss()
         state = None if self.kf is None else (float(self.kf.x[0, 0]), float(self.kf.x[1, 0]))
         return self._lead(), LeadDebug(ob, ref, z, contact, expansion, used, state, self.hits, self.misses)
@@ -179,6 +189,21 @@ class LongitudinalSlot:
     def _predict(self) -> None:
         if self.kf is not None:
             self.kf.predict()
+            self._constrain()
+
+    def _constrain(self) -> None:
+        """Hold the range rate at or above -(v_ego + reverse_mps): a lead is at most standing still (a far box at the
+        horizon jumping between ranges, taken for a lead braking hard, otherwise closes at 30 m/s on a car doing 10).
+        Estimate projection (Simon, "Kalman filtering with state constraints", IET Control Theory Appl. 4(8), 2010)
+        onto D x >= d, D = [0 1 0]: x <- x - P D^T (D P D^T)^-1 (D x - d), which also moves the range and
+        acceleration by their correlation with the rate."""
+        v = self._ego_mps
+        if not np.isfinite(v):
+            return
+        # d = -(v_ego + reverse)
+        excess = float(self.kf.x[1, 0]) + v + self.cfg.reverse_mps
+        if excess < 0:
+            self.kf.x = self.kf.x - self.kf.P[:, 1:2] / self.kf.P[1, 1] * excess
 
     def _new_track(self, z: float, sigma: float) -> None:
         kf = KalmanFilter(dim_x=3, dim_z=1)
@@ -207,6 +232,7 @@ class LongitudinalSlot:
         if innovation * innovation > self.cfg.gate_sigma ** 2 * s:
             return False
         self.kf.update(np.array([[value]]), R=R, H=H)
+        self._constrain()
         return True
 
     def _update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
@@ -239,7 +265,8 @@ class LongitudinalSlot:
         if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, _RANGE):
             used += ("contact",)
         if used:
-            self.hits, self.misses = self.hits + 1, 0
+            self.hits += 1
+            self.misses = 0 if ref is not None else self.misses
         return used
 
     def _refined_update(self, z: float, sigma: float, overlap: float) -> tuple[tuple[str, ...], bool]:
@@ -258,6 +285,7 @@ class LongitudinalSlot:
         # the same object, manoeuvring (braking hard): open the filter up and take the measurement
         self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
         self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
+        self._constrain()
         self.outliers = 0
         return ("stereo",), False
 

@@ -79,3 +79,58 @@ def test_a_range_that_does_not_refine_neither_starts_a_track_nor_drags_one_away(
     # ... while a coarse range near the track still updates it (a lead whose face did not refine this frame)
     slot._predict()
     assert slot._update(12.3, None, car, None) == ("stereo",)
+
+
+class _Scripted:
+    """Stand-ins for the slot's cues: each frame's obstacle and whether its range refines, from a script."""
+
+    def __init__(self, slot, script):
+        self.script, self.fb = iter(script), slot.fb
+        slot.finder.find = self.find
+        slot._refine = lambda left, right, ob: self.refined
+        slot.contact.measure = lambda gray, box, z: None
+        slot.flow.measure = lambda gray, box, t: None
+
+    def find(self, left, right, path):
+        from percept.longitudinal import Obstacle, Refined
+
+        range_m, refines = next(self.script)
+        self.refined = Refined(self.fb / range_m, 0.02, 200, True) if refines else None
+        return Obstacle(range_m, (300, 240, 340, 260), 800.0), {}
+
+
+def run_script(script, speed_mps=10.0):
+    slot = LongitudinalSlot(StereoRig(), 1 / 15)
+    _Scripted(slot, script)
+    grey = np.full((480, 640, 3), 128, np.uint8)
+    out = []
+    for i in range(len(script)):
+        f = Frame(i, i / 15, grey, grey, ImuSample(np.zeros(3), np.zeros(3)), speed_mps)
+        out.append(slot.step(f, {"lateral": EgoPath.straight(speed_mps)}))
+    return slot, out
+
+
+def test_a_track_whose_range_stops_refining_is_dropped_after_hold_s():
+    # a lead seen well, then a far box at the road's end that never refines: its coarse ranges agree with the
+    # track (their noise at 60 m is metres) but do not keep it alive past hold_s
+    slot, out = run_script([(60.0, True)] * 10 + [(60.0, False)] * 20)
+    assert out[9][0] is not None
+    hold = int(slot.cfg.hold_s * 15)
+    assert out[9 + hold][0] is not None and out[9 + hold][0].confidence < 0.2
+    assert all(lead is None for lead, _ in out[11 + hold:])
+    assert slot.kf is None
+    # while a refined range now and then keeps it
+    slot, out = run_script([(60.0, True), (60.0, False), (60.0, False)] * 10)
+    assert all(lead is not None for lead, _ in out[6:])  # confirmed by its third refined range
+
+
+def test_no_lead_comes_towards_the_ego_faster_than_the_ego_drives():
+    # ranges alternating between 48 and 68 m on the same box (the horizon at night): without the bound the filter
+    # took them for a lead braking hard and closed at -30 m/s on a car doing 10
+    slot, out = run_script([(68.0 if i % 4 < 2 else 48.0, True) for i in range(60)], speed_mps=10.0)
+    rates = [dbg.state[1] for _, dbg in out if dbg.state is not None]
+    assert min(rates) >= -(10.0 + slot.cfg.reverse_mps) - 1e-9
+    assert min(rates) < -5.0  # the case is hard: it did pull the rate down to the bound
+    # a car standing still ahead is closed on at the ego's speed, as it should be: the bound does not hide it
+    slot, out = run_script([(60.0 - 10.0 * i / 15, True) for i in range(45)], speed_mps=10.0)
+    assert out[-1][0].range_rate_mps == pytest.approx(-10.0, abs=0.5)
