@@ -105,7 +105,7 @@ class LongitudinalSlot:
     def reset(self) -> None:
         """A new run: no track, and the road plane back to the rig's."""
         self.finder.reset()
-        self._ego_mps = float("nan")
+        self._rate_floor_mps = -np.inf
         self._drop_track()
 
     def _drop_track(self) -> None:
@@ -116,7 +116,9 @@ class LongitudinalSlot:
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
         path = upstream.get("lateral") or EgoPath.straight(frame.wheel_speed_mps)
-        self._ego_mps = frame.wheel_speed_mps
+        # nothing in the path comes towards the ego faster than it drives: range rate >= -(v_ego + reverse_mps)
+        v = frame.wheel_speed_mps
+        self._rate_floor_mps = -(v + self.cfg.reverse_mps) if np.isfinite(v) else -np.inf
         self._predict()
         ob = ref = z = contact = expansion = None
         used: tuple[str, ...] = ()
@@ -132,7 +134,9 @@ class LongitudinalSlot:
                 expansion = self.flow.measure(left, ob.box_px, frame.timestamp_s) if used else None
                 if expansion is not None and self._update_rate(expansion):
                     used += ("flow",)
-        if not used or ref is None:
+        if used and ref is not None:
+            self.misses = 0
+        else:
             # a frame without a refined stereo range is a miss for the track's life, though its unrefined range and
             # the ground contact still update the filter: a far box that never refines (the road's end at night,
             # where contact edges jump between rows metres apart) is not followed for longer than hold_s
@@ -192,18 +196,19 @@ class LongitudinalSlot:
             self._constrain()
 
     def _constrain(self) -> None:
-        """Hold the range rate at or above -(v_ego + reverse_mps): a lead is at most standing still (a far box at the
-        horizon jumping between ranges, taken for a lead braking hard, otherwise closes at 30 m/s on a car doing 10).
-        Estimate projection (Simon, "Kalman filtering with state constraints", IET Control Theory Appl. 4(8), 2010)
-        onto D x >= d, D = [0 1 0]: x <- x - P D^T (D P D^T)^-1 (D x - d), which also moves the range and
+        """Hold the range rate at or above this frame's floor, -(v_ego + reverse_mps): a lead is at most standing
+        still (a far box at the road's end, pulled about by contact edges, otherwise closed at 33 m/s on a car doing
+        10). Estimate projection (Simon, "Kalman filtering with state constraints", IET Control Theory Appl. 4(8),
+        2010) onto D x >= d, D = [0 1 0]: x <- x - P D^T (D P D^T)^-1 (D x - d), which also moves the range and
         acceleration by their correlation with the rate."""
-        v = self._ego_mps
-        if not np.isfinite(v):
-            return
-        # d = -(v_ego + reverse)
-        excess = float(self.kf.x[1, 0]) + v + self.cfg.reverse_mps
+        excess = float(self.kf.x[1, 0]) - self._rate_floor_mps
         if excess < 0:
             self.kf.x = self.kf.x - self.kf.P[:, 1:2] / self.kf.P[1, 1] * excess
+
+    def _apply(self, value: float, R: np.ndarray, H: np.ndarray) -> None:
+        """The filter's update with one measurement, then the rate floor."""
+        self.kf.update(np.array([[value]]), R=R, H=H)
+        self._constrain()
 
     def _new_track(self, z: float, sigma: float) -> None:
         kf = KalmanFilter(dim_x=3, dim_z=1)
@@ -231,8 +236,7 @@ class LongitudinalSlot:
         innovation = value - float((H @ self.kf.x)[0, 0])
         if innovation * innovation > self.cfg.gate_sigma ** 2 * s:
             return False
-        self.kf.update(np.array([[value]]), R=R, H=H)
-        self._constrain()
+        self._apply(value, R, H)
         return True
 
     def _update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
@@ -266,7 +270,6 @@ class LongitudinalSlot:
             used += ("contact",)
         if used:
             self.hits += 1
-            self.misses = 0 if ref is not None else self.misses
         return used
 
     def _refined_update(self, z: float, sigma: float, overlap: float) -> tuple[tuple[str, ...], bool]:
@@ -284,8 +287,7 @@ class LongitudinalSlot:
             return ("stereo",), True
         # the same object, manoeuvring (braking hard): open the filter up and take the measurement
         self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
-        self.kf.update(np.array([[z]]), R=np.array([[sigma ** 2]]), H=_RANGE)
-        self._constrain()
+        self._apply(z, np.array([[sigma ** 2]]), _RANGE)
         self.outliers = 0
         return ("stereo",), False
 

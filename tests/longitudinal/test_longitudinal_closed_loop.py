@@ -125,8 +125,8 @@ def test_a_track_whose_range_stops_refining_is_dropped_after_hold_s():
 
 
 def test_no_lead_comes_towards_the_ego_faster_than_the_ego_drives():
-    # ranges alternating between 48 and 68 m on the same box (the horizon at night): without the bound the filter
-    # took them for a lead braking hard and closed at -30 m/s on a car doing 10
+    # refined ranges alternating between 48 and 68 m on the same box: without the bound the filter takes them for a
+    # lead braking hard and its rate reaches -93 m/s on a car doing 10
     slot, out = run_script([(68.0 if i % 4 < 2 else 48.0, True) for i in range(60)], speed_mps=10.0)
     rates = [dbg.state[1] for _, dbg in out if dbg.state is not None]
     assert min(rates) >= -(10.0 + slot.cfg.reverse_mps) - 1e-9
