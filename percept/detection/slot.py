@@ -6,11 +6,11 @@ Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over t
 ``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
 frame, the two levels around each tracked person's predicted window. A lone window (one that grouping would
 drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
-its feet touch the road. Only confirmed tracks act; a track walking sideways counts as walking only when it has
-``WALK_HITS`` detections and its lateral speed is a person's and clear of its own uncertainty (1.5 standard
+its feet touch the road. Only confirmed tracks act, and only once the stereo pair has seen them stand where their
+feet touch the road (``STEREO_HITS``); a track walking sideways counts as walking only when it has ``WALK_HITS``
+detections and its lateral speed is a person's and clear of its own uncertainty (``WALK_SIGMAS`` standard
 deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
-braking. The conflict rule is the privileged slot's
-(``percept.sensors.conflict``).
+braking. The conflict rule is the privileged slot's (``percept.sensors.conflict``).
 """
 
 from __future__ import annotations
@@ -35,6 +35,14 @@ WALK_MAX_MPS = 3.0
 """A lateral speed above this is no person's walk but a tracking error [m/s]."""
 WALK_HITS = 8
 """Detections a track needs before its speed is trusted (about half a second)."""
+MAX_YAW_RATE_RPS = 2.0
+"""A gyro yaw rate beyond this is no car's on a road but a bad sample [rad/s]."""
+WALK_SIGMAS = 1.5
+"""A track's lateral speed must stand this many of its standard deviations clear of zero to count as walking."""
+STEREO_HITS = 1
+"""Detections a track needs whose stereo depth agreed with their ground contact before it may ask for braking: a
+person stands where their feet touch the road; lane paint under dark scenery at night, which the detector can take
+for legs, does not give the stereo pair anything to match at the feet's depth."""
 
 
 @dataclass(frozen=True)
@@ -75,23 +83,27 @@ class PedestrianSlot:
         self.tracker = PersonTracker(rig, dt_s, tracking)
         self.sweep_frames = sweep_frames
         self.cam_x = float(rig.camera_position()[0])
-        self._speed = 0.0
+        self._speed = self._yaw_rate = 0.0
 
     def reset(self) -> None:
         self.tracker.reset()
-        self._speed = 0.0
+        self._speed = self._yaw_rate = 0.0
 
-    def _ego_speed(self, frame: Frame) -> float:
-        """The wheel speed, or the last good one when the sample is not a finite, plausible speed."""
+    def _ego_motion(self, frame: Frame) -> tuple[float, float]:
+        """The wheel speed [m/s] and the gyro's yaw rate [rad/s], each the last good one when the sample is not a
+        finite, plausible value."""
         v = frame.wheel_speed_mps
         if isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v < 100.0:
             self._speed = float(v)
-        return self._speed
+        w = frame.imu.yaw_rate_rps if frame.imu is not None else math.nan
+        if math.isfinite(w) and abs(w) < MAX_YAW_RATE_RPS:
+            self._yaw_rate = w
+        return self._speed, self._yaw_rate
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
-        speed = self._ego_speed(frame)
+        speed, yaw_rate = self._ego_motion(frame)
         path = upstream.get("lateral") or EgoPath.straight(speed)
-        predicted = self.tracker.predict(speed)
+        predicted = self.tracker.predict(speed, yaw_rate)
         if frame.left is None:
             tracks = self.tracker.update([], [], seen=False)
             dets, levels, stats = [], (), None
@@ -117,22 +129,22 @@ class PedestrianSlot:
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M
         best = None
         for t in tracks:
-            if not t.confirmed:
+            if not t.confirmed or t.stereo_hits < STEREO_HITS:
                 continue
-            x, y = t.position_m
             vy = t.velocity_mps[1]
             # walking sideways only when the track is old enough to have a speed, the speed is a person's and it
             # stands clear of its uncertainty
             walking = (t.hits >= WALK_HITS and abs(vy) <= WALK_MAX_MPS
-                       and abs(vy) > max(WALK_MIN_MPS, 1.5 * t.sigma_vy_mps))
-            vy_eff = vy if walking else 0.0
-            c = person_conflict(x, y, vy_eff, float(path.centre_y(x)), lane_w, speed)
-            if c.any and (best is None or x < best[0].position_m[0]):
-                best = (t, c)
+                       and abs(vy) > max(WALK_MIN_MPS, WALK_SIGMAS * t.sigma_vy_mps))
+            # a person taken to stand is where they were last seen, not carried on by a speed not trusted
+            x, y = t.position_m if walking else t.standing_m
+            c = person_conflict(x, y, vy if walking else 0.0, float(path.centre_y(x)), lane_w, speed)
+            if c.any and (best is None or x < best[0]):
+                best = (x, t, c)
         if best is None:
             return None, None
-        t, c = best
+        x, t, c = best
         why = "pedestrian in the path" if c.now else "pedestrian stepping into the path"
         # range: the left camera's depth of the feet; its rate: the person's own x speed less the ego's
-        return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed, why, ObjectKind.PEDESTRIAN,
+        return BrakingRequest(x - self.cam_x, t.velocity_mps[0] - speed, why, ObjectKind.PEDESTRIAN,
                               t.track_id), t.track_id

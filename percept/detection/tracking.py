@@ -1,7 +1,8 @@
 """People tracked on the ground plane: each detection's feet (the bottom centre of its person box) projected onto
 the road through the rig, a constant-velocity Kalman filter (filterpy) per person over (x, y, vx, vy) in the
-vehicle frame with the ego's own motion as its control input, greedy nearest-neighbour association inside a
-Mahalanobis gate, confirmation after ``confirm_hits`` hits, and coasting through misses and dropped frames.
+vehicle frame (the velocity over the ground, turned with the vehicle) with the ego's own motion, its travel and its
+turn, as the control input, greedy nearest-neighbour association inside a Mahalanobis gate, confirmation after
+``confirm_hits`` hits, and coasting through misses and dropped frames.
 
 Ground-contact range: a feet row v below the horizon lies at depth Z = fy h / (v - v_horizon) for a camera h
 above the road, so a row error sigma_v gives sigma_Z = Z^2 sigma_v / (fy h): the measurement noise grows with Z^2.
@@ -57,7 +58,10 @@ class PersonTrack:
     over the ground [m/s] (the ego's own motion removed); sigma_vy_mps: standard deviation of vy; height_m: the
     person's estimated height; box_px: (u0, v0, u1, v1) the person box in the left image (predicted when not seen
     this frame); score: the last detection's score; hits; misses: frames since the last detection; confirmed;
-    seen: confirmed and detected within the last ``report_misses`` frames (what the slot reports as seen)."""
+    seen: confirmed and detected within the last ``report_misses`` frames (what the slot reports as seen);
+    standing_m: (x, y) where the person would be had they stood still since their last detection [m] (the
+    position then, moved by the ego's own motion only); stereo_hits: detections whose stereo depth agreed with
+    their ground contact's (``TrackConfig.verify_chi2``)."""
 
     track_id: int
     position_m: tuple[float, float]
@@ -70,33 +74,44 @@ class PersonTrack:
     misses: int
     confirmed: bool
     seen: bool
+    standing_m: tuple[float, float]
+    stereo_hits: int
 
 
 class _Track:
     def __init__(self, tid: int, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float,
-                 cfg: TrackConfig):
+                 stereo_ok: bool, cfg: TrackConfig):
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([xy[0], xy[1], 0.0, 0.0])
         kf.H = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
         kf.P = np.diag([0.0, 0.0, cfg.sigma_v0_mps ** 2, cfg.sigma_v0_mps ** 2])
         kf.P[:2, :2] = r
         self.kf, self.id, self.height_m, self.box, self.score = kf, tid, height_m, box, score
-        self.hits, self.misses, self.cfg = 1, 0, cfg
+        self.hits, self.misses, self.stereo_hits, self.cfg = 1, 0, int(stereo_ok), cfg
         self.predicted = box  # the person box predicted for the current frame
+        self.standing = kf.x[:2].copy()  # the last detection's position, moved by the ego's motion since
 
-    def predict(self, dt: float, ego_speed_mps: float) -> None:
+    def predict(self, dt: float, ego_speed_mps: float, yaw_rate_rps: float) -> None:
         kf = self.kf
-        kf.F = np.array([[1.0, 0, dt, 0], [0, 1.0, 0, dt], [0, 0, 1.0, 0], [0, 0, 0, 1.0]])
+        th = yaw_rate_rps * dt
+        c, s = np.cos(th), np.sin(th)
+        rt = np.array([[c, s], [-s, c]])  # R(th)^T: the old vehicle frame's vectors in the new one
+        # p_k+1 = R^T (p_k + v_k dt - t), v_k+1 = R^T v_k, with the ego's travel t = v_ego dt (cos th/2, sin th/2)
+        # (the chord of its arc): the ego's own motion moves and turns everything the other way
+        kf.F = np.block([[rt, rt * dt], [np.zeros((2, 2)), rt]])
         kf.Q = Q_discrete_white_noise(2, dt, self.cfg.accel_mps2 ** 2, block_size=2, order_by_dim=False)
-        # x_k+1 = x_k + vx dt - v_ego dt: the ego's own travel moves everything back
-        kf.predict(u=np.array([ego_speed_mps * dt]), B=np.array([[-1.0], [0.0], [0.0], [0.0]]))
+        travel = ego_speed_mps * dt * np.array([np.cos(th / 2), np.sin(th / 2)])
+        kf.predict(u=travel, B=np.vstack([-rt, np.zeros((2, 2))]))
+        self.standing = rt @ (self.standing - travel)
 
-    def update(self, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float) -> None:
+    def update(self, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float, stereo_ok: bool) -> None:
         self.kf.update(xy, R=r)
+        self.standing = self.kf.x[:2].copy()
         # the height: a running mean of the per-frame estimates
         self.height_m += (height_m - self.height_m) / min(self.hits + 1, 10)
         self.box, self.score = box, score
         self.hits += 1
+        self.stereo_hits += int(stereo_ok)
         self.misses = 0
 
 
@@ -113,12 +128,13 @@ class PersonTracker:
         self.tracks, self._next_id = [], 1
 
     def measure(self, box: Box, stereo: StereoDepth | None = None,
-                verify: bool = False) -> tuple[np.ndarray, np.ndarray, float] | None:
-        """A person box -> feet (x, y) [m], its 2x2 covariance and the person's height [m]; None above the horizon
-        or nearer than the camera. ``stereo(box, z_ground_m)``, when given, returns the box's stereo depth and its
-        standard deviation [m] (or None), fused with the ground contact's by their inverse variances. ``verify``:
-        None also unless the stereo depth agrees with the ground contact's (``TrackConfig.verify_chi2``): a person
-        stands where their feet touch the road, a pattern on the road or the scenery behind it does not."""
+                verify: bool = False) -> tuple[np.ndarray, np.ndarray, float, bool] | None:
+        """A person box -> feet (x, y) [m], its 2x2 covariance, the person's height [m] and whether the stereo depth
+        agreed with the ground contact's (``TrackConfig.verify_chi2``); None above the horizon or nearer than the
+        camera. ``stereo(box, z_ground_m)``, when given, returns the box's stereo depth and its standard deviation
+        [m] (or None), fused with the ground contact's by their inverse variances. ``verify``: None also unless the
+        stereo depth agrees: a person stands where their feet touch the road, a pattern on the road or the scenery
+        behind it does not."""
         cam, h_cam = self.rig.camera, self.rig.mount_height_m
         u0, v0, u1, v1 = box
         h_px = v1 - v0
@@ -132,7 +148,8 @@ class PersonTracker:
         var_z = max(z * z * self.cfg.row_sigma_frac * h_px / (cam.fy * h_cam), 0.1) ** 2
         zs = stereo(box, z) if stereo is not None else None
         # (z_s - z_g)^2 <= chi2 (s_g^2 + s_s^2)
-        if verify and (zs is None or (zs[0] - z) ** 2 > self.cfg.verify_chi2 * (var_z + zs[1] ** 2)):
+        agreed = zs is not None and bool((zs[0] - z) ** 2 <= self.cfg.verify_chi2 * (var_z + zs[1] ** 2))
+        if verify and not agreed:
             return None
         cy = float(self.rig.camera_position()[1])
         if zs is not None:
@@ -152,7 +169,7 @@ class PersonTracker:
         t = (xy[1] - cy) / z
         r = var_z * np.array([[1.0, t], [t, t * t]]) + np.diag([0.0, s_y * s_y])
         # H = h_px Z / fy
-        return xy, r, float(h_px * z / cam.fy)
+        return xy, r, float(h_px * z / cam.fy), agreed
 
     def predicted_box(self, t: _Track) -> Box:
         """The person box the track predicts in the left image: its feet projected, its height above them."""
@@ -161,10 +178,11 @@ class PersonTracker:
         uv, _ = self.rig.project_vehicle_points(pts)
         return standing_box(uv[0, 0], uv[0, 1], max(uv[0, 1] - uv[1, 1], 1.0))
 
-    def predict(self, ego_speed_mps: float) -> list[Box]:
-        """Advance every track one frame; the predicted person boxes (for the search's regions of interest)."""
+    def predict(self, ego_speed_mps: float, yaw_rate_rps: float = 0.0) -> list[Box]:
+        """Advance every track one frame while the ego drives ``ego_speed_mps`` and turns at ``yaw_rate_rps``
+        (positive to the left); the predicted person boxes (for the search's regions of interest)."""
         for t in self.tracks:
-            t.predict(self.dt_s, ego_speed_mps)
+            t.predict(self.dt_s, ego_speed_mps, yaw_rate_rps)
         boxes = [self.predicted_box(t) for t in self.tracks]
         # a track that has walked (or been driven) out of the image, or behind the camera, has gone
         w = self.rig.camera.width
@@ -185,19 +203,19 @@ class PersonTracker:
         pairs = self._associate(meas)
         used = set()
         for ti, mi in pairs:
-            (xy, r, hm), b, s = meas[mi]
-            self.tracks[ti].update(xy, r, hm, b, s)
+            (xy, r, hm, ok), b, s = meas[mi]
+            self.tracks[ti].update(xy, r, hm, b, s, ok)
             used.add(mi)
         matched = {ti for ti, _ in pairs}
         for i, t in enumerate(self.tracks):
             if seen and i not in matched:
                 t.misses += 1
         self.tracks = [t for t in self.tracks if t.misses <= self.cfg.max_misses]
-        for mi, ((xy, r, hm), b, s) in enumerate(meas):
+        for mi, ((xy, r, hm, ok), b, s) in enumerate(meas):
             # a detection on a person already tracked (a second window on them) starts no track of its own
             taken = [t.box if t.misses == 0 else t.predicted for t in self.tracks]
             if mi not in used and not (taken and iou_matrix(np.array([b]), np.array(taken)).max() > 0.3):
-                self.tracks.append(_Track(self._next_id, xy, r, hm, b, s, self.cfg))
+                self.tracks.append(_Track(self._next_id, xy, r, hm, b, s, ok, self.cfg))
                 self._next_id += 1
         return [self._public(t) for t in self.tracks]
 
@@ -212,7 +230,7 @@ class PersonTracker:
         for ti, t in enumerate(self.tracks):
             hx = t.kf.H @ t.kf.x
             hp = t.kf.H @ t.kf.P @ t.kf.H.T
-            for mi, ((xy, r, _), box, _) in enumerate(meas):
+            for mi, ((xy, r, _, _), box, _) in enumerate(meas):
                 overlap = float(overlaps[mi, ti])
                 d = xy - hx
                 # d^2 = (z - H x)^T S^-1 (z - H x), S = H P H^T + R
@@ -239,4 +257,5 @@ class PersonTracker:
                            float(np.sqrt(max(t.kf.P[3, 3], 0.0))), float(t.height_m),
                            tuple(float(c) for c in box), float(t.score), t.hits, t.misses,
                            t.hits >= self.cfg.confirm_hits,
-                           t.hits >= self.cfg.confirm_hits and t.misses <= self.cfg.report_misses)
+                           t.hits >= self.cfg.confirm_hits and t.misses <= self.cfg.report_misses,
+                           (float(t.standing[0]), float(t.standing[1])), t.stereo_hits)

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from percept.detection import PedestrianSlot
+from percept.detection import PedestrianSlot, PersonTrack
 from percept.drive import DriveConfig, run_drive
 from percept.sensors import EgoPath, Frame, ImuSample, StereoRig
 from percept.sims import WorldConfig, check_condition
@@ -63,3 +63,28 @@ def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
     assert r["pedestrian_collisions"] == 0 and r["collisions"] == 0
     assert len(p["stops"]) == 3 and all(p["stops"]), p
     assert p["recall_by_height"]["24-40"] >= 0.7 and p["fppi"] <= 0.02, p
+
+
+def track(tid: int, x: float, y: float, vy: float = 0.0, stereo_hits: int = 5, standing=None, hits: int = 20):
+    """A confirmed, seen track of a person at (x, y) walking sideways at vy [m/s] (sigma 0.1 m/s)."""
+    return PersonTrack(tid, (x, y), (0.0, vy), 0.1, 1.75, (300.0, 200.0, 320.0, 260.0), 1.0, hits, 0, True, True,
+                       standing if standing is not None else (x, y), stereo_hits)
+
+
+def test_only_tracks_the_stereo_pair_has_placed_on_the_road_ask_for_braking():
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(10.0)
+    request, rid = slot._request([track(1, 15.0, 0.5, stereo_hits=0), track(2, 25.0, -0.5)], path, 10.0)
+    assert rid == 2 and request.reason == "pedestrian in the path"
+    assert request.stop_before_m == pytest.approx(25.0 - slot.cam_x)
+    assert slot._request([track(1, 15.0, 0.5, stereo_hits=0)], path, 10.0) == (None, None)
+
+
+def test_a_track_not_walking_is_judged_where_it_was_last_seen():
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(10.0)
+    # carried into the corridor by a speed not yet trusted (5 detections), last seen on the verge: no braking
+    assert slot._request([track(1, 15.0, 1.0, vy=-1.2, hits=5, standing=(15.0, 3.5))], path, 10.0) == (None, None)
+    # the same track once its walk is trusted: in the path
+    request, _ = slot._request([track(1, 15.0, 1.0, vy=-1.2, standing=(15.0, 3.5))], path, 10.0)
+    assert request.reason == "pedestrian in the path"

@@ -82,11 +82,61 @@ def test_a_box_to_verify_is_kept_only_where_its_stereo_depth_agrees_with_its_gro
     z = 35.0 - tr.cam_x
     agree = lambda b, z_ground: (z + 0.5, 1.5)  # noqa: E731
     behind = lambda b, z_ground: (z + 25.0, 3.0)  # noqa: E731  (the scenery behind, not a person standing there)
-    assert tr.measure(box, agree, verify=True) is not None
+    assert tr.measure(box, agree, verify=True)[3] is True  # kept, and counted as the stereo pair's agreement
     assert tr.measure(box, behind, verify=True) is None
     assert tr.measure(box, lambda b, zg: None, verify=True) is None  # no stereo match: nothing confirms it
     assert tr.measure(box, None, verify=True) is None  # no right image
-    assert tr.measure(box, behind) is not None  # a box that needs no verification is measured as before
+    assert tr.measure(box, behind)[3] is False  # a box that needs no verification is measured, not agreed with
     far_behind = lambda b, z_ground: (z_ground + 25.0, 3.0) if z_ground > 30.0 else (z_ground, 1.0)  # noqa: E731
     tracks = tr.update([box, person_box(rig, 20.0, 3.0)], [0.3, 1.0], stereo=far_behind, verify=[True, True])
     assert [round(t.position_m[1]) for t in tracks] == [3]
+
+
+def test_stereo_agreements_are_counted_per_track():
+    rig = StereoRig()
+    tr = PersonTracker(rig, DT)
+    agree = lambda b, z_ground: (z_ground, 0.5)  # noqa: E731
+    for k in range(6):
+        tr.predict(0.0)
+        # the stereo pair agrees on every other frame, and finds nothing to match on the others
+        tracks = tr.update([person_box(rig, 20.0, 2.0)], [1.0], stereo=agree if k % 2 else (lambda b, z: None))
+    assert tracks[0].hits == 6 and tracks[0].stereo_hits == 3
+
+
+def test_a_person_standing_beside_a_bend_is_not_taken_to_walk_while_the_ego_turns():
+    # the ego drives a 150 m radius bend at 15 m/s (0.1 rad/s, turning left); a person stands still 30 m ahead: in
+    # the vehicle frame they sweep to the right at up to 3 m/s, which is the ego's turn, not their walk
+    rig = StereoRig()
+    turning, straight = PersonTracker(rig, DT), PersonTracker(rig, DT)
+    v, w = 15.0, 0.1
+    ego, heading = np.zeros(2), 0.0
+    person = np.array([30.0, 3.0])
+    for _ in range(15):
+        heading += w * DT
+        ego = ego + v * DT * np.array([np.cos(heading - w * DT / 2), np.sin(heading - w * DT / 2)])
+        c, s = np.cos(heading), np.sin(heading)
+        x, y = np.array([[c, s], [-s, c]]) @ (person - ego)
+        turning.predict(v, w)
+        straight.predict(v)
+        (t,) = turning.update([person_box(rig, x, y)], [1.0])
+        (t_straight,) = straight.update([person_box(rig, x, y)], [1.0])
+    assert x < 16.0 and abs(t.velocity_mps[1]) < 0.1 and abs(t.velocity_mps[0]) < 0.1, t
+    assert t.position_m[1] == pytest.approx(y, abs=0.05)
+    assert t_straight.velocity_mps[1] < -1.0  # the turn left out: a walk to the right
+
+
+def test_a_coasting_track_stands_where_it_was_last_seen():
+    rig = StereoRig()
+    tr = PersonTracker(rig, DT)
+    ego, x, y = 10.0, 30.0, 4.0
+    for _ in range(6):  # six detections stepping left at 1.5 m/s: too few to trust as a walk
+        tr.predict(ego)
+        x, y = x - ego * DT, y - 1.5 * DT
+        (t,) = tr.update([person_box(rig, x, y)], [1.0])
+    seen = t.position_m
+    for k in range(1, 9):  # then missed: the filter carries its speed on, the standing position only the ego's travel
+        tr.predict(ego)
+        (t,) = tr.update([], [])
+        assert t.standing_m[0] == pytest.approx(seen[0] - ego * DT * k)
+        assert t.standing_m[1] == pytest.approx(seen[1])
+    assert t.position_m[1] < seen[1] - 0.3
