@@ -37,7 +37,7 @@ WALK_HITS = 8
 """Detections a track needs before its speed is trusted (about half a second)."""
 MAX_YAW_RATE_RPS = 2.0
 """A gyro yaw rate beyond this is no car's on a road but a bad sample [rad/s]."""
-WALK_SIGMAS = 1.5
+WALK_SIGMAS = 2.5
 """A track's lateral speed must stand this many of its standard deviations clear of zero to count as walking."""
 STEREO_HITS = 1
 """Detections a track needs whose stereo depth agreed with their ground contact before it may ask for braking: a
