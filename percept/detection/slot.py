@@ -95,7 +95,7 @@ class PedestrianSlot:
         v = frame.wheel_speed_mps
         if isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v < 100.0:
             self._speed = float(v)
-        w = frame.imu.yaw_rate_rps if frame.imu is not None else math.nan
+        w = frame.imu.yaw_rate_rps
         if math.isfinite(w) and abs(w) < MAX_YAW_RATE_RPS:
             self._yaw_rate = w
         return self._speed, self._yaw_rate

@@ -1,5 +1,5 @@
 """The vision pedestrians slot: in the closed loop it stops for a crossing person and its reported people are
-scored against the truth; dropped frames, a black frame and a NaN wheel speed degrade gracefully."""
+scored against the truth; dropped frames, a black frame and a NaN wheel speed or yaw rate degrade gracefully."""
 
 import math
 
@@ -39,7 +39,7 @@ def frame(index: int, left, speed: float = 10.0) -> Frame:
     return Frame(index, index / 15, left, left, ImuSample(np.zeros(3), np.zeros(3)), speed)
 
 
-def test_dropped_and_black_frames_and_a_nan_wheel_speed_degrade_gracefully():
+def test_dropped_and_black_frames_and_nan_wheel_speed_or_yaw_rate_degrade_gracefully():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(10.0)
     black = np.zeros((480, 640, 3), np.uint8)
@@ -49,6 +49,11 @@ def test_dropped_and_black_frames_and_a_nan_wheel_speed_degrade_gracefully():
     assert request is None and debug.stats is None and debug.levels == ()
     request, debug = slot.step(frame(2, black, speed=math.nan), {})  # no path: a straight corridor
     assert request is None and slot._speed == 10.0  # the last good wheel speed is kept
+    turning = Frame(3, 3 / 15, black, black, ImuSample(np.zeros(3), np.array([0.0, 0.0, 0.1])), 10.0)
+    slot.step(turning, {"lateral": path})
+    broken = Frame(4, 4 / 15, black, black, ImuSample(np.zeros(3), np.array([0.0, 0.0, np.nan])), 10.0)
+    request, _ = slot.step(broken, {"lateral": path})
+    assert request is None and slot._yaw_rate == 0.1  # and the last good yaw rate
     with pytest.raises(ValueError, match="sweep_frames"):
         PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=0)
 
