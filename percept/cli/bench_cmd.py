@@ -24,6 +24,9 @@ def bench(
                                                           "(repeat; default every one).")] = None,
     seconds: Annotated[float, typer.Option("--seconds", help="With --stack: simulated seconds of each closed loop, "
                                                              "1 to 600.")] = 10.0,
+    repeats: Annotated[int, typer.Option("--repeats", help="With --stack: closed loops per scenario without and "
+                                                           "with recording, alternating, 1 to 20 (the table shows "
+                                                           "the median and the range).")] = 3,
     soak_minutes: Annotated[float, typer.Option("--soak-minutes", help="Also a recorded closed loop (highway, "
                                                 "every slot on vision) this many simulated minutes long, with the "
                                                 "process's memory each minute (0: none; 20 takes ~10 min).")] = 0.0,
@@ -37,6 +40,7 @@ def bench(
 
     opt.check_number("--frames", frames, 1, 10000)
     opt.check_number("--seconds", seconds, 1, 600)
+    opt.check_number("--repeats", repeats, 1, 20)
     opt.check_number("--soak-minutes", soak_minutes, 0, 600)
     scenarios = _scenarios(scenario) if stack else []
     check_outputs([json_path])
@@ -51,7 +55,7 @@ def bench(
     console.print(_stage_table(results))
     out = {"stages": [r.to_dict() for r in results]}
     if stack or soak_minutes:
-        out.update(_stack(scenarios, seconds, soak_minutes))
+        out.update(_stack(scenarios, seconds, repeats, soak_minutes))
     write_json(json_path, out)
 
 
@@ -76,23 +80,24 @@ def _scenarios(names: list[str] | None) -> list[str]:
     return list(names) if names else list(SCENARIOS)
 
 
-def _stack(scenarios: list[str], seconds: float, soak_minutes: float) -> dict:
+def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: float) -> dict:
     """The whole stack per scenario, the render per condition and the soak, printed and as the JSON's groups."""
     from percept.drive.bench_stack import CONDITIONS, bench_stack, render_per_condition, soak
     from percept.sims.env import SIMULATION_HZ
 
     loop_frames = int(round(seconds * SIMULATION_HZ))
-    total = 2 * loop_frames * len(scenarios) + int(round(soak_minutes * 60 * SIMULATION_HZ))
+    total = 2 * repeats * loop_frames * len(scenarios) + int(round(soak_minutes * 60 * SIMULATION_HZ))
     with progress_bar() as bar:
         task = bar.add_task("the whole stack", total=total)
         tick = lambda: bar.advance(task)  # noqa: E731
-        stacks = [bench_stack(sc, seconds, progress=tick) for sc in scenarios]
+        stacks = [bench_stack(sc, seconds, repeats=repeats, progress=tick) for sc in scenarios]
         conditions = render_per_condition() if scenarios else {}
         soaked = soak(soak_minutes, progress=tick) if soak_minutes else None
     out = {}
     if stacks:
-        t = Table(title="the whole stack, every slot on vision, in the closed loop (one thread, ms per frame); the "
-                        "stock composition = detectMultiScale + StereoSGBM + a Hough lane fit on the same scenario")
+        t = Table(title=f"the whole stack, every slot on vision, in the closed loop (one thread, ms per frame: the "
+                        f"median of {repeats} drives; realtime: the median [min-max]); the stock composition = "
+                        f"detectMultiScale + StereoSGBM + a Hough lane fit on the same scenario")
         for col in ("scenario", "render", "lanes", "longitudinal", "pedestrians", "odometry", "perception total",
                     "stock", "faster", "top-down render", "realtime", "realtime recorded"):
             t.add_column(col, justify="left" if col == "scenario" else "right")
@@ -100,8 +105,9 @@ def _stack(scenarios: list[str], seconds: float, soak_minutes: float) -> dict:
             tm = c.timing_ms
             t.add_row(c.scenario, *(fmt(tm.get(k)) for k in ("render", "lanes", "longitudinal", "pedestrians",
                                                              "odometry", "perception_total")),
-                      fmt(c.stock_ms), fmt(c.speedup), fmt(c.peers_ms["render"]), fmt(c.realtime_factor),
-                      fmt(c.realtime_factor_recording))
+                      fmt(c.stock_ms), fmt(c.speedup), fmt(c.peers_ms["render"]),
+                      _spread(c.realtime_factor, c.realtime_factors),
+                      _spread(c.realtime_factor_recording, c.realtime_factors_recording))
         console.print(t)
         console.print("stereo pair with each condition (highway, ms): " + ", ".join(
             f"{k} {fmt(conditions[k])}" for k in CONDITIONS))
@@ -113,3 +119,8 @@ def _stack(scenarios: list[str], seconds: float, soak_minutes: float) -> dict:
                       f"{soaked['realtime_factor']}")
         out["soak"] = soaked
     return out
+
+
+def _spread(median: float, values: tuple[float, ...]) -> str:
+    """``median [min-max]`` of several drives' figures, or the one figure."""
+    return fmt(median) if len(values) < 2 else f"{fmt(median)} [{fmt(min(values))}-{fmt(max(values))}]"

@@ -15,10 +15,9 @@ braking. The conflict rule is the privileged slot's (``percept.sensors.conflict`
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
-from percept.sensors import BrakingRequest, EgoPath, Frame, ObjectKind, StereoRig
+from percept.sensors import BrakingRequest, EgoMotionGate, EgoPath, Frame, ObjectKind, StereoRig
 from percept.sensors.conflict import person_conflict
 
 from .constrained import FEET_MARGIN_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
@@ -35,8 +34,6 @@ WALK_MAX_MPS = 3.0
 """A lateral speed above this is no person's walk but a tracking error [m/s]."""
 WALK_HITS = 8
 """Detections a track needs before its speed is trusted (about half a second)."""
-MAX_YAW_RATE_RPS = 2.0
-"""A gyro yaw rate beyond this is no car's on a road but a bad sample [rad/s]."""
 WALK_SIGMAS = 2.5
 """A track's lateral speed must stand this many of its standard deviations clear of zero to count as walking."""
 STEREO_HITS = 1
@@ -83,25 +80,15 @@ class PedestrianSlot:
         self.tracker = PersonTracker(rig, dt_s, tracking)
         self.sweep_frames = sweep_frames
         self.cam_x = float(rig.camera_position()[0])
-        self._speed = self._yaw_rate = 0.0
+        self.motion = EgoMotionGate()
 
     def reset(self) -> None:
         self.tracker.reset()
-        self._speed = self._yaw_rate = 0.0
-
-    def _ego_motion(self, frame: Frame) -> tuple[float, float]:
-        """The wheel speed [m/s] and the gyro's yaw rate [rad/s], each the last good one when the sample is not a
-        finite, plausible value."""
-        v = frame.wheel_speed_mps
-        if isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v < 100.0:
-            self._speed = float(v)
-        w = frame.imu.yaw_rate_rps
-        if math.isfinite(w) and abs(w) < MAX_YAW_RATE_RPS:
-            self._yaw_rate = w
-        return self._speed, self._yaw_rate
+        self.motion.reset()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
-        speed, yaw_rate = self._ego_motion(frame)
+        motion = self.motion.update(frame)
+        speed, yaw_rate = motion.speed_mps, motion.yaw_rate_rps
         path = upstream.get("lateral") or EgoPath.straight(speed)
         predicted = self.tracker.predict(speed, yaw_rate)
         if frame.left is None:

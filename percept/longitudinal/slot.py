@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from percept.sensors import EgoPath, Frame, Lead, ObjectKind, StereoRig, iou
+from percept.sensors import EgoMotionGate, EgoPath, Frame, Lead, ObjectKind, StereoRig, iou
 
 from .contact import Contact, ContactConfig, ContactRange
 from .flow import Expansion, ExpansionTracker, FlowConfig
@@ -100,11 +100,13 @@ class LongitudinalSlot:
         self.contact = ContactRange(rig, cfg.contact)
         self.flow = ExpansionTracker(cfg.flow)
         self.fb = rig.camera.fx * rig.baseline_m
+        self.motion = EgoMotionGate()
         self.reset()
 
     def reset(self) -> None:
         """A new run: no track, and the road plane back to the rig's."""
         self.finder.reset()
+        self.motion.reset()
         self._rate_floor_mps = -np.inf
         self._drop_track()
 
@@ -115,10 +117,10 @@ class LongitudinalSlot:
         self.flow.reset()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
-        path = upstream.get("lateral") or EgoPath.straight(frame.wheel_speed_mps)
+        motion = self.motion.update(frame)
+        path = upstream.get("lateral") or EgoPath.straight(motion.speed_mps)
         # nothing in the path comes towards the ego faster than it drives: range rate >= -(v_ego + reverse_mps)
-        v = frame.wheel_speed_mps
-        self._rate_floor_mps = -(v + self.cfg.reverse_mps) if np.isfinite(v) else -np.inf
+        self._rate_floor_mps = -(motion.speed_mps + self.cfg.reverse_mps) if motion.speed_ok else -np.inf
         self._predict()
         ob = ref = z = contact = expansion = None
         used: tuple[str, ...] = ()

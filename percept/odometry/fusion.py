@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 
-from percept.sensors import Pose2D, wrap_angle
+from percept.sensors import Pose2D, plausible_accel, plausible_speed, plausible_yaw_rate, wrap_angle
 from percept.sensors.vehicle import WHEELBASE_M
 
 # state: pose (x, y, yaw), speed, gyro bias, wheel scale, accelerometer bias, visual odometry's scale error and
@@ -39,8 +39,8 @@ class FusionNoise:
     accelerometer bias's random walk and prior std; vo_scale_sigma, vo_yaw_drift_sigma_rad_per_m: prior std of
     visual odometry's systematic errors (translation scale, yaw per metre travelled), with vo_bias_walk their
     relative random walk per sqrt(s): without landmarks they are unobservable and the estimate's covariance grows
-    with the distance as it should; max_yaw_rate_rps, max_accel_mps2, max_speed_mps: a sample
-    beyond these is absurd and rejected; vo_scale_translation, vo_scale_rotation: multiply the visual odometry's
+    with the distance as it should (a NaN or implausible IMU or wheel sample, by ``percept.sensors``' one rule, is
+    rejected); vo_scale_translation, vo_scale_rotation: multiply the visual odometry's
     own variances of translation and of yaw (its covariance comes from the reprojection residuals alone and leaves
     out the keyframe points' depth error; these factors were measured from its innovations on `loop`);
     lockout_sightings, lockout_widen: after this many landmark sightings refused in a row, the pose variances are
@@ -57,9 +57,6 @@ class FusionNoise:
     vo_scale_sigma: float = 0.003
     vo_yaw_drift_sigma_rad_per_m: float = 2e-5
     vo_bias_walk: float = 0.2
-    max_yaw_rate_rps: float = 3.0
-    max_accel_mps2: float = 20.0
-    max_speed_mps: float = 90.0
     vo_scale_translation: float = 9.0
     vo_scale_rotation: float = 4.0
     lockout_sightings: int = 3
@@ -136,8 +133,7 @@ class PoseFilter:
         """Propagate by ``dt`` [s] with one IMU sample; an absurd or NaN sample is replaced by the last good one
         (with widened noise) and False is returned."""
         n = self.noise
-        good = (math.isfinite(yaw_rate_rps) and math.isfinite(accel_mps2) and abs(yaw_rate_rps) <= n.max_yaw_rate_rps
-                and abs(accel_mps2) <= n.max_accel_mps2)
+        good = plausible_yaw_rate(yaw_rate_rps) and plausible_accel(accel_mps2)
         if good:
             self._last_input = (yaw_rate_rps, accel_mps2)
         else:
@@ -170,7 +166,7 @@ class PoseFilter:
 
     def update_wheel(self, wheel_speed_mps: float) -> bool:
         """Wheel speed = scale x speed. Rejects NaN and absurd readings (returns False)."""
-        if not (math.isfinite(wheel_speed_mps) and -1.0 <= wheel_speed_mps <= self.noise.max_speed_mps):
+        if not plausible_speed(wheel_speed_mps):
             self.rejected += 1
             return False
         if not self._started:

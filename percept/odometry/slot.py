@@ -12,7 +12,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from percept.sensors import Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig
+from percept.sensors import (Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig, plausible_speed,
+                             plausible_yaw_rate)
 
 from .features import to_gray
 from .fusion import FusionNoise, PoseFilter
@@ -142,10 +143,10 @@ class OdometrySlot:
 
     def _prior(self, frame: Frame) -> np.ndarray | None:
         """The camera motion since the last image that the wheel speed and the gyro alone predict (None before the
-        first image or without a finite sample): independent of the visual odometry it guides, so that a biased
+        first image or without a plausible sample): independent of the visual odometry it guides, so that a biased
         VO cannot select the points that confirm its bias."""
         w, v = float(frame.imu.gyro_rps[2]), float(frame.wheel_speed_mps)
-        if self._frames <= 1 or not (math.isfinite(w) and math.isfinite(v)):
+        if self._frames <= 1 or not (plausible_yaw_rate(w) and plausible_speed(v)):
             return None
         dt = self._since_image * self.dt_s
         # planar motion at constant speed and yaw rate: the heading turns by w dt, the chord lies at half of it

@@ -5,6 +5,8 @@ from .camera import PinholeCamera
 from .chessboard import CameraCalibration, calibrate_chessboards, chessboard_images, parse_pattern
 from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, VideoReader, list_footage,
                       list_images, open_video, read_image)
+from .ego_motion import (MAX_ACCEL_MPS2, MAX_SPEED_MPS, MAX_YAW_RATE_RPS, MIN_SPEED_MPS, EgoMotion, EgoMotionGate,
+                         plausible_accel, plausible_speed, plausible_yaw_rate)
 from .frame import Frame, ImuSample
 from .records import BrakingRequest, EgoPath, LandmarkMap, LaneEstimate, Lead, ObjectKind, PoseEstimate, Source
 from .poses import Pose2D, Transform, rot_z, rotate_to_vehicle, wrap_angle
@@ -15,4 +17,6 @@ __all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "
            "list_images", "open_video", "read_image",
            "CameraCalibration", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform",
            "calibrate_chessboards", "check_boxes", "chessboard_images", "iou", "iou_matrix", "parse_pattern", "rot_z",
-           "rotate_to_vehicle", "wrap_angle"]
+           "rotate_to_vehicle", "wrap_angle",
+           "MAX_ACCEL_MPS2", "MAX_SPEED_MPS", "MAX_YAW_RATE_RPS", "MIN_SPEED_MPS", "EgoMotion", "EgoMotionGate",
+           "plausible_accel", "plausible_speed", "plausible_yaw_rate"]

@@ -94,7 +94,7 @@ def test_bench_prints_the_render_ratio(tmp_path):
 def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_composition(tmp_path):
     out = tmp_path / "bench.json"
     r = runner.invoke(app, ["bench", "--frames", "2", "--stack", "--scenario", "crossing", "--seconds", "1",
-                            "--soak-minutes", "0.05", "--json", str(out)])
+                            "--repeats", "2", "--soak-minutes", "0.05", "--json", str(out)])
     assert r.exit_code == 0, r.output
     d = json.loads(out.read_text())
     (c,) = d["stack"]
@@ -105,6 +105,10 @@ def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_compos
     assert c["stock_ms"] == pytest.approx(sum(c["peers_ms"][k] for k in ("people", "stereo", "lanes")), abs=0.01)
     assert c["speedup"] == pytest.approx(c["stock_ms"] / tm["perception_total"], rel=1e-2)
     assert c["realtime_factor"] > 0 and c["realtime_factor_recording"] > 0
+    for key, each in (("realtime_factor", "realtime_factors"), ("realtime_factor_recording",
+                                                                "realtime_factors_recording")):
+        runs = c[each]  # two drives each, the median between them
+        assert len(runs) == 2 and min(runs) <= c[key] <= max(runs)
     assert set(d["render_conditions_ms"]) == {"clear", "night", "rain", "glare", "noise"}
     assert d["soak"]["frames"] == 45 and len(d["soak"]["rss_mb"]) == 2 and d["soak"]["peak_mb"] > 0
 
@@ -112,3 +116,9 @@ def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_compos
 def test_bench_refuses_an_unknown_scenario_in_one_line():
     r = runner.invoke(app, ["bench", "--stack", "--scenario", "moon"])
     assert r.exit_code == 2 and "unknown scenario 'moon'" in r.output and "Traceback" not in r.output
+
+
+def test_bench_refuses_a_repeat_count_out_of_range_in_one_line():
+    r = runner.invoke(app, ["bench", "--stack", "--repeats", "0"])
+    assert r.exit_code == 2 and "--repeats" in r.output and "Traceback" not in r.output
+    assert len(r.output.strip().splitlines()) == 1

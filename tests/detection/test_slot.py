@@ -48,12 +48,12 @@ def test_dropped_and_black_frames_and_nan_wheel_speed_or_yaw_rate_degrade_gracef
     request, debug = slot.step(frame(1, None), {"lateral": path})  # dropped: nothing searched
     assert request is None and debug.stats is None and debug.levels == ()
     request, debug = slot.step(frame(2, black, speed=math.nan), {})  # no path: a straight corridor
-    assert request is None and slot._speed == 10.0  # the last good wheel speed is kept
+    assert request is None and slot.motion.last.speed_mps == 10.0  # the last good wheel speed is kept
     turning = Frame(3, 3 / 15, black, black, ImuSample(np.zeros(3), np.array([0.0, 0.0, 0.1])), 10.0)
     slot.step(turning, {"lateral": path})
     broken = Frame(4, 4 / 15, black, black, ImuSample(np.zeros(3), np.array([0.0, 0.0, np.nan])), 10.0)
     request, _ = slot.step(broken, {"lateral": path})
-    assert request is None and slot._yaw_rate == 0.1  # and the last good yaw rate
+    assert request is None and slot.motion.last.yaw_rate_rps == 0.1  # and the last good yaw rate
     with pytest.raises(ValueError, match="sweep_frames"):
         PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=0)
 

@@ -146,6 +146,20 @@ def test_black_frame_and_dropped_frame_degrade_gracefully():
     assert dbg.evidence is None and not est.valid
 
 
+def test_slot_holds_the_last_plausible_wheel_speed_and_yaw_rate():
+    from percept.lanes import LaneSlot
+    from percept.sensors import Frame, ImuSample
+
+    slot = LaneSlot(StereoRig(), 1 / 15)
+    black = np.zeros((480, 640, 3), np.uint8)
+    speeds = []
+    for i, (v, w) in enumerate([(20.0, 0.1), (float("nan"), float("nan")), (1e6, 40.0), (None, 0.0), (21.0, 0.0)]):
+        path, _ = slot.step(Frame(i, i / 15, black, black, ImuSample(np.zeros(3), np.array([0, 0, w])), v), {})
+        speeds.append(path.speed_mps)
+    # the ego path (what longitudinal and pedestrians read) never carries a bad sample
+    assert speeds == [20.0, 20.0, 20.0, 20.0, 21.0]
+
+
 def test_tracking_on_the_simulated_highway():
     from percept.drive import TASKS, Agent, SlotContext, Source, TruthFeed
     from percept.sims import SimWorld, WorldConfig

@@ -22,8 +22,8 @@ def test_vision_longitudinal_follows_and_brakes_for_the_lead_without_collision()
     assert r["timing_ms"]["longitudinal"] > 0 and lon["ttc_abs_err_s"] is not None
 
 
-def frame(left, right, i=0):
-    return Frame(i, i / 15, left, right, ImuSample(np.zeros(3), np.zeros(3)), 20.0)
+def frame(left, right, i=0, speed=20.0):
+    return Frame(i, i / 15, left, right, ImuSample(np.zeros(3), np.zeros(3)), speed)
 
 
 def test_dropped_and_featureless_frames_give_no_lead_and_no_error():
@@ -35,9 +35,11 @@ def test_dropped_and_featureless_frames_give_no_lead_and_no_error():
     for i in range(5):
         lead, dbg = slot.step(frame(black, black, i), path)
         assert lead is None and dbg.obstacle is None
-    # no ego path from upstream (e.g. a lateral slot that is not there): a straight corridor
-    lead, _ = slot.step(frame(black, black), {})
-    assert lead is None
+    # no ego path from upstream (e.g. a lateral slot that is not there): a straight corridor, at the last plausible
+    # wheel speed when this frame's sample is bad
+    for bad in (float("nan"), -30.0, None):
+        lead, _ = slot.step(frame(black, black, speed=bad), {})
+        assert lead is None and slot.motion.last.speed_mps == 20.0 and not slot.motion.last.speed_ok
 
 
 def test_stereo_contact_and_flow_all_reach_the_filter():
