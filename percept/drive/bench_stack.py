@@ -49,13 +49,21 @@ def lane_fit_full_frame(frames: list) -> tuple[str, Callable]:
     return "Canny + HoughLinesP + a line per side, full frame", run
 
 
+def middle(values, key=None):
+    """The median element of ``values`` (the lower of the middle two for an even count): one drive's figure, never an
+    average of two."""
+    return sorted(values, key=key)[(len(values) - 1) // 2]
+
+
 @dataclass(frozen=True)
 class StackCost:
     """scenario; frames: frames each closed loop ran; timing_ms: the run JSON's (render, each slot,
-    perception_total) [ms/frame] of the unrecorded drive with the median perception_total; peers_ms: the stock way to do each job
-    on the same scenario's frames (people, stereo, lanes) and highway-env's top-down render [ms/frame];
+    perception_total) [ms/frame] of the unrecorded drive with the median perception_total; peers_ms: the stock way
+    to do each job on the same scenario's frames (people, stereo, lanes) and highway-env's top-down render
+    [ms/frame];
     realtime_factors, realtime_factors_recording: each drive's, without / with recording (the drives alternate, so
-    that a change in the machine's speed falls on both)."""
+    that a change in the machine's speed falls on both). The median of several is the middle one (the lower of the
+    middle two for an even count), for the timings as for the realtime factors."""
 
     scenario: str
     frames: int
@@ -67,12 +75,12 @@ class StackCost:
     @property
     def realtime_factor(self) -> float:
         """The median drive's realtime factor without recording."""
-        return float(np.median(self.realtime_factors))
+        return middle(self.realtime_factors)
 
     @property
     def realtime_factor_recording(self) -> float:
         """The median drive's realtime factor with recording."""
-        return float(np.median(self.realtime_factors_recording))
+        return middle(self.realtime_factors_recording)
 
     @property
     def stock_ms(self) -> float:
@@ -161,7 +169,7 @@ def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20, rep
         with tempfile.TemporaryDirectory() as tmp:
             recorded.append(_drive(scenario, seconds, Path(tmp) / "bench.rrd", progress=progress))
     # the stage timings of the median unrecorded drive by perception_total, whole, so that they still add up
-    middle = sorted(runs, key=lambda r: r["timing_ms"]["perception_total"] or 0.0)[(len(runs) - 1) // 2]
+    typical = middle(runs, key=lambda r: r["timing_ms"]["perception_total"] or 0.0)
     shots, top_ms = _peer_frames(scenario, peer_frames)
     peers, shot = {}, cycle(shots, None)
     for key, make in (("people", people_detector_full_frame), ("stereo", sgbm_full_frame),
@@ -169,8 +177,8 @@ def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20, rep
         _, fn = make(shots)
         peers[key] = median_ms(lambda: fn(shot()), len(shots))
     peers["render"] = top_ms
-    return StackCost(scenario, middle["frames"], middle["timing_ms"], peers, tuple(r["realtime_factor"] for r in runs),
-                     tuple(r["realtime_factor"] for r in recorded))
+    return StackCost(scenario, typical["frames"], typical["timing_ms"], peers,
+                     tuple(r["realtime_factor"] for r in runs), tuple(r["realtime_factor"] for r in recorded))
 
 
 def render_per_condition(frames: int = 20, scenario: str = "highway") -> dict:

@@ -13,10 +13,10 @@ clothoid road model with curvature rate in the state).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from filterpy.kalman import KalmanFilter
+
+from percept.sensors import plausible_speed, plausible_yaw_rate
 
 from .types import LaneEstimate, LaneFit
 
@@ -39,8 +39,9 @@ class LaneTracker:
         self.confidence = 0.0
 
     def predict(self, speed_mps: float, yaw_rate_rps: float, dt: float) -> None:
-        v = speed_mps if math.isfinite(speed_mps) else 0.0
-        r = yaw_rate_rps if math.isfinite(yaw_rate_rps) else 0.0
+        # a bad sample (percept.sensors' rule) predicts no motion
+        v = speed_mps if plausible_speed(speed_mps) else 0.0
+        r = yaw_rate_rps if plausible_yaw_rate(yaw_rate_rps) else 0.0
         d = v * dt
         F = np.array([[1, d, 0, 0, 0], [0, 1, -d, -d * d / 2, 0], [0, 0, 1, d, 0], [0, 0, 0, 1, 0],
                       [0, 0, 0, 0, 1.0]])

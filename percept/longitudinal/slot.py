@@ -10,7 +10,7 @@ lanes), else the same lead manoeuvring (braking hard): the filter's uncertainty 
 by hits on an obstacle that stays in place in the image, reported once confirmed, kept through short misses,
 dropped frames and frames whose range does not refine, with a confidence that falls while it is only predicted.
 Nothing in the ego's path drives backwards towards it, so the range rate is held at or above minus the ego's wheel
-speed (a state constraint).
+speed (a state constraint; none on a frame whose wheel-speed sample is bad).
 """
 
 from __future__ import annotations

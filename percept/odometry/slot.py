@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from percept.sensors import (Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig, plausible_speed,
+from percept.sensors import (Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig, as_sample, plausible_speed,
                              plausible_yaw_rate)
 
 from .features import to_gray
@@ -94,8 +94,8 @@ class OdometrySlot:
         imu = frame.imu
         for f in self.filters:
             if self._frames:
-                f.predict(float(imu.gyro_rps[2]), float(imu.accel_mps2[0]), self.dt_s)
-            f.update_wheel(float(frame.wheel_speed_mps))
+                f.predict(as_sample(imu.gyro_rps[2]), as_sample(imu.accel_mps2[0]), self.dt_s)
+            f.update_wheel(as_sample(frame.wheel_speed_mps))
         self._frames += 1
         # the left image in grey once, for VO and the sign search
         left = None if frame.left is None else to_gray(frame.left)
@@ -145,7 +145,7 @@ class OdometrySlot:
         """The camera motion since the last image that the wheel speed and the gyro alone predict (None before the
         first image or without a plausible sample): independent of the visual odometry it guides, so that a biased
         VO cannot select the points that confirm its bias."""
-        w, v = float(frame.imu.gyro_rps[2]), float(frame.wheel_speed_mps)
+        w, v = as_sample(frame.imu.gyro_rps[2]), as_sample(frame.wheel_speed_mps)
         if self._frames <= 1 or not (plausible_yaw_rate(w) and plausible_speed(v)):
             return None
         dt = self._since_image * self.dt_s

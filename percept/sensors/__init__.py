@@ -6,7 +6,7 @@ from .chessboard import CameraCalibration, calibrate_chessboards, chessboard_ima
 from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, VideoReader, list_footage,
                       list_images, open_video, read_image)
 from .ego_motion import (MAX_ACCEL_MPS2, MAX_SPEED_MPS, MAX_YAW_RATE_RPS, MIN_SPEED_MPS, EgoMotion, EgoMotionGate,
-                         plausible_accel, plausible_speed, plausible_yaw_rate)
+                         as_sample, plausible_accel, plausible_speed, plausible_yaw_rate)
 from .frame import Frame, ImuSample
 from .records import BrakingRequest, EgoPath, LandmarkMap, LaneEstimate, Lead, ObjectKind, PoseEstimate, Source
 from .poses import Pose2D, Transform, rot_z, rotate_to_vehicle, wrap_angle
@@ -19,4 +19,4 @@ __all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "
            "calibrate_chessboards", "check_boxes", "chessboard_images", "iou", "iou_matrix", "parse_pattern", "rot_z",
            "rotate_to_vehicle", "wrap_angle",
            "MAX_ACCEL_MPS2", "MAX_SPEED_MPS", "MAX_YAW_RATE_RPS", "MIN_SPEED_MPS", "EgoMotion", "EgoMotionGate",
-           "plausible_accel", "plausible_speed", "plausible_yaw_rate"]
+           "as_sample", "plausible_accel", "plausible_speed", "plausible_yaw_rate"]

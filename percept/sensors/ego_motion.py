@@ -38,8 +38,8 @@ def plausible_accel(a_mps2: float) -> bool:
     return math.isfinite(a_mps2) and abs(a_mps2) <= MAX_ACCEL_MPS2
 
 
-def _number(x) -> float:
-    """``x`` as a float, NaN when it is not a number (a missing sample)."""
+def as_sample(x) -> float:
+    """A sensor reading ``x`` as a float, NaN when it is not a number at all (a missing sample)."""
     try:
         return float(x)
     except (TypeError, ValueError):
@@ -70,7 +70,7 @@ class EgoMotionGate:
         self.last = EgoMotion(0.0, 0.0, False, False)
 
     def update(self, frame: Frame) -> EgoMotion:
-        v, w = _number(frame.wheel_speed_mps), _number(frame.imu.gyro_rps[2])
+        v, w = as_sample(frame.wheel_speed_mps), as_sample(frame.imu.gyro_rps[2])
         speed_ok, yaw_rate_ok = plausible_speed(v), plausible_yaw_rate(w)
         if speed_ok:
             self._speed = v

@@ -107,8 +107,8 @@ def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_compos
     assert c["realtime_factor"] > 0 and c["realtime_factor_recording"] > 0
     for key, each in (("realtime_factor", "realtime_factors"), ("realtime_factor_recording",
                                                                 "realtime_factors_recording")):
-        runs = c[each]  # two drives each, the median between them
-        assert len(runs) == 2 and min(runs) <= c[key] <= max(runs)
+        runs = c[each]  # two drives each: the median is one of them, the slower (never an average)
+        assert len(runs) == 2 and c[key] == min(runs)
     assert set(d["render_conditions_ms"]) == {"clear", "night", "rain", "glare", "noise"}
     assert d["soak"]["frames"] == 45 and len(d["soak"]["rss_mb"]) == 2 and d["soak"]["peak_mb"] > 0
 

@@ -152,12 +152,14 @@ def test_slot_holds_the_last_plausible_wheel_speed_and_yaw_rate():
 
     slot = LaneSlot(StereoRig(), 1 / 15)
     black = np.zeros((480, 640, 3), np.uint8)
-    speeds = []
+    speeds, yaw_rates = [], []
     for i, (v, w) in enumerate([(20.0, 0.1), (float("nan"), float("nan")), (1e6, 40.0), (None, 0.0), (21.0, 0.0)]):
         path, _ = slot.step(Frame(i, i / 15, black, black, ImuSample(np.zeros(3), np.array([0, 0, w])), v), {})
         speeds.append(path.speed_mps)
-    # the ego path (what longitudinal and pedestrians read) never carries a bad sample
-    assert speeds == [20.0, 20.0, 20.0, 20.0, 21.0]
+        yaw_rates.append(slot.motion.last.yaw_rate_rps)
+    # the ego path (what longitudinal and pedestrians read) never carries a bad sample, nor does the tracker's
+    # prediction
+    assert speeds == [20.0, 20.0, 20.0, 20.0, 21.0] and yaw_rates == [0.1, 0.1, 0.1, 0.0, 0.0]
 
 
 def test_tracking_on_the_simulated_highway():

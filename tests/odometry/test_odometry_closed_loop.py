@@ -45,12 +45,13 @@ def test_nan_and_absurd_sensors_and_black_frames_degrade_gracefully():
     slot = OdometrySlot(StereoRig(), 1 / 15, None, Pose2D(10.0, -4.0, 0.0))
     black = np.zeros((480, 640, 3), np.uint8)
     samples = [dict(), dict(gyro=float("nan")), dict(wheel=float("nan")), dict(accel=1e9), dict(wheel=-50.0),
-               dict(left=black, right=black), dict(left=black)]
+               dict(wheel=None), dict(left=black, right=black), dict(left=black)]
     for i, kw in enumerate(samples * 3):
         est, dbg = slot.step(frame(i, **kw), {})
         assert est.valid and np.all(np.isfinite([est.pose.x_m, est.pose.y_m, est.pose.yaw_rad, est.speed_mps]))
         assert np.all(np.isfinite(est.covariance)) and not dbg.vo_step.ok and not dbg.landmark_fix
-    # NaN gyro, NaN wheel, absurd accel, absurd wheel: 4 rejections per filter per round, 3 filters, 3 rounds
-    assert dbg.rejected == 4 * 3 * 3
-    # about 20 frames at 20 m/s straight ahead from (10, -4)
-    assert est.pose.x_m == pytest.approx(10.0 + 20.0 * 20 / 15, abs=2.0) and abs(est.pose.y_m + 4.0) < 0.1
+    # NaN gyro, NaN wheel, absurd accel, absurd wheel, missing wheel: 5 rejections per filter per round, 3 filters,
+    # 3 rounds
+    assert dbg.rejected == 5 * 3 * 3
+    # about 23 frames at 20 m/s straight ahead from (10, -4)
+    assert est.pose.x_m == pytest.approx(10.0 + 20.0 * 23 / 15, abs=2.0) and abs(est.pose.y_m + 4.0) < 0.1

@@ -19,8 +19,8 @@ def test_plausible_speed(v, ok):
     assert plausible_speed(v) is ok
 
 
-@pytest.mark.parametrize("w, ok", [(0.0, True), (-0.4, True), (MAX_YAW_RATE_RPS, True), (-MAX_YAW_RATE_RPS - 0.1, False),
-                                   (math.nan, False), (-math.inf, False)])
+@pytest.mark.parametrize("w, ok", [(0.0, True), (-0.4, True), (MAX_YAW_RATE_RPS, True),
+                                   (-MAX_YAW_RATE_RPS - 0.1, False), (math.nan, False), (-math.inf, False)])
 def test_plausible_yaw_rate(w, ok):
     assert plausible_yaw_rate(w) is ok
 
