@@ -14,7 +14,8 @@ from typing import Callable, Iterable, Optional, Union
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TextColumn, TimeRemainingColumn
+from rich.text import Text
 from typer.core import TyperCommand, TyperGroup
 
 console = Console()
@@ -45,9 +46,25 @@ class _Bar(Progress):
         self.live.stop()  # cleared, and no line ending the bar (Progress.stop would print one)
 
 
-def progress_bar() -> Progress:
-    return _Bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                console=err, transient=False)
+class MeanPaceRemaining(ProgressColumn):
+    """Time left at the mean pace since the task started, for steps a minute long (evaluation runs): Rich's own
+    column looks at the last 30 s only, where two workers' runs finishing together read as a run every second.
+    Steps completed when the task was added (``completed=``, e.g. runs reused by a resumed batch) are not pace."""
+
+    def render(self, task) -> Text:
+        done = task.completed - task.fields.get("start_completed", 0)
+        if task.total is None or task.elapsed is None or done <= 0:
+            return Text("-:--:--", style="progress.remaining")
+        left_s = int(task.elapsed / done * max(task.total - task.completed, 0))
+        return Text(f"{left_s // 3600}:{left_s // 60 % 60:02d}:{left_s % 60:02d}", style="progress.remaining")
+
+
+def progress_bar(long_steps: bool = False) -> Progress:
+    """The commands' progress bar on stderr; ``long_steps``: the time left from the mean pace (``MeanPaceRemaining``)
+    rather than Rich's recent one."""
+    remaining = MeanPaceRemaining() if long_steps else TimeRemainingColumn()
+    return _Bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), remaining, console=err,
+                transient=False)
 
 
 def check_outputs(outputs: Iterable[Optional[Path]], inputs: Iterable[Optional[Path]] = ()) -> None:

@@ -138,8 +138,10 @@ def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict
         return f"{n} finished run{'' if n == 1 else 's'} kept in {out / 'runs'}; run the same command to resume"
 
     on_interrupt(kept)
-    with progress_bar() as bar:
-        task = bar.add_task(f"eval {len(plan.jobs)} runs, 0 failed", total=len(plan.jobs))
+    reused = len(files.done)  # finished runs of the same settings, reused whatever --redo says
+    with progress_bar(long_steps=True) as bar:
+        task = bar.add_task(f"eval {len(plan.jobs)} runs, 0 failed", total=len(plan.jobs), completed=reused,
+                            start_completed=reused)
         try:
             return evaluate(plan, out, workers, eng, address, progress=advance, redo=redo, files=files)
         except (RuntimeError, ValueError) as e:

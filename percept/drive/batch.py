@@ -189,7 +189,8 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
              redo: bool = False, files: RunFiles | None = None) -> dict:
     """Run every job of ``plan`` without a finished run of the same settings in ``out_dir/runs``; write and return
     the summary. Damaged run files are redone; runs made under other settings raise ValueError before any work,
-    or are redone with ``redo``. ``files``: a ``scan_runs`` already made (the CLI reports it first)."""
+    or are redone with ``redo``. ``files``: a ``scan_runs`` already made (the CLI reports it first).
+    ``progress(run)`` is called after each run this call drives (not for the finished runs it reuses)."""
     out_dir = Path(out_dir)
     files = files if files is not None else scan_runs(plan, out_dir)
     if not redo:
@@ -197,9 +198,6 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
     settings = run_settings(plan)
     results = list(files.done.values())
-    for r in results:
-        if progress:
-            progress(r)
     todo = [job for job in plan.jobs if job not in files.done]
     stream = _local(plan, todo, workers) if Engine(engine) is Engine.LOCAL else _ray(plan, todo, address)
     with contextlib.closing(stream):

@@ -83,6 +83,37 @@ def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, seed_1_cras
                                                                      "lead-brake-clear-2.json"]
 
 
+def test_a_resumed_batch_reports_only_the_runs_it_drives(tmp_path, seed_1_crashes):
+    plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0)
+    ev.evaluate(plan, tmp_path)
+    seen = []
+    ev.evaluate(plan, tmp_path, progress=seen.append)
+    # seeds 0 and 2 are reused (the bar starts with them done), seed 1 failed and is driven again
+    assert len(seen) == 1 and "simulated crash" in seen[0]["error"]
+
+
+def test_time_left_is_the_mean_pace_not_the_last_30_seconds():
+    import io
+
+    from rich.console import Console
+    from rich.progress import Progress, TimeRemainingColumn
+
+    from percept.cli.common import MeanPaceRemaining
+
+    clock = [0.0]
+    bar = Progress(get_time=lambda: clock[0], auto_refresh=False, console=Console(file=io.StringIO()))
+    task = bar.add_task("eval", total=10, completed=4, start_completed=4)  # 4 runs reused
+    ours, rich_own = MeanPaceRemaining(), TimeRemainingColumn()
+    assert ours.render(bar.tasks[0]).plain == "-:--:--"
+    # two workers: a run a minute each, finishing together
+    for t in (60.0, 61.0):
+        clock[0] = t
+        bar.advance(task, 1)
+    # 2 runs in 61 s, 4 left: 122 s; Rich's own column read the pair as a run a second
+    assert ours.render(bar.tasks[0]).plain == "0:02:02"
+    assert rich_own.render(bar.tasks[0]).plain == "0:00:04"
+
+
 def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
     plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0)
     a = ev.evaluate(plan, tmp_path / "a", workers=1)
