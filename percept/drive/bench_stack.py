@@ -60,10 +60,9 @@ class StackCost:
     """scenario; frames: frames each closed loop ran; timing_ms: the run JSON's (render, each slot,
     perception_total) [ms/frame] of the unrecorded drive with the median perception_total; peers_ms: the stock way
     to do each job on the same scenario's frames (people, stereo, lanes) and highway-env's top-down render
-    [ms/frame];
-    realtime_factors, realtime_factors_recording: each drive's, without / with recording (the drives alternate, so
-    that a change in the machine's speed falls on both). The median of several is the middle one (the lower of the
-    middle two for an even count), for the timings as for the realtime factors."""
+    [ms/frame]; realtime_factors, realtime_factors_recording: each drive's, without / with recording (the drives
+    alternate, so that a change in the machine's speed falls on both). The median of several is the middle one
+    (``middle``), for the timings as for the realtime factors."""
 
     scenario: str
     frames: int

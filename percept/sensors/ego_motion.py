@@ -66,15 +66,12 @@ class EgoMotionGate:
         self.reset()
 
     def reset(self) -> None:
-        self._speed = self._yaw_rate = 0.0
         self.last = EgoMotion(0.0, 0.0, False, False)
 
     def update(self, frame: Frame) -> EgoMotion:
         v, w = as_sample(frame.wheel_speed_mps), as_sample(frame.imu.gyro_rps[2])
         speed_ok, yaw_rate_ok = plausible_speed(v), plausible_yaw_rate(w)
-        if speed_ok:
-            self._speed = v
-        if yaw_rate_ok:
-            self._yaw_rate = w
-        self.last = EgoMotion(self._speed, self._yaw_rate, speed_ok, yaw_rate_ok)
+        held = self.last
+        self.last = EgoMotion(v if speed_ok else held.speed_mps, w if yaw_rate_ok else held.yaw_rate_rps, speed_ok,
+                              yaw_rate_ok)
         return self.last
