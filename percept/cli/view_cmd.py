@@ -51,12 +51,15 @@ def recording_problem(exe: str, recording: Path) -> str | None:
     if head != RRD_MAGIC:
         return "it does not start like a Rerun recording"
     try:
-        r = subprocess.run([exe, "rrd", "verify", str(recording)], env=rerun_env(), capture_output=True, text=True)
+        # percept's recordings have no footer (``review.recorder``), nor has any file cut short: not required here
+        r = subprocess.run([exe, "rrd", "verify", "--check-footers", "false", str(recording)], env=rerun_env(),
+                           capture_output=True, text=True)
     except OSError as e:
         return f"cannot run `rerun rrd verify` ({e.strerror or e})"
     # verify exits 0 on files it cannot read at all ("0 files verified"), so its count is checked too
     if r.returncode == 0 and "1 file verified" in r.stdout + r.stderr:
-        return None
+        # and on a file cut before its first chunk: without a footer the end of the data is where the file ends
+        return None if _has_chunks(exe, recording) else "it is truncated or holds no recording"
     lines = [ln.strip() for ln in (r.stdout + r.stderr).splitlines() if ln.strip() and "INFO" not in ln
              and "files verified" not in ln and not ln.startswith("Error: Verification failed")]
     why = next(iter(lines), "it is truncated or holds no recording")
@@ -64,6 +67,12 @@ def recording_problem(exe: str, recording: Path) -> str | None:
     if why.startswith('"'):  # '"FILE": what is wrong'
         why = why.split(": ", 1)[-1]
     return why if len(why) <= 120 else why[:119] + "…"
+
+
+def _has_chunks(exe: str, recording: Path) -> bool:
+    """Whether ``rerun rrd print`` lists at least one chunk of data in ``recording``."""
+    r = subprocess.run([exe, "rrd", "print", str(recording)], env=rerun_env(), capture_output=True, text=True)
+    return r.returncode == 0 and any(ln.startswith("Chunk(") for ln in r.stdout.splitlines())
 
 
 def check_bind(bind: str) -> str:

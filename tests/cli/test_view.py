@@ -12,14 +12,14 @@ runner = CliRunner()
 REAL_RUN = subprocess.run
 
 
-@pytest.fixture
-def rrd(tmp_path):
-    """A small valid recording."""
+@pytest.fixture(params=[True, False], ids=["footer", "no-footer"])
+def rrd(tmp_path, request):
+    """A small valid recording, with an RRD footer and without (as percept's recorder writes them)."""
     import rerun as rr
 
     path = tmp_path / "run.rrd"
     rec = rr.RecordingStream("percept-test")
-    rec.save(str(path))
+    rec.save(str(path), write_footer=request.param)
     rec.set_time("sim_time", duration=0.0)
     rec.log("x", rr.Scalars(1.0))
     rec.flush()
@@ -29,11 +29,11 @@ def rrd(tmp_path):
 
 @pytest.fixture
 def viewer_calls(monkeypatch):
-    """Viewer launches are recorded (and succeed); `rerun rrd verify` runs for real."""
+    """Viewer launches are recorded (and succeed); `rerun rrd verify` and `rrd print` run for real."""
     calls = []
 
     def fake_run(cmd, env, **kw):
-        if cmd[1:3] == ["rrd", "verify"]:
+        if cmd[1] == "rrd":
             return REAL_RUN(cmd, env=env, **kw)
         calls.append(cmd)
         return subprocess.CompletedProcess(cmd, 0)

@@ -40,8 +40,9 @@ def rerun(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([rerun_executable(), *args], env=ENV, capture_output=True, text=True, timeout=120)
 
 
-def verify(path: Path) -> None:
-    r = rerun("rrd", "verify", str(path))
+def verify(path: Path, footer: bool = False) -> None:
+    """``path`` loads (``rrd verify``); with a footer that lists its chunks when ``footer``."""
+    r = rerun("rrd", "verify", "--check-footers", str(footer).lower(), str(path))
     assert r.returncode == 0 and "1 file verified" in r.stdout + r.stderr, r.stdout + r.stderr
 
 
@@ -96,6 +97,17 @@ def test_every_task_is_recorded_with_all_slots_privileged(privileged):
     # one trajectory point and one ego pose per frame, never re-sent
     assert cols["/world/trajectory"]["Points3D:positions"] == result["frames"]
     assert cols["/world/ego"]["Transform3D:translation"] == result["frames"]
+
+
+def test_the_recording_has_no_footer_and_optimize_gives_one_with_the_same_data(privileged, tmp_path):
+    """No footer: Rerun's SDK would hold its manifest, a row per chunk, in memory until the file closes."""
+    path = privileged[0]
+    r = rerun("rrd", "verify", str(path))
+    assert r.returncode != 0 and "footer" in (r.stdout + r.stderr).lower(), r.stdout + r.stderr
+    out = tmp_path / "optimized.rrd"
+    assert rerun("rrd", "optimize", str(path), "-o", str(out)).returncode == 0
+    verify(out, footer=True)
+    assert columns_by_entity(out) == columns_by_entity(path)
 
 
 def test_objects_are_under_the_ego_in_its_frame(privileged):
