@@ -115,7 +115,8 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
                     "render_conditions_ms": {k: round(v, 3) for k, v in conditions.items()}})
     if soaked:
         console.print(f"soak: {soaked['minutes']:g} simulated minutes recorded, memory each minute "
-                      f"{soaked['rss_mb']} MB (peak {soaked['peak_mb']}, growth {soaked['growth_mb']}), realtime "
+                      f"{soaked['rss_mb']} MB (peak {soaked['peak_mb']}, growth {soaked['growth_mb']}, after the first "
+                      f"minute {fmt(soaked['mb_per_minute'])} MB a minute), realtime "
                       f"{soaked['realtime_factor']}")
         out["soak"] = soaked
     return out

@@ -201,7 +201,10 @@ def render_per_condition(frames: int = 20, scenario: str = "highway") -> dict:
 
 def soak(minutes: float, scenario: str = "highway", progress: Callable[[], None] | None = None) -> dict:
     """Resident memory [MB] of the process through a recorded closed loop of ``minutes`` simulated minutes with
-    every slot on vision, sampled each simulated minute; ``growth_mb``: the last sample less the first."""
+    every slot on vision, sampled as the drive starts, each simulated minute and once the recording has closed;
+    ``growth_mb``: the last sample less the first; ``mb_per_minute``: the least-squares slope of the samples taken
+    while it drives from the first minute on (the first minute holds the slots' and renderer's first allocations),
+    None for a drive under two minutes."""
     from percept.sims.env import SIMULATION_HZ
 
     samples = []
@@ -212,9 +215,12 @@ def soak(minutes: float, scenario: str = "highway", progress: Callable[[], None]
 
     with tempfile.TemporaryDirectory() as tmp:
         run = _drive(scenario, 60.0 * minutes, Path(tmp) / "soak.rrd", progress=progress, each_frame=sample)
+    driving = samples[1:]
     samples.append(_rss_mb())
+    slope = float(np.polyfit(np.arange(len(driving)), driving, 1)[0]) if len(driving) >= 2 else None
     return {"scenario": scenario, "minutes": minutes, "frames": run["frames"], "rss_mb": [round(s, 1) for s in samples],
             "peak_mb": round(max(samples), 1), "growth_mb": round(samples[-1] - samples[0], 1),
+            "mb_per_minute": None if slope is None else round(slope, 3),
             "realtime_factor": round(run["realtime_factor"], 3)}
 
 

@@ -111,6 +111,7 @@ def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_compos
         assert len(runs) == 2 and c[key] == min(runs)
     assert set(d["render_conditions_ms"]) == {"clear", "night", "rain", "glare", "noise"}
     assert d["soak"]["frames"] == 45 and len(d["soak"]["rss_mb"]) == 2 and d["soak"]["peak_mb"] > 0
+    assert d["soak"]["mb_per_minute"] is None  # no slope from a drive shorter than two minutes
 
 
 def test_bench_refuses_an_unknown_scenario_in_one_line():
