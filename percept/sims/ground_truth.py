@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from percept.sensors import ImuSample, ObjectKind, Pose2D, Side, StereoRig, wrap_angle
+from percept.sensors import ImuSample, ObjectKind, PinholeCamera, Pose2D, StereoRig, Transform, wrap_angle
 
 from .coords import hw_to_world_yaw
 from .render.scene import ObjectState
@@ -101,36 +101,39 @@ def lane_truth(ego) -> LaneTruth:
     return LaneTruth(-float(lat_hw), rel, k, float(lane.width_at(s)), tuple(ego.lane_index))
 
 
-def in_frame_share(rig: StereoRig, points_v: np.ndarray) -> float:
-    """Share of the box that bounds the projections of ``points_v`` (vehicle frame) inside the left image; 1 when
-    some point is behind the camera (the projection is not a box then)."""
-    uv, z = rig.project_vehicle_points(points_v)
-    if np.any(z <= 0.1):
+_BOX_GRID = np.array([[a, b, h] for a in (-0.5, 0, 0.5) for b in (-0.5, 0, 0.5) for h in (0.0, 0.5, 1.0)])
+"""Corners, edge and face centres of a box as fractions of its (length, width, height), from its base centre (27, 3)."""
+
+
+def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> float:
+    """Share of the box that bounds the projections of ``points_c`` (camera frame, (N, 3) [m]) inside the image; 1
+    when some point is behind the camera (the projection is not a box then)."""
+    if np.any(points_c[:, 2] <= 0.1):
         return 1.0
+    uv = camera.project(points_c)
     (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
     area = (u1 - u0) * (v1 - v0)
     if area <= 0:
         return 1.0
-    cam = rig.camera
     # the part of the box inside [0, W] x [0, H]
-    inside = max(min(u1, cam.width) - max(u0, 0.0), 0.0) * max(min(v1, cam.height) - max(v0, 0.0), 0.0)
+    inside = max(min(u1, camera.width) - max(u0, 0.0), 0.0) * max(min(v1, camera.height) - max(v0, 0.0), 0.0)
     return float(inside / area)
 
 
-def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, box_px, visible: float,
-                 crossing: bool) -> ObjectTruth:
-    """Vehicle-frame position and camera distance of one object."""
+def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, cam_from_vehicle: Transform, box_px,
+                 visible: float, crossing: bool) -> ObjectTruth:
+    """Vehicle-frame position and camera distance of one object; ``cam_from_vehicle``: the left camera's
+    ``rig.cam_from_vehicle()`` (built once for all the objects of a frame)."""
     c = ego.to_vehicle_xy(np.array([state.pose.x_m, state.pose.y_m]))
     yaw = float(wrap_angle(state.pose.yaw_rad - ego.yaw_rad))
     # nearest point of the 3D box: sample its corners and face centres in the left camera
     cy, sy = np.cos(yaw), np.sin(yaw)
     L, W, H = state.length_m, state.width_m, state.height_m
-    g = np.array([[a, b, h] for a in (-0.5, 0, 0.5) for b in (-0.5, 0, 0.5) for h in (0.0, 0.5, 1.0)])
-    local = g * np.array([L, W, H])
+    local = _BOX_GRID * np.array([L, W, H])
     pts = np.column_stack([c[0] + cy * local[:, 0] - sy * local[:, 1], c[1] + sy * local[:, 0] + cy * local[:, 1],
                            local[:, 2]])
-    z = rig.cam_from_vehicle(Side.LEFT).apply(pts)[:, 2]
+    pc = cam_from_vehicle.apply(pts)
     if box_px is not None:
-        visible *= in_frame_share(rig, pts)
-    return ObjectTruth(state.obj_id, state.kind, box_px, float(visible), float(z.min()),
+        visible *= in_frame_share(rig.camera, pc)
+    return ObjectTruth(state.obj_id, state.kind, box_px, float(visible), float(pc[:, 2].min()),
                        (float(c[0]), float(c[1]), H / 2), (L, W, H), yaw, state.speed_mps, crossing, state.marker_id)

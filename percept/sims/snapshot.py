@@ -18,6 +18,8 @@ class ObjectIds:
     def __init__(self) -> None:
         self._ids: dict[int, int] = {}
         self.objects: dict[int, object] = {}
+        self.static_states: dict[int, ObjectState] = {}
+        """The states of signs by id: they never move, so ``scene_from_road`` builds each once."""
 
     def __call__(self, obj) -> int:
         key = id(obj)
@@ -48,7 +50,12 @@ def scene_from_road(road, ego, ids: ObjectIds) -> Scene:
     for obj in list(road.vehicles) + list(road.objects):
         if obj is ego:
             continue
-        s = object_state(obj, ids(obj))
+        oid = ids(obj)
+        s = ids.static_states.get(oid)
+        if s is None:
+            s = object_state(obj, oid)
+            if isinstance(obj, Sign):
+                ids.static_states[oid] = s
         if s is not None:
             states.append(s)
     return Scene(hw_pose(ego), tuple(states))

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from percept.sensors import Frame, LandmarkMap, StereoRig
+from percept.sensors import Frame, LandmarkMap, Side, StereoRig
 from percept.sensors.vehicle import SIGN_PANEL_CENTRE_M
 
 from .actors import Pedestrian, Sign
@@ -128,14 +128,15 @@ class SimWorld:
             depth = np.full((rig.camera.height, rig.camera.width), np.nan, np.float32)
             boxes, visible = {}, {}
         objects = []
+        cam_from_vehicle = rig.cam_from_vehicle(Side.LEFT)
         for st in scene.objects:
             dx, dy = st.pose.x_m - scene.ego.x_m, st.pose.y_m - scene.ego.y_m
             if dx * dx + dy * dy > TRUTH_RANGE_M ** 2:
                 continue
             src = self.ids.objects[st.obj_id]
             crossing = bool(getattr(src, "crossing", False))
-            objects.append(object_truth(st, scene.ego, rig, boxes.get(st.obj_id), visible.get(st.obj_id, 0.0),
-                                        crossing))
+            objects.append(object_truth(st, scene.ego, rig, cam_from_vehicle, boxes.get(st.obj_id),
+                                        visible.get(st.obj_id, 0.0), crossing))
         ped_hit = tuple(self.ids(p) for p in self.env.road.objects if isinstance(p, Pedestrian) and (p.crashed or p.hit))
         gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
                          bool(ego.crashed), ped_hit)
