@@ -349,3 +349,17 @@ def test_indexed_network_answers_like_highway_env():
             p = p + rng.normal(0, 100, 2)  # off the road: the full search answers
         h = lane.heading_at(0.0) + rng.normal(0, 0.3)
         assert net.get_closest_lane_index(p, h) == RoadNetwork.get_closest_lane_index(net, p, h)
+
+
+def test_a_snapshot_builds_each_sign_once_and_every_vehicle_each_frame():
+    from percept.sims.snapshot import object_state, scene_from_road
+
+    world = SimWorld(WorldConfig("loop", seed=0, autopilot=True))
+    first = {s.obj_id: s for s in scene_from_road(world.env.road, world.ego, world.ids).objects}
+    world.step()
+    later = {s.obj_id: s for s in scene_from_road(world.env.road, world.ego, world.ids).objects}
+    signs = {world.ids(o) for o in world.env.road.objects if isinstance(o, Sign)}
+    assert signs and all(later[i] is first[i] for i in signs)
+    # the kept states are what a fresh snapshot of the sign gives
+    assert all(object_state(world.ids.objects[i], i) == later[i] for i in signs)
+    assert all(later[i] is not first[i] for i in later if i not in signs)
