@@ -18,8 +18,8 @@ class ObjectIds:
     def __init__(self) -> None:
         self._ids: dict[int, int] = {}
         self.objects: dict[int, object] = {}
+        # the states of signs by id: they never move, so ``scene_from_road`` builds each once
         self.static_states: dict[int, ObjectState] = {}
-        """The states of signs by id: they never move, so ``scene_from_road`` builds each once."""
 
     def __call__(self, obj) -> int:
         key = id(obj)
