@@ -91,15 +91,16 @@ class OdometrySlot:
         return self.dead_reckoning, self.fused, self.estimate
 
     def step(self, frame: Frame, upstream: dict) -> tuple[PoseEstimate, OdometryDebug]:
-        imu = frame.imu
+        # this frame's readings, once (NaN when missing; each filter and the VO prior judge them alike)
+        w, a, v = as_sample(frame.imu.gyro_rps[2]), as_sample(frame.imu.accel_mps2[0]), as_sample(frame.wheel_speed_mps)
         for f in self.filters:
             if self._frames:
-                f.predict(as_sample(imu.gyro_rps[2]), as_sample(imu.accel_mps2[0]), self.dt_s)
-            f.update_wheel(as_sample(frame.wheel_speed_mps))
+                f.predict(w, a, self.dt_s)
+            f.update_wheel(v)
         self._frames += 1
         # the left image in grey once, for VO and the sign search
         left = None if frame.left is None else to_gray(frame.left)
-        vo = self._visual_odometry(frame, left, upstream)
+        vo = self._visual_odometry(frame, left, upstream, self._prior(w, v))
         sightings: list[LandmarkSighting] = []
         fixes = 0
         if self.finder is not None and left is not None and frame.right is not None:
@@ -113,12 +114,13 @@ class OdometrySlot:
                               sum(f.rejected for f in self.filters))
         return PoseEstimate(est.pose, est.speed_mps, est.pose_covariance, True), debug
 
-    def _visual_odometry(self, frame: Frame, left: np.ndarray | None, upstream: dict) -> VOStep:
-        """VO on this frame's pair (the lead's box, from the longitudinal slot, left out: it moves); the VO-only
-        chain takes every step, the filters the pose against the last keyframe when the keyframe changes (one
-        independent measurement per keyframe span)."""
+    def _visual_odometry(self, frame: Frame, left: np.ndarray | None, upstream: dict,
+                         prior: np.ndarray | None) -> VOStep:
+        """VO on this frame's pair guided by ``prior`` (``_prior``; the lead's box, from the longitudinal slot, left
+        out: it moves); the VO-only chain takes every step, the filters the pose against the last keyframe when the
+        keyframe changes (one independent measurement per keyframe span)."""
         lead = upstream.get("longitudinal")
-        step = self.vo.process(left, frame.right, self._prior(frame), [getattr(lead, "box_px", None)])
+        step = self.vo.process(left, frame.right, prior, [getattr(lead, "box_px", None)])
         if left is None or frame.right is None:
             self._since_image += 1
             return step  # dropped: the next image's motion is measured from the last image
@@ -141,11 +143,10 @@ class OdometrySlot:
                 f.clone()
         return step
 
-    def _prior(self, frame: Frame) -> np.ndarray | None:
-        """The camera motion since the last image that the wheel speed and the gyro alone predict (None before the
-        first image or without a plausible sample): independent of the visual odometry it guides, so that a biased
-        VO cannot select the points that confirm its bias."""
-        w, v = as_sample(frame.imu.gyro_rps[2]), as_sample(frame.wheel_speed_mps)
+    def _prior(self, w: float, v: float) -> np.ndarray | None:
+        """The camera motion since the last image that the wheel speed ``v`` [m/s] and the gyro's yaw rate ``w``
+        [rad/s] alone predict (None before the first image or without a plausible sample): independent of the
+        visual odometry it guides, so that a biased VO cannot select the points that confirm its bias."""
         if self._frames <= 1 or not (plausible_yaw_rate(w) and plausible_speed(v)):
             return None
         dt = self._since_image * self.dt_s

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from percept.sensors import ImuSample, ObjectKind, PinholeCamera, Pose2D, StereoRig, Transform, wrap_angle
+from percept.sensors import ImuSample, ObjectKind, PinholeCamera, Pose2D, Transform, wrap_angle
 
 from .coords import hw_to_world_yaw
 from .render.scene import ObjectState
@@ -120,10 +120,10 @@ def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> float:
     return float(inside / area)
 
 
-def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, cam_from_vehicle: Transform, box_px,
+def object_truth(state: ObjectState, ego: Pose2D, camera: PinholeCamera, cam_from_vehicle: Transform, box_px,
                  visible: float, crossing: bool) -> ObjectTruth:
-    """Vehicle-frame position and camera distance of one object; ``cam_from_vehicle``: the left camera's
-    ``rig.cam_from_vehicle()`` (built once for all the objects of a frame)."""
+    """Vehicle-frame position and camera distance of one object; ``camera``, ``cam_from_vehicle``: the left
+    camera's intrinsics and its ``StereoRig.cam_from_vehicle()`` (built once for all the objects of a frame)."""
     c = ego.to_vehicle_xy(np.array([state.pose.x_m, state.pose.y_m]))
     yaw = float(wrap_angle(state.pose.yaw_rad - ego.yaw_rad))
     # nearest point of the 3D box: sample its corners and face centres in the left camera
@@ -134,6 +134,6 @@ def object_truth(state: ObjectState, ego: Pose2D, rig: StereoRig, cam_from_vehic
                            local[:, 2]])
     pc = cam_from_vehicle.apply(pts)
     if box_px is not None:
-        visible *= in_frame_share(rig.camera, pc)
+        visible *= in_frame_share(camera, pc)
     return ObjectTruth(state.obj_id, state.kind, box_px, float(visible), float(pc[:, 2].min()),
                        (float(c[0]), float(c[1]), H / 2), (L, W, H), yaw, state.speed_mps, crossing, state.marker_id)

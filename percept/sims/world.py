@@ -135,7 +135,7 @@ class SimWorld:
                 continue
             src = self.ids.objects[st.obj_id]
             crossing = bool(getattr(src, "crossing", False))
-            objects.append(object_truth(st, scene.ego, rig, cam_from_vehicle, boxes.get(st.obj_id),
+            objects.append(object_truth(st, scene.ego, rig.camera, cam_from_vehicle, boxes.get(st.obj_id),
                                         visible.get(st.obj_id, 0.0), crossing))
         ped_hit = tuple(self.ids(p) for p in self.env.road.objects if isinstance(p, Pedestrian) and (p.crashed or p.hit))
         gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
