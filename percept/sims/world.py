@@ -137,7 +137,8 @@ class SimWorld:
             crossing = bool(getattr(src, "crossing", False))
             objects.append(object_truth(st, scene.ego, rig.camera, cam_from_vehicle, boxes.get(st.obj_id),
                                         visible.get(st.obj_id, 0.0), crossing))
-        ped_hit = tuple(self.ids(p) for p in self.env.road.objects if isinstance(p, Pedestrian) and (p.crashed or p.hit))
+        ped_hit = tuple(self.ids(p) for p in self.env.road.objects
+                        if isinstance(p, Pedestrian) and (p.crashed or p.hit))
         gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
                          bool(ego.crashed), ped_hit)
         frame = Frame(self.frame_index, self.time_s, None if dropped else left, None if dropped else right, imu, wheel)
