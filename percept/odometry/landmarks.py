@@ -82,10 +82,10 @@ class LandmarkFinder:
                 out.append((self.map.ids[k], box))
         return out
 
-    def _find(self, gray: np.ndarray, box: tuple[int, int, int, int], marker_id: int) -> np.ndarray | None:
-        """The marker's corners (4, 2) in ``box`` of the image, or None."""
+    def _find(self, image: np.ndarray, box: tuple[int, int, int, int], marker_id: int) -> np.ndarray | None:
+        """The marker's corners (4, 2) in ``box`` of the image (BGR or grey: only the box is made grey), or None."""
         u0, v0, u1, v1 = box
-        corners, ids, _ = self.detector.detectMarkers(gray[v0:v1, u0:u1])
+        corners, ids, _ = self.detector.detectMarkers(to_gray(image[v0:v1, u0:u1]))
         if ids is None:
             return None
         for c, i in zip(corners, ids.ravel()):
@@ -98,16 +98,15 @@ class LandmarkFinder:
         wanted = self.expected(pose, pose_cov)
         if not wanted:
             return []
-        gl, gr = to_gray(left), to_gray(right)
         out = []
         for marker_id, box in wanted:
-            cl = self._find(gl, box, marker_id)
+            cl = self._find(left, box, marker_id)
             if cl is None:
                 continue
             # in the right image the sign is shifted left by its disparity: up to f b / min_range
             d_max = self.rig.disparity_px(self.config.min_range_m)
             rbox = (int(max(box[0] - d_max, 0)), box[1], box[2], box[3])
-            cr = self._find(gr, rbox, marker_id)
+            cr = self._find(right, rbox, marker_id)
             if cr is not None:
                 s = self._measure(marker_id, cl, cr)
                 if s is not None:
