@@ -197,3 +197,19 @@ def test_ctrl_c_during_a_kernel_is_a_keyboard_interrupt():
     out = subprocess.run([sys.executable, "-c", CTRL_C], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.split() == ["KeyboardInterrupt"] * 12
+
+
+def test_a_silhouette_is_summarised_from_its_distinct_pixels():
+    """Box, distinct pixel count and pixels showing the object, from pixel lists that repeat pixels (two patches
+    of one object overlap) and are partly hidden (the id map shows another object there)."""
+    h, w = 6, 10
+    ids = np.zeros((h, w), np.int32)
+    ids[2, 3:6] = 7
+    ids[3, 4] = 9  # hidden by object 9
+    target = RenderTarget(np.zeros((h, w, 3), np.uint8), np.full((h, w), np.inf, np.float32), ids)
+    target.silhouettes[7] = [np.array([2 * w + 3, 2 * w + 4, 2 * w + 5], np.int32),
+                             np.array([2 * w + 4, 3 * w + 4, 4 * w + 1], np.int32)]
+    assert target.silhouette(7) == ((1, 2, 6, 5), 5, 3)
+    assert target.silhouette(8) is None
+    no_ids = RenderTarget(target.image, target.depth, None, silhouettes={7: target.silhouettes[7]})
+    assert no_ids.silhouette(7) == ((1, 2, 6, 5), 5, 0)

@@ -221,3 +221,24 @@ def shade_winners(img, ids, em, wpix, wspan, rp, obj_id, emissive, color, albedo
         a = albedo[w]
         for ch in range(3):
             img[p, ch] = np.uint8(color[i, ch] * a)
+
+
+@kernel()
+def silhouette_stats(pix, W, ids, obj_id):  # pragma: no cover - compiled
+    """Of flat pixel indices ``pix`` (N,) int32 (row * W + col, N >= 1, repeats allowed) of one object: the tight
+    box (u0, v0, u1, v1) (u1, v1 exclusive), how many distinct pixels, and how many of them show ``obj_id`` in the
+    flat id map ``ids`` (empty: none counted)."""
+    lo, hi = pix.min(), pix.max()
+    base = (lo // W) * W
+    mark = np.zeros(hi - base + 1, np.bool_)
+    u0, v0, u1, v1 = W, hi // W, -1, -1
+    count, seen = 0, 0
+    for p in pix:
+        if not mark[p - base]:
+            mark[p - base] = True
+            count += 1
+            v, u = p // W, p % W
+            u0, u1, v0, v1 = min(u0, u), max(u1, u), min(v0, v), max(v1, v)
+            if ids.size > 0 and ids[p] == obj_id:
+                seen += 1
+    return u0, v0, u1 + 1, v1 + 1, count, seen

@@ -24,9 +24,11 @@ import numpy as np
 
 from percept.sensors import PinholeCamera, Transform
 
+from .compiled import optional
 from .cull import inverse_rows, project_patches
 from .fragments import NEAR_M, PreparedPatches, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
+from .pixels import silhouette_stats
 from .textures import TextureAtlas
 from .vec3 import cross, dot
 
@@ -74,16 +76,9 @@ class RenderTarget:
         pix = np.concatenate(parts)
         if not len(pix):
             return None
-        W = self.image.shape[1]
-        v0, v1 = int(pix.min()) // W, int(pix.max()) // W + 1
-        # union of the parts on the rows they span
-        mark = np.zeros((v1 - v0, W), bool)
-        mark.reshape(-1)[pix - v0 * W] = True
-        rows = np.flatnonzero(mark.any(axis=1))
-        cols = np.flatnonzero(mark.any(axis=0))
-        seen = int(np.count_nonzero(mark & (self.ids[v0:v1] == obj_id))) if self.ids is not None else 0
-        box = (int(cols[0]), v0 + int(rows[0]), int(cols[-1]) + 1, v0 + int(rows[-1]) + 1)
-        return box, int(np.count_nonzero(mark)), seen
+        ids = optional(self.ids, np.int32).reshape(-1)
+        u0, v0, u1, v1, count, seen = silhouette_stats(pix, self.image.shape[1], ids, obj_id)
+        return (int(u0), int(v0), int(u1), int(v1)), int(count), int(seen)
 
 
 def rasterize(target: RenderTarget, batch: PatchBatch, cam: PinholeCamera, cam_from_world: Transform,
@@ -128,6 +123,8 @@ def warm_up() -> None:
                               emission=np.zeros((h, w), np.float32))
         rasterize(target, batch, cam, Transform(np.eye(3), np.zeros(3)), atlas, np.array([0.0, 0.0, -1.0]),
                   silhouettes=left)
+        if left:
+            target.silhouette(1)
     _WARM.append(True)
 
 
