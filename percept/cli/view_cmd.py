@@ -70,9 +70,13 @@ def recording_problem(exe: str, recording: Path) -> str | None:
 
 
 def _has_chunks(exe: str, recording: Path) -> bool:
-    """Whether ``rerun rrd print`` lists at least one chunk of data in ``recording``."""
-    r = subprocess.run([exe, "rrd", "print", str(recording)], env=rerun_env(), capture_output=True, text=True)
-    return r.returncode == 0 and any(ln.startswith("Chunk(") for ln in r.stdout.splitlines())
+    """Whether ``rerun rrd print`` lists at least one chunk of data in ``recording``: read up to the first one, not
+    the whole listing (a line per chunk: 0.7 s for a 94 MB recording)."""
+    with subprocess.Popen([exe, "rrd", "print", str(recording)], env=rerun_env(), stdout=subprocess.PIPE,
+                          stderr=subprocess.DEVNULL, text=True) as p:
+        found = any(ln.startswith("Chunk(") for ln in p.stdout)
+        p.kill()
+    return found
 
 
 def check_bind(bind: str) -> str:

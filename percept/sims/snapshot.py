@@ -54,7 +54,7 @@ def scene_from_road(road, ego, ids: ObjectIds) -> Scene:
         s = ids.static_states.get(oid)
         if s is None:
             s = object_state(obj, oid)
-            if isinstance(obj, Sign):
+            if s is not None and isinstance(obj, Sign):
                 ids.static_states[oid] = s
         if s is not None:
             states.append(s)
