@@ -9,7 +9,9 @@ shares them too, within a scale). A linear model w on a window at block (x, y) s
 
     s(x, y) = b + sum_{i < 7, j < 15} w_ij . B(x + i, y + j)
 
-which is computed as one product of every block with all 105 weight vectors, then sums along shifted views.
+which is computed as one product of every block with all 105 weight vectors (BLAS), then the sums over j and i in
+one compiled pass (``_window_sums``: the float32 additions in the order numpy's strided sums made them, so the
+scores are the same to the bit).
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from numpy.lib.stride_tricks import as_strided
+
+from percept.compiled import kernel
 
 WINDOW_PX = (64, 128)
 """Detection window (width, height) [px]."""
@@ -129,19 +132,35 @@ class LinearModel:
     def score_map(self, blocks: np.ndarray) -> np.ndarray:
         """Score of the window at every block position of ``blocks`` (nbx, nby, 36): (nbx - 6, nby - 14)."""
         nbx, nby, _ = blocks.shape
-        nx, ny = nbx - BLOCKS[0] + 1, nby - BLOCKS[1] + 1
         # every block against all 105 weight vectors in one product: P[bx, by, i, j] = w_ij . B(bx, by)
         p = (blocks.reshape(-1, BLOCK_LEN) @ self._weights_t).reshape(nbx, nby, BLOCKS[0], BLOCKS[1])
-        sx, sy, si, sj = p.strides
-        # Q[bx, y, i] = sum_j P[bx, y + j, i, j]: a view whose last axis steps one block down and one j along
-        q = as_strided(p, (nbx, ny, BLOCKS[0], BLOCKS[1]), (sx, sy, si, sy + sj), writeable=False).sum(axis=3)
-        # s(x, y) = b + sum_i Q[x + i, y, i]
-        s = q[:nx, :, 0] + np.float32(self.bias)
-        for i in range(1, BLOCKS[0]):
-            s += q[i:i + nx, :, i]
-        return s
+        return _window_sums(p, np.float32(self.bias))
 
     @cached_property
     def _weights_t(self) -> np.ndarray:
         """The weights as a (36, 105) matrix, column i * 15 + j the vector w_ij of block (i, j) of a window."""
         return np.ascontiguousarray(self.weights.reshape(BLOCKS[0] * BLOCKS[1], BLOCK_LEN).T)
+
+
+@kernel()
+def _window_sums(p, bias):  # pragma: no cover - compiled
+    """s(x, y) = b + sum_i Q[x + i, y, i] with Q[bx, y, i] = sum_j P[bx, y + j, i, j], from P (nbx, nby, 7, 15)
+    float32: (nbx - 6, nby - 14) float32, each sum accumulated in float32 from its first term on."""
+    nbx, nby, ni, nj = p.shape
+    nx, ny = nbx - ni + 1, nby - nj + 1
+    q = np.empty((nbx, ny, ni), np.float32)
+    for bx in range(nbx):
+        for y in range(ny):
+            for i in range(ni):
+                acc = p[bx, y, i, 0]
+                for j in range(1, nj):
+                    acc += p[bx, y + j, i, j]
+                q[bx, y, i] = acc
+    s = np.empty((nx, ny), np.float32)
+    for x in range(nx):
+        for y in range(ny):
+            v = q[x, y, 0] + bias
+            for i in range(1, ni):
+                v += q[x + i, y, i]
+            s[x, y] = v
+    return s

@@ -31,6 +31,27 @@ def test_every_window_scores_as_its_own_descriptor_would():
         assert scores[u // 8, v // 8] == pytest.approx(float(d @ model.weights) + model.bias, abs=1e-4)
 
 
+def test_the_compiled_window_sums_equal_numpys_strided_sums_to_the_bit():
+    """score_map's sums are compiled; the detections (and so every run) stay those of numpy's strided sums, which
+    add the j terms in order, then the i terms onto the bias."""
+    from numpy.lib.stride_tricks import as_strided
+
+    rng = np.random.default_rng(4)
+    model = LinearModel.inria()
+    for nbx, nby in ((7, 15), (8, 16), (139, 24), (40, 57)):
+        blocks = rng.random((nbx, nby, 36), dtype=np.float32)
+        p = (blocks.reshape(-1, 36) @ model._weights_t).reshape(nbx, nby, 7, 15)
+        sx, sy, si, sj = p.strides
+        nx, ny = nbx - 6, nby - 14
+        q = as_strided(p, (nbx, ny, 7, 15), (sx, sy, si, sy + sj), writeable=False).sum(axis=3)
+        expected = q[:nx, :, 0] + np.float32(model.bias)
+        for i in range(1, 7):
+            expected += q[i:i + nx, :, i]
+        got = model.score_map(blocks)
+        assert got.dtype == np.float32 and got.shape == (nx, ny)
+        assert np.array_equal(got, expected)
+
+
 def test_pyramid_scales_stop_where_a_window_no_longer_fits():
     s = pyramid_scales(640, 480, 1.05)
     assert s[0] == 1.0 and s[1] == pytest.approx(1.05)

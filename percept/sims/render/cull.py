@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import kernel
+from percept.compiled import kernel
+
 from .vec3 import cross, dot
 
 

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .compiled import optional
+from percept.compiled import optional
+
 from .pixels import big_patches, put_albedo, shade_winners, small_fragments, texel_coords
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas

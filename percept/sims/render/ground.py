@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from percept.compiled import kernel
 from percept.sensors import Pose2D, Side, StereoRig
 
 from ..road_geometry import RoadGeometry
-from .compiled import kernel
 from .paint import GroundPaint, RoadIndex, ground_paint
 from .textures import ground_tile, mip_chain
 

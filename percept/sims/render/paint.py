@@ -20,10 +20,10 @@ import numpy as np
 
 from numba.extending import register_jitable
 
+from percept.compiled import kernel
 from percept.sensors import Pose2D, StereoRig, rotate_to_vehicle
 
 from ..road_geometry import DASH_GAP_M, DASH_LENGTH_M, MARKING_WIDTH_M, YELLOW, RoadGeometry
-from .compiled import kernel
 from .raster import NEAR_M
 
 SURFACE_FAR_M = 400.0

@@ -26,7 +26,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .compiled import kernel
+from percept.compiled import kernel
+
 from .figure import ROW, box, disc, limb, packed, pymax, scaled
 from .scene import ObjectState
 from .vec3 import UP, Vec3, add, dot, madd, mul, norm, vec

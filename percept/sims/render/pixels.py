@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .compiled import kernel
+from percept.compiled import kernel
 
 f32 = np.float32
 

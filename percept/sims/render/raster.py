@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from percept.compiled import optional
 from percept.sensors import PinholeCamera, Transform
 
-from .compiled import optional
 from .cull import inverse_rows, project_patches
 from .fragments import NEAR_M, PreparedPatches, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder

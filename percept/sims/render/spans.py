@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import kernel, optional
+from percept.compiled import kernel, optional
 
 EDGE_TOL = 2e-5
 """Relative 1/Z tolerance that tells "this pixel shows the patch" (float32 rounding is about 1e-7) from "it

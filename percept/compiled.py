@@ -1,4 +1,5 @@
-"""The renderer's compiled kernels (numba): one decorator for every kernel Python calls, ``kernel``.
+"""percept's compiled kernels (numba; the renderer's and HOG's window sums): one decorator for every kernel Python
+calls, ``kernel``.
 
 A kernel is compiled the first time it is called with new argument types and cached on disk (``cache=True``),
 and it raises Ctrl-C as KeyboardInterrupt: a SIGINT that lands while a kernel runs is handled by Python's signal
