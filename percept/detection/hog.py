@@ -148,6 +148,7 @@ def _window_sums(p, bias):  # pragma: no cover - compiled
     float32: (nbx - 6, nby - 14) float32, each sum accumulated in float32 from its first term on."""
     nbx, nby, ni, nj = p.shape
     nx, ny = nbx - ni + 1, nby - nj + 1
+    # Q[bx, y, i] = sum_j P[bx, y + j, i, j]
     q = np.empty((nbx, ny, ni), np.float32)
     for bx in range(nbx):
         for y in range(ny):
@@ -156,6 +157,7 @@ def _window_sums(p, bias):  # pragma: no cover - compiled
                 for j in range(1, nj):
                     acc += p[bx, y + j, i, j]
                 q[bx, y, i] = acc
+    # s(x, y) = b + sum_i Q[x + i, y, i]
     s = np.empty((nx, ny), np.float32)
     for x in range(nx):
         for y in range(ny):
