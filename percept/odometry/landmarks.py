@@ -99,12 +99,12 @@ class LandmarkFinder:
         if not wanted:
             return []
         out = []
+        # in the right image a sign is shifted left by its disparity: up to f b / min_range
+        d_max = self.rig.disparity_px(self.config.min_range_m)
         for marker_id, box in wanted:
             cl = self._find(left, box, marker_id)
             if cl is None:
                 continue
-            # in the right image the sign is shifted left by its disparity: up to f b / min_range
-            d_max = self.rig.disparity_px(self.config.min_range_m)
             rbox = (int(max(box[0] - d_max, 0)), box[1], box[2], box[3])
             cr = self._find(right, rbox, marker_id)
             if cr is not None:
