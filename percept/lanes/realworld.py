@@ -33,7 +33,7 @@ def _real_lane_config() -> LaneConfig:
     # from a quadratic: the curvature-rate prior is that tight.
     return LaneConfig(evidence=EvidenceConfig(min_contrast=6.0, rel_contrast=0.2, brightness=Brightness.MAX_RG_YELLOW,
                                               row_step_px=4.0),
-                      fit=FitConfig(curvature_rate_sigma_1pm2=3e-5))
+                      fit=FitConfig(curvature_rate_sigma_1pm2=3e-5, straight_seeds=True))
 
 
 @dataclass(frozen=True)

@@ -118,6 +118,20 @@ def test_tusimple_format_on_the_samples(tmp_path):
                 x["raw_file"], on)
 
 
+@needs["tusimple"]
+@pytest.mark.parametrize("height_m", np.arange(1.6, 1.81, 0.025).round(3).tolist())
+def test_a_car_over_the_far_end_of_a_line_does_not_bend_the_lane(height_m):
+    # 3.jpg's dark SUV pasted over the right line of 1.jpg where its far dashes run (as a car one lane over,
+    # straddling the line), fitted at heights about the 1.69 m a folder of such frames gives. Before the straight
+    # starts, the right boundary hooked round the car at 1.675 and 1.725 m (curvature -0.0049 and -0.0144 1/m,
+    # heading -3.2 and -8.5 deg) at confidence 1.
+    image = read_image(TUSIMPLE / "1.jpg").copy()
+    car = read_image(TUSIMPLE / "3.jpg")[228:378, 175:372]
+    image[271:400, 775:945] = cv2.resize(car, (170, 129), interpolation=cv2.INTER_AREA)
+    e = FootageLanes(RealLaneConfig(mount_height_m=height_m)).still(image).estimate
+    assert e.valid and abs(e.curvature_1pm) < 2.5e-3 and abs(e.heading_rad) < np.radians(1.0), e
+
+
 def test_tusimple_format_needs_images_and_a_json(tmp_path):
     img = tmp_path / "a.png"
     cv2.imwrite(str(img), np.full((72, 128, 3), 90, np.uint8))
