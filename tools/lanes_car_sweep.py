@@ -1,0 +1,93 @@
+"""A car straddling an ego lane line: how far does the fitted lane move?
+
+Pastes the dark SUV of TuSimple 3.jpg (rows 228-378, columns 175-372), scaled to 1.9 m wide, with its bottom centre
+on the left or the right ego boundary of a TuSimple sample at ranges of 12-50 m, and reports per placement the
+lane's curvature, heading, width and confidence and how far each boundary moved (max |du| [px]) in the rows below
+the car, against the same frame without the car.
+
+    python tools/lanes_car_sweep.py 1.jpg 2.jpg [--height 1.64] [--out DIR]
+
+``--out`` writes a small overlay per placement. Needs ../shared/data/tusimple-samples.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from percept.lanes.overlay import draw_overlay
+from percept.lanes.realworld import FootageLanes, RealLaneConfig
+from percept.sensors import read_image
+
+SAMPLES = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "tusimple-samples"
+RANGES_M = (12, 16, 20, 25, 30, 40, 50)
+CAR_WIDTH_M = 1.9
+TOLERANCE_PX = 20
+
+
+def sweep(name: str, height_m: float, out: Path | None) -> tuple[int, int]:
+    """Placements tried and those that moved a boundary by more than TOLERANCE_PX below the car."""
+    car = read_image(SAMPLES / "3.jpg")[228:378, 175:372]
+    frame = read_image(SAMPLES / name)
+    lanes = FootageLanes(RealLaneConfig(mount_height_m=height_m))
+    plain = lanes.still(frame)
+    rows = np.arange(160, frame.shape[0], 10)
+    before = plain.u_at_rows(rows)
+    e = plain.estimate
+    print(f"{name} at {height_m} m, no car: curvature {e.curvature_1pm:+.5f} 1/m, heading "
+          f"{math.degrees(e.heading_rad):+.2f} deg, width {e.width_m:.2f} m")
+    tried = moved = 0
+    for side in ("left", "right"):
+        for x in RANGES_M:
+            # bottom row v = horizon + f h / x; width f W / x [px]
+            v_bottom = int(round(plain.rig.horizon_row + plain.rig.camera.fx * height_m / x))
+            w_px = int(round(plain.rig.camera.fx * CAR_WIDTH_M / x))
+            h_px = int(round(w_px * car.shape[0] / car.shape[1]))
+            u_c = plain.u_at_rows(np.array([v_bottom]))[side][0]
+            if v_bottom >= frame.shape[0] - 1 or not np.isfinite(u_c):
+                continue
+            u0 = int(round(u_c - w_px / 2))
+            a, b = max(u0, 0), min(u0 + w_px, frame.shape[1])
+            if b - a < 8:
+                continue
+            image = frame.copy()
+            image[v_bottom - h_px:v_bottom, a:b] = cv2.resize(car, (w_px, h_px), interpolation=cv2.INTER_AREA)[
+                :, a - u0:b - u0]
+            r = lanes.still(image)
+            after = r.u_at_rows(rows)
+            below = rows > v_bottom
+            du = {k: np.abs(after[k][below] - before[k][below]) for k in after}
+            worst = {k: float(np.nanmax(d)) if np.isfinite(d).any() else float("nan") for k, d in du.items()}
+            tried += 1
+            moved += max(worst.values()) > TOLERANCE_PX
+            e = r.estimate
+            print(f"  car on the {side:5s} line at {x:2d} m: curvature {e.curvature_1pm:+.5f}, heading "
+                  f"{math.degrees(e.heading_rad):+.2f} deg, width {e.width_m:.2f} m, confidence {e.confidence:.2f}; "
+                  f"moved below the car: left {worst['left']:.0f} px, right {worst['right']:.0f} px")
+            if out is not None:
+                small = cv2.resize(draw_overlay(image, r, f"car on the {side} line at {x} m"), (640, 360))
+                cv2.imwrite(str(out / f"{Path(name).stem}_{side}_{x}m.png"), small)
+    return tried, moved
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("frames", nargs="+", help="TuSimple sample names, e.g. 1.jpg 2.jpg")
+    ap.add_argument("--height", type=float, default=1.64, help="camera height [m] (the samples' folder gives 1.64)")
+    ap.add_argument("--out", type=Path, default=None, help="folder for overlays")
+    args = ap.parse_args()
+    if args.out is not None:
+        args.out.mkdir(parents=True, exist_ok=True)
+    tried = moved = 0
+    for name in args.frames:
+        t, m = sweep(name, args.height, args.out)
+        tried, moved = tried + t, moved + m
+    print(f"{moved} of {tried} placements moved a boundary by more than {TOLERANCE_PX} px below the car")
+
+
+if __name__ == "__main__":
+    main()
