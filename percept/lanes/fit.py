@@ -161,11 +161,13 @@ def _straight(cfg: FitConfig) -> FitConfig:
 
 STRAIGHT_MARGIN = 1.1
 """With ``FitConfig.straight_seeds``, a lane grown from a straight start replaces the best grown from the seeds' own
-near-range fits only when its evidence is this many times stronger. Measured on TuSimple 1.jpg and on it with a car
-pasted over the far end of its right line, fitted at camera heights 1.55-1.85 m (steps of 25 mm): a few scattered
-points near the car bent the near-range fit at three heights (curvature -0.0024 to -0.0145 1/m, heading down to
--7.5 deg), its bent boundaries then gated out the far dashes, and the straight start gathered 1.14-1.30 times the
-evidence; where nothing bent, a straight start that won did so by 1.01-1.06 times."""
+near-range fits only when its evidence is this many times stronger. Measured on TuSimple 1.jpg, and on it with a
+car pasted over the far end of its right line, at camera heights 1.55-1.85 m: where a few scattered near points
+bent the near-range fit and its boundaries then gated out their own far dashes (curvature down to -0.0145 1/m,
+heading down to -7.5 deg), the straight start gathered 1.12-1.30 times the evidence; where nothing bent, a straight
+start that was stronger was so by 1.01-1.06 times (at 1.64 m it took 1.jpg's right boundary 15 px to the left at
+the bottom row, and less on its dashes than 25 px to the right). The margin lies between the two, with little room
+on either side."""
 
 
 GROW_REACH_M = (35.0,)
