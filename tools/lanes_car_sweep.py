@@ -1,7 +1,7 @@
 """A car straddling an ego lane line: how far does the fitted lane move?
 
-Pastes the dark SUV of TuSimple 3.jpg (rows 228-378, columns 175-372), scaled to 1.9 m wide, with its bottom centre
-on the left or the right ego boundary of a TuSimple sample at ranges of 12-50 m, and reports per placement the
+Pastes the dark SUV of TuSimple 3.jpg (its outline only, CAR_OUTLINE_PX), scaled to 1.9 m wide, with its bottom
+centre on the left or the right ego boundary of a TuSimple sample at ranges of 12-50 m, and reports per placement the
 lane's curvature, heading, width and confidence and how far each boundary moved (max |du| [px]) in the rows below
 the car, against the same frame without the car.
 
@@ -25,13 +25,18 @@ from percept.sensors import read_image
 
 SAMPLES = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "tusimple-samples"
 RANGES_M = (12, 16, 20, 25, 30, 40, 50)
+CAR_OUTLINE_PX = np.array([(180, 376), (180, 262), (187, 250), (200, 240), (212, 236), (317, 235), (335, 250),
+                           (350, 272), (366, 283), (366, 300), (363, 376)], np.int32)
+"""The SUV's outline in 3.jpg (u, v) [px]: the road and the markings around it stay out of the paste."""
 CAR_WIDTH_M = 1.9
 TOLERANCE_PX = 20
 
 
 def sweep(name: str, height_m: float, out: Path | None) -> tuple[int, int]:
     """Placements tried and those that moved a boundary by more than TOLERANCE_PX below the car."""
-    car = read_image(SAMPLES / "3.jpg")[228:378, 175:372]
+    u, v, w, h = cv2.boundingRect(CAR_OUTLINE_PX)
+    car = read_image(SAMPLES / "3.jpg")[v:v + h, u:u + w]
+    outline = cv2.fillPoly(np.zeros((h, w), np.uint8), [CAR_OUTLINE_PX - [u, v]], 255)
     frame = read_image(SAMPLES / name)
     lanes = FootageLanes(RealLaneConfig(mount_height_m=height_m))
     plain = lanes.still(frame)
@@ -55,8 +60,9 @@ def sweep(name: str, height_m: float, out: Path | None) -> tuple[int, int]:
             if b - a < 8:
                 continue
             image = frame.copy()
-            image[v_bottom - h_px:v_bottom, a:b] = cv2.resize(car, (w_px, h_px), interpolation=cv2.INTER_AREA)[
-                :, a - u0:b - u0]
+            pasted = cv2.resize(car, (w_px, h_px), interpolation=cv2.INTER_AREA)[:, a - u0:b - u0]
+            inside = cv2.resize(outline, (w_px, h_px), interpolation=cv2.INTER_AREA)[:, a - u0:b - u0] > 127
+            image[v_bottom - h_px:v_bottom, a:b][inside] = pasted[inside]
             r = lanes.still(image)
             after = r.u_at_rows(rows)
             below = rows > v_bottom
