@@ -1,13 +1,15 @@
 """A car straddling an ego lane line: how far does the fitted lane move?
 
 Pastes the dark SUV of TuSimple 3.jpg (its outline only, CAR_OUTLINE_PX), scaled to 1.9 m wide, with its bottom
-centre on the left or the right ego boundary of a TuSimple sample at ranges of 12-50 m, and reports per placement the
-lane's curvature, heading, width and confidence and how far each boundary moved (max |du| [px]) in the rows below
-the car, against the same frame without the car.
+centre on the left or the right ego boundary of each frame at ranges of 12-50 m, and reports per placement the lane's
+curvature, heading, width and confidence and how far each boundary moved (max |du| [px]) in the rows below the car,
+against the same frame without the car.
 
-    python tools/lanes_car_sweep.py 1.jpg 2.jpg [--height 1.64] [--out DIR]
+    python tools/lanes_car_sweep.py FRAME... [--calib FILE] [--height M] [--out DIR]
 
-``--out`` writes a small overlay per placement. Needs ../shared/data/tusimple-samples.
+FRAME: image files of one camera (a TuSimple sample name such as 1.jpg means that sample). Without ``--height``
+the camera height is measured over the frames, as ``percept lanes`` does for a folder. ``--out`` writes a small
+overlay per placement. Needs ../shared/data/tusimple-samples (the car comes from 3.jpg).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import numpy as np
 
 from percept.lanes.overlay import draw_overlay
 from percept.lanes.realworld import FootageLanes, RealLaneConfig
-from percept.sensors import read_image
+from percept.sensors import CameraCalibration, read_image
 
 SAMPLES = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "tusimple-samples"
 RANGES_M = (12, 16, 20, 25, 30, 40, 50)
@@ -32,18 +34,23 @@ CAR_WIDTH_M = 1.9
 TOLERANCE_PX = 20
 
 
-def sweep(name: str, height_m: float, out: Path | None) -> tuple[int, int]:
-    """Placements tried and those that moved a boundary by more than TOLERANCE_PX below the car."""
+def frame_path(name: str) -> Path:
+    """A TuSimple sample's path for its bare name, else the path given."""
+    return SAMPLES / name if not Path(name).exists() and (SAMPLES / name).exists() else Path(name)
+
+
+def sweep(path: Path, frame: np.ndarray, lanes: FootageLanes, out: Path | None) -> tuple[int, int]:
+    """Placements tried on ``frame`` (as the fit sees it: undistorted) and those that moved a boundary by more than
+    TOLERANCE_PX below the car."""
     u, v, w, h = cv2.boundingRect(CAR_OUTLINE_PX)
     car = read_image(SAMPLES / "3.jpg")[v:v + h, u:u + w]
     outline = cv2.fillPoly(np.zeros((h, w), np.uint8), [CAR_OUTLINE_PX - [u, v]], 255)
-    frame = read_image(SAMPLES / name)
-    lanes = FootageLanes(RealLaneConfig(mount_height_m=height_m))
     plain = lanes.still(frame)
+    height_m = plain.rig.mount_height_m
     rows = np.arange(160, frame.shape[0], 10)
     before = plain.u_at_rows(rows)
     e = plain.estimate
-    print(f"{name} at {height_m} m, no car: curvature {e.curvature_1pm:+.5f} 1/m, heading "
+    print(f"{path.name} at {height_m:.2f} m, no car: curvature {e.curvature_1pm:+.5f} 1/m, heading "
           f"{math.degrees(e.heading_rad):+.2f} deg, width {e.width_m:.2f} m")
     tried = moved = 0
     for side in ("left", "right"):
@@ -76,21 +83,30 @@ def sweep(name: str, height_m: float, out: Path | None) -> tuple[int, int]:
                   f"moved below the car: left {worst['left']:.0f} px, right {worst['right']:.0f} px")
             if out is not None:
                 small = cv2.resize(draw_overlay(image, r, f"car on the {side} line at {x} m"), (640, 360))
-                cv2.imwrite(str(out / f"{Path(name).stem}_{side}_{x}m.png"), small)
+                cv2.imwrite(str(out / f"{path.stem}_{side}_{x}m.png"), small)
     return tried, moved
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("frames", nargs="+", help="TuSimple sample names, e.g. 1.jpg 2.jpg")
-    ap.add_argument("--height", type=float, default=1.64, help="camera height [m] (the samples' folder gives 1.64)")
+    ap.add_argument("frames", nargs="+", help="image files of one camera, or TuSimple sample names (1.jpg)")
+    ap.add_argument("--calib", type=Path, default=None, help="calibration file from `percept calibrate`")
+    ap.add_argument("--height", type=float, default=None, help="camera height [m] (default: from the frames)")
     ap.add_argument("--out", type=Path, default=None, help="folder for overlays")
     args = ap.parse_args()
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
+    paths = [frame_path(n) for n in args.frames]
+    lanes = FootageLanes(RealLaneConfig(mount_height_m=args.height),
+                         CameraCalibration.load(args.calib) if args.calib else None)
+    # undistorted once here, so that the car is pasted where the fit sees the road
+    frames = [lanes.prepare(read_image(p)) for p in paths]
+    lanes._undistort = None
+    if args.height is None:
+        lanes.calibrate(frames)
     tried = moved = 0
-    for name in args.frames:
-        t, m = sweep(name, args.height, args.out)
+    for path, frame in zip(paths, frames):
+        t, m = sweep(path, frame, lanes, args.out)
         tried, moved = tried + t, moved + m
     print(f"{moved} of {tried} placements moved a boundary by more than {TOLERANCE_PX} px below the car")
 
