@@ -60,7 +60,7 @@ def sweep(path: Path, frame: np.ndarray, lanes: FootageLanes, out: Path | None) 
             w_px = int(round(plain.rig.camera.fx * CAR_WIDTH_M / x))
             h_px = int(round(w_px * car.shape[0] / car.shape[1]))
             u_c = plain.u_at_rows(np.array([v_bottom]))[side][0]
-            if v_bottom >= frame.shape[0] - 1 or not np.isfinite(u_c):
+            if v_bottom >= frame.shape[0] - 1 or v_bottom < h_px or not np.isfinite(u_c):
                 continue
             u0 = int(round(u_c - w_px / 2))
             a, b = max(u0, 0), min(u0 + w_px, frame.shape[1])
