@@ -101,7 +101,7 @@ def main() -> None:
                          CameraCalibration.load(args.calib) if args.calib else None)
     # undistorted once here, so that the car is pasted where the fit sees the road
     frames = [lanes.prepare(read_image(p)) for p in paths]
-    lanes._undistort = None
+    lanes = lanes.for_prepared()
     if args.height is None:
         lanes.calibrate(frames)
     tried = moved = 0

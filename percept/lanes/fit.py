@@ -41,7 +41,8 @@ class FitConfig:
 
 def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list[np.ndarray]:
     """Without a prediction: side assignments seeded by the strongest pairs of near-range lateral clusters that
-    straddle the car about a lane apart (each is fitted; the fit with the strongest evidence wins)."""
+    straddle the car about a lane apart, each distinct one once (each is fitted; the fit with the strongest evidence
+    wins)."""
     near = pts[:, 0] < 16.0
     if near.sum() < 4:
         return []
@@ -66,13 +67,16 @@ def _initial_sides(pts: np.ndarray, cfg: FitConfig, candidates: int = 4) -> list
         others = others[others > 0.2]
         return min(cfg.gate_m, 0.5 * float(others.min())) if others.size else cfg.gate_m
 
-    out = []
+    out, seen = [], set()
     for _, yl, yr in pairs[:candidates]:
         # straight-line seeds over the near range only; the fit then grows along each boundary
         sides = np.zeros(len(pts), dtype=int)
         sides[near & (np.abs(pts[:, 1] - yl) < gate(yl))] = 1
         sides[near & (np.abs(pts[:, 1] - yr) < gate(yr))] = -1
-        out.append(sides)
+        # neighbouring pairs often gate the same points: each distinct seed is grown once
+        if sides.tobytes() not in seen:
+            seen.add(sides.tobytes())
+            out.append(sides)
     return out
 
 

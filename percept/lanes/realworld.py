@@ -10,6 +10,7 @@ tracking at an assumed speed. Each boundary is reported from the bottom row to t
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 
@@ -190,6 +191,13 @@ class FootageLanes:
         if image is None or image.ndim != 3 or image.shape[2] != 3:
             raise ValueError("expected a BGR colour image")
         return image if self._undistort is None else self._undistort(image)
+
+    def for_prepared(self) -> "FootageLanes":
+        """The same camera (and height) for images ``prepare`` has already undistorted: a runner that takes them as
+        they are (a tool that draws on the undistorted image before fitting, for instance)."""
+        out = copy.copy(self)
+        out._undistort = None
+        return out
 
     def camera(self, width: int, height: int) -> PinholeCamera:
         if self.calibration is not None:

@@ -108,6 +108,18 @@ def test_calibrated_images_through_the_cli(calib_file, tmp_path):
     assert d["summary"]["both_boundaries"] == 8
 
 
+@needs_lanes
+def test_a_runner_for_prepared_images_fits_what_the_calibrated_runner_fits(calib_file):
+    raw = read_image(LANES / "test_images" / "test2.jpg")
+    lanes = FootageLanes(RealLaneConfig(), CameraCalibration.load(calib_file))
+    undistorted = lanes.prepare(raw)
+    assert not np.array_equal(undistorted, raw)
+    prepared = lanes.for_prepared()
+    # the same fit from the undistorted image as from the raw one; the calibrated runner still undistorts
+    assert prepared.still(undistorted).to_dict() == lanes.still(raw).to_dict()
+    assert prepared.prepare(undistorted) is undistorted and lanes.prepare(raw) is not raw
+
+
 @pytest.mark.skipif(not VIDEO.is_file(), reason=f"{VIDEO} is absent (real data in ../shared/data)")
 def test_video_runs_end_to_end(tmp_path):
     js = tmp_path / "video.json"
