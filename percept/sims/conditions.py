@@ -86,6 +86,12 @@ class ConditionEffects:
         self._haze_lit = tuple(float(c) for c in np.float32(0.38) * np.array([150, 150, 145], np.float32)) + (0.0,)
         self.H, self.W = H, W
 
+    @property
+    def reads_emission(self) -> bool:
+        """Whether ``apply`` reads the renderer's lamp map (only the night does: what glows), so that a renderer can
+        skip drawing one for the other conditions."""
+        return self.condition is Condition.NIGHT
+
     def night_gain(self, inv_depth: np.ndarray | None, camera: int) -> np.ndarray:
         """(H, W) light reaching each pixel's surface at night: ambient plus the headlight beam, which lights
         points ahead within about 1.5 m of the ego's centreline, widening and fading with distance. Computed from

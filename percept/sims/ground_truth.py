@@ -105,35 +105,45 @@ _BOX_GRID = np.array([[a, b, h] for a in (-0.5, 0, 0.5) for b in (-0.5, 0, 0.5) 
 """Corners, edge and face centres of a box as fractions of its (length, width, height), from its base centre (27, 3)."""
 
 
-def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> float:
-    """Share of the box that bounds the projections of ``points_c`` (camera frame, (N, 3) [m]) inside the image; 1
-    when some point is behind the camera (the projection is not a box then)."""
-    if np.any(points_c[:, 2] <= 0.1):
-        return 1.0
-    uv = camera.project(points_c)
-    (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
+def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:
+    """Per object, the share of the box that bounds the projections of its points ``points_c`` (camera frame,
+    (N, K, 3) [m]: K points of each of N objects) inside the image; 1 when some point is behind the camera (the
+    projection is not a box then). (N,)"""
+    behind = np.any(points_c[..., 2] <= 0.1, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        uv = camera.project(points_c)
+    (u0, v0), (u1, v1) = uv.min(axis=1).T, uv.max(axis=1).T
     area = (u1 - u0) * (v1 - v0)
-    if area <= 0:
-        return 1.0
     # the part of the box inside [0, W] x [0, H]
-    inside = max(min(u1, camera.width) - max(u0, 0.0), 0.0) * max(min(v1, camera.height) - max(v0, 0.0), 0.0)
-    return float(inside / area)
+    inside = (np.maximum(np.minimum(u1, camera.width) - np.maximum(u0, 0.0), 0.0)
+              * np.maximum(np.minimum(v1, camera.height) - np.maximum(v0, 0.0), 0.0))
+    ok = ~behind & ~(area <= 0)
+    return np.where(ok, inside / np.where(ok, area, 1.0), 1.0)
 
 
-def object_truth(state: ObjectState, ego: Pose2D, camera: PinholeCamera, cam_from_vehicle: Transform, box_px,
-                 visible: float, crossing: bool) -> ObjectTruth:
-    """Vehicle-frame position and camera distance of one object; ``camera``, ``cam_from_vehicle``: the left
-    camera's intrinsics and its ``StereoRig.cam_from_vehicle()`` (built once for all the objects of a frame)."""
-    c = ego.to_vehicle_xy(np.array([state.pose.x_m, state.pose.y_m]))
-    yaw = float(wrap_angle(state.pose.yaw_rad - ego.yaw_rad))
+def objects_truth(states: list[ObjectState], ego: Pose2D, camera: PinholeCamera, cam_from_vehicle: Transform,
+                  boxes_px: list, visible: list[float], crossing: list[bool]) -> tuple[ObjectTruth, ...]:
+    """Vehicle-frame position and camera distance of each object of a frame (one entry of ``boxes_px``, ``visible``
+    and ``crossing`` each); ``camera``, ``cam_from_vehicle``: the left camera's intrinsics and its
+    ``StereoRig.cam_from_vehicle()``. All objects at once: the same arithmetic element by element as one by one."""
+    if not states:
+        return ()
+    c = ego.to_vehicle_xy(np.array([[s.pose.x_m, s.pose.y_m] for s in states]))
+    yaw = wrap_angle(np.array([s.pose.yaw_rad for s in states]) - ego.yaw_rad)
     # nearest point of the 3D box: sample its corners and face centres in the left camera
-    cy, sy = np.cos(yaw), np.sin(yaw)
-    L, W, H = state.length_m, state.width_m, state.height_m
-    local = _BOX_GRID * np.array([L, W, H])
-    pts = np.column_stack([c[0] + cy * local[:, 0] - sy * local[:, 1], c[1] + sy * local[:, 0] + cy * local[:, 1],
-                           local[:, 2]])
-    pc = cam_from_vehicle.apply(pts)
-    if box_px is not None:
-        visible *= in_frame_share(camera, pc)
-    return ObjectTruth(state.obj_id, state.kind, box_px, float(visible), float(pc[:, 2].min()),
-                       (float(c[0]), float(c[1]), H / 2), (L, W, H), yaw, state.speed_mps, crossing, state.marker_id)
+    cy, sy = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
+    size = np.array([[s.length_m, s.width_m, s.height_m] for s in states])
+    local = _BOX_GRID[None] * size[:, None, :]
+    pts = np.stack([c[:, :1] + cy * local[..., 0] - sy * local[..., 1], c[:, 1:] + sy * local[..., 0]
+                    + cy * local[..., 1], local[..., 2]], axis=-1)
+    pc = cam_from_vehicle.apply(pts.reshape(-1, 3)).reshape(pts.shape)
+    share = in_frame_share(camera, pc)
+    nearest = pc[..., 2].min(axis=1)
+    out = []
+    for k, st in enumerate(states):
+        seen = float(visible[k] * share[k]) if boxes_px[k] is not None else float(visible[k])
+        L, W, H = st.length_m, st.width_m, st.height_m
+        out.append(ObjectTruth(st.obj_id, st.kind, boxes_px[k], seen, float(nearest[k]),
+                               (float(c[k, 0]), float(c[k, 1]), H / 2), (L, W, H), float(yaw[k]), st.speed_mps,
+                               crossing[k], st.marker_id))
+    return tuple(out)

@@ -6,14 +6,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from percept.sensors import Frame, LandmarkMap, Side, StereoRig
+from percept.sensors import Frame, LandmarkMap, Pose2D, Side, StereoRig
 from percept.sensors.vehicle import SIGN_PANEL_CENTRE_M
 
 from .actors import Pedestrian, Sign
 from .conditions import Condition, ConditionEffects, is_dropped
 from .coords import hw_to_world_xy
 from .env import PerceptEnv
-from .ground_truth import GroundTruth, lane_truth, object_truth
+from .ground_truth import GroundTruth, lane_truth, objects_truth
 from .imu import ImuModel
 from .render import StereoRenderer
 from .road_geometry import build_road_geometry
@@ -118,7 +118,7 @@ class SimWorld:
         imu, wheel = self.imu.measure(truth_imu, float(ego.speed), self.dt)
         dropped = is_dropped(self.cfg.condition, self.cfg.seed, self.frame_index)
         if render:
-            img = self.renderer.render(scene)
+            img = self.renderer.render(scene, emission=self.effects.reads_emission)
             left = self.effects.apply(img.left, self.cfg.seed, self.frame_index, 0, img.inv_depth[0], img.emission[0])
             right = self.effects.apply(img.right, self.cfg.seed, self.frame_index, 1, img.inv_depth[1],
                                        img.emission[1])
@@ -127,19 +127,13 @@ class SimWorld:
             left = right = None
             depth = np.full((rig.camera.height, rig.camera.width), np.nan, np.float32)
             boxes, visible = {}, {}
-        objects = []
-        cam_from_vehicle = rig.cam_from_vehicle(Side.LEFT)
-        for st in scene.objects:
-            dx, dy = st.pose.x_m - scene.ego.x_m, st.pose.y_m - scene.ego.y_m
-            if dx * dx + dy * dy > TRUTH_RANGE_M ** 2:
-                continue
-            src = self.ids.objects[st.obj_id]
-            crossing = bool(getattr(src, "crossing", False))
-            objects.append(object_truth(st, scene.ego, rig.camera, cam_from_vehicle, boxes.get(st.obj_id),
-                                        visible.get(st.obj_id, 0.0), crossing))
+        near = [st for st in scene.objects if _within(st.pose, scene.ego, TRUTH_RANGE_M)]
+        objects = objects_truth(near, scene.ego, rig.camera, rig.cam_from_vehicle(Side.LEFT),
+                                [boxes.get(st.obj_id) for st in near], [visible.get(st.obj_id, 0.0) for st in near],
+                                [bool(getattr(self.ids.objects[st.obj_id], "crossing", False)) for st in near])
         ped_hit = tuple(self.ids(p) for p in self.env.road.objects
                         if isinstance(p, Pedestrian) and (p.crashed or p.hit))
-        gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), tuple(objects), depth, truth_imu,
+        gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), objects, depth, truth_imu,
                          bool(ego.crashed), ped_hit)
         frame = Frame(self.frame_index, self.time_s, None if dropped else left, None if dropped else right, imu, wheel)
         return frame, gt
@@ -162,3 +156,9 @@ class SimWorld:
                 x, y = hw_to_world_xy(o.position)
                 out[o.marker_id] = [float(x), float(y), SIGN_PANEL_CENTRE_M]
         return LandmarkMap.from_dict(out)
+
+
+def _within(a: Pose2D, b: Pose2D, range_m: float) -> bool:
+    """Whether ``a`` lies within ``range_m`` of ``b`` on the ground: dx² + dy² <= range²."""
+    dx, dy = a.x_m - b.x_m, a.y_m - b.y_m
+    return not dx * dx + dy * dy > range_m ** 2

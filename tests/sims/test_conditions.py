@@ -115,6 +115,8 @@ def test_world_applies_the_condition_to_both_cameras(clear):
     effects = ConditionEffects(rig, Condition.NIGHT)
     assert np.array_equal(night.left, effects.apply(frame.left, 0, 0, 0, img.inv_depth[0], img.emission[0]))
     assert np.array_equal(night.right, effects.apply(frame.right, 0, 0, 1, img.inv_depth[1], img.emission[1]))
+    # only the night reads the lamp map, so the world renders it only then
+    assert [c for c in Condition if ConditionEffects(rig, c).reads_emission] == [Condition.NIGHT]
 
 
 def test_the_headlight_beam_lies_on_the_world_so_both_cameras_see_it_at_the_surface_s_disparity(clear):

@@ -118,3 +118,29 @@ def test_same_inputs_render_identical_frames(rig, road):
     for name in ("left", "right", "depth_m", "ids"):
         assert getattr(a, name).tobytes() == getattr(b, name).tobytes(), name
     assert a.boxes_px == b.boxes_px and a.visible == b.visible
+
+
+def test_the_reused_winner_map_is_left_clear_and_an_interrupted_frame_does_not_leak(rig, road):
+    # the large patches' scratch map is lent to each frame and cleared over the boxes it drew on
+    scene = Scene(EGO, (car(1, EGO.x_m + 8.0), car(2, EGO.x_m + 20.0, EGO.y_m + 4.0, style=5)))
+    r = StereoRenderer(rig, road, seed=11)
+    first = r.render(scene)
+    for side in (Side.LEFT, Side.RIGHT):
+        assert (r._winners[side].map == -1).all(), side
+    # a rasterisation stopped half-way (Ctrl-C) leaves the map lent and dirty: the next frame fills it afresh
+    dirty = r._winners[Side.LEFT].take()
+    dirty[200:400, 100:500] = 3
+    again = r.render(scene)
+    for name in ("left", "right", "depth_m", "ids"):
+        assert getattr(first, name).tobytes() == getattr(again, name).tobytes(), name
+    assert (r._winners[Side.LEFT].map == -1).all()
+
+
+def test_without_the_lamp_map_the_frames_are_the_same(rig, road):
+    scene = Scene(EGO, (car(1, EGO.x_m + 8.0), car(2, EGO.x_m + 30.0, EGO.y_m + 4.0, style=5)))
+    r = StereoRenderer(rig, road, seed=11)
+    lit, plain = r.render(scene), r.render(scene, emission=False)
+    assert lit.emission[0].max() == 1.0 and plain.emission == (None, None)
+    for name in ("left", "right", "depth_m", "ids"):
+        assert getattr(lit, name).tobytes() == getattr(plain, name).tobytes(), name
+    assert lit.boxes_px == plain.boxes_px and lit.visible == plain.visible

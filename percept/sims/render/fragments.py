@@ -21,7 +21,7 @@ import numpy as np
 
 from percept.compiled import optional
 
-from .pixels import big_patches, put_albedo, shade_winners, small_fragments, texel_coords
+from .pixels import big_patches, clear_boxes, put_albedo, shade_winners, small_fragments, texel_coords
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
 
@@ -33,6 +33,25 @@ NEAR_M = 0.3
 INV_NEAR = 1.0 / NEAR_M
 _ALBEDO = (np.arange(256, dtype=np.float32) * np.float32(1.0 / 255.0)).reshape(256, 1, 1)
 """Texel value / 255, the colour map of a patch's albedo when multiplied by its colour."""
+
+
+class WinnerMap:
+    """A camera's (H, W) int32 scratch map for ``big_patches`` (which patch holds each pixel), all -1 between
+    frames: lent to one rasterisation at a time and cleared over the boxes it drew on, so that no frame fills a
+    fresh one; filled again if a rasterisation did not give it back (interrupted)."""
+
+    def __init__(self, shape: tuple[int, int]):
+        self.map = np.full(shape, -1, np.int32)
+        self._lent = False
+
+    def take(self) -> np.ndarray:
+        if self._lent:
+            self.map.fill(-1)
+        self._lent = True
+        return self.map
+
+    def give_back(self) -> None:
+        self._lent = False
 
 
 @dataclass
@@ -125,15 +144,24 @@ def _big_patches(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndar
     h = p.y1[front] - p.y0[front]
     span_row[front] = np.cumsum(h) - h
     textured = p.entry >= 0
-    winner = np.full(target.inv_depth.shape, -1, np.int32)
+    winner = target.winner.take() if target.winner is not None else np.full(target.inv_depth.shape, -1, np.int32)
     held, ends, sil_pix, sil_oid = big_patches(
         target.inv_depth, optional(target.ids, np.int32), optional(target.emission, np.float32), target.image,
         winner, order, p.x0, p.x1, p.y0, p.y1, p.ma, p.mb, p.mc, p.ellipse, span_row, los, his, p.obj_id, p.emissive,
         p.color, textured, sil is not None, np.float32(INV_NEAR))
     _add_silhouettes(sil, sil_pix, sil_oid)
     ks = np.flatnonzero(textured[order] & (held > 0))
-    if not len(ks):
-        return
+    if len(ks):
+        _put_textures(target, p, atlas, order, ks, ends, winner)
+    if target.winner is not None:
+        clear_boxes(winner, order, p.x0, p.x1, p.y0, ends)
+        target.winner.give_back()
+
+
+def _put_textures(target, p: PreparedPatches, atlas: TextureAtlas, order: np.ndarray, ks: np.ndarray,
+                  ends: np.ndarray, winner: np.ndarray) -> None:
+    """The textured big patches ``order[ks]`` warped by OpenCV over their boxes down to ``ends`` and written where
+    ``winner`` still names them."""
     idx = order[ks]
     x0s, x1s, y0s, y_ends = p.x0[idx].tolist(), p.x1[idx].tolist(), p.y0[idx].tolist(), ends[ks].tolist()
     # colour * albedo / 255, per channel, as a 256-entry colour map of the albedo

@@ -191,10 +191,8 @@ class GroundLayer:
             self._index = (road, RoadIndex(road))
         return self._index[1]
 
-    def paint(self, pose: Pose2D, road: RoadGeometry, prepared: GroundPaint | None = None, depth: bool = True
-              ) -> tuple[np.ndarray, np.ndarray | None]:
-        """Sky, grass, road surface and markings: image (H, W, 3) uint8 and depth (H, W) float32 [m] (a fresh
-        copy, or None when not ``depth``).
+    def paint(self, pose: Pose2D, road: RoadGeometry, prepared: GroundPaint | None = None) -> np.ndarray:
+        """Sky, grass, road surface and markings: image (H, W, 3) uint8 (its depth is ``ground_depth``).
 
         prepared: the road's polygons near ``pose`` (``ground_paint``), shared by the two cameras."""
         cam = self.rig.camera
@@ -203,7 +201,7 @@ class GroundLayer:
         img = np.empty((H, W, 3), np.uint8)
         img[:r0] = self.sky[:r0]
         if r0 >= H:
-            return img, self.ground_depth.copy() if depth else None
+            return img
         grain = self.grain(pose)
         if prepared is None:
             prepared = ground_paint(self.road_index(road), pose, self.rig, self.palette)
@@ -221,7 +219,7 @@ class GroundLayer:
         h0, h1 = self.haze_rows
         if h1 > h0:
             _haze(img, self._haze_keep, self._haze_add, h0)
-        return img, self.ground_depth.copy() if depth else None
+        return img
 
 
 @kernel()

@@ -100,6 +100,28 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
 
 
 @kernel()
+def clear_boxes(winner, order, x0, x1, y0, ends):  # pragma: no cover - compiled
+    """Set ``winner`` back to -1 over each box k of ``big_patches`` (patch ``order[k]``'s columns x0..x1, rows
+    y0 up to ``ends[k]``, the row after the last one it won a pixel in): everywhere it wrote."""
+    for k in range(len(order)):
+        i = order[k]
+        for y in range(y0[i], ends[k]):
+            for x in range(x0[i], x1[i]):
+                winner[y, x] = -1
+
+
+@kernel()
+def zbuffer_depth(inv, base, background):  # pragma: no cover - compiled
+    """Depth (H, W) float32 [m]: 1 / ``inv`` wherever a patch won the z-test (``inv`` differs from ``base``, what
+    the z-buffer held before any patch), else ``background``'s (float32 1/x, as numpy divides)."""
+    out = np.empty_like(background)
+    for y in range(inv.shape[0]):
+        for x in range(inv.shape[1]):
+            out[y, x] = f32(1.0) / inv[y, x] if inv[y, x] != base[y, x] else background[y, x]
+    return out
+
+
+@kernel()
 def put_albedo(img, alb, lut, winner, k, x0, y0):  # pragma: no cover - compiled
     """``img`` (H, W, 3) uint8 = ``lut[alb]`` (the colour map (256, 1, 3) uint8 of the albedo ``alb`` (h, w) uint8
     warped over the box from (x0, y0)) wherever ``winner`` names patch k."""

@@ -26,9 +26,9 @@ from percept.compiled import optional
 from percept.sensors import PinholeCamera, Transform
 
 from .cull import inverse_rows, project_patches
-from .fragments import NEAR_M, PreparedPatches, rasterize_prepared
+from .fragments import NEAR_M, PreparedPatches, WinnerMap, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
-from .pixels import silhouette_stats
+from .pixels import silhouette_stats, zbuffer_depth
 from .textures import TextureAtlas
 from .vec3 import cross, dot
 
@@ -57,6 +57,8 @@ class RenderTarget:
     silhouettes: dict[int, list[np.ndarray]] = field(default_factory=dict)
     """Per object id, flat pixel indices (row * W + col) its patches cover before the z-test: the
     silhouette without occluders (may repeat pixels)."""
+    winner: WinnerMap | None = None
+    """The camera's scratch map for the large patches, reused from frame to frame (None: a fresh one is filled)."""
 
     def __post_init__(self) -> None:
         if self.inv_depth is None:
@@ -102,8 +104,9 @@ def warm_up() -> None:
     """Compile the rasteriser's kernels (numba: the first time after an install) or load them from numba's disk
     cache (about 0.5 s with the renderer's other kernels), once per process, by drawing a small synthetic scene
     through every path the renderer takes: large and small patches, textured and not, quads and discs, a lamp, a
-    patch cut by the near plane, into a left camera's targets (depth, ids, silhouettes) and a right one's. The
-    renderer calls it when it is built, so that no timed frame pays for it."""
+    patch cut by the near plane, into a left camera's targets (depth, ids, silhouettes, the depth taken from the
+    z-buffer) and a right one's, each with a reused winner map. The renderer calls it when it is built, so that no
+    timed frame pays for it."""
     if _WARM:
         return
     cam = PinholeCamera(150.0, 150.0, 80.0, 60.0, 160, 120)
@@ -120,11 +123,12 @@ def warm_up() -> None:
         h, w = cam.height, cam.width
         target = RenderTarget(np.zeros((h, w, 3), np.uint8), np.full((h, w), np.inf, np.float32) if left else None,
                               np.zeros((h, w), np.int32) if left else None, np.zeros((h, w), np.float32),
-                              emission=np.zeros((h, w), np.float32))
+                              emission=np.zeros((h, w), np.float32), winner=WinnerMap((h, w)))
         rasterize(target, batch, cam, Transform(np.eye(3), np.zeros(3)), atlas, np.array([0.0, 0.0, -1.0]),
                   silhouettes=left)
         if left:
             target.silhouette(1)
+            zbuffer_depth(target.inv_depth, target.base_inv_depth, target.depth)
     _WARM.append(True)
 
 

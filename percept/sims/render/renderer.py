@@ -21,10 +21,11 @@ from percept.sensors import Pose2D, Side, StereoRig
 
 from ..road_geometry import RoadGeometry
 from .ground import GroundLayer, Palette
-from .fragments import PreparedPatches, rasterize_prepared
+from .fragments import PreparedPatches, WinnerMap, rasterize_prepared
 from .paint import GroundPaint, ground_paint
 from .patches import SUN_DIR, PatchBatch, PatchBuilder
 from .pedestrian import pedestrian_packed
+from .pixels import zbuffer_depth
 from .raster import LOD_PX, RenderTarget, prepare, warm_up
 from .scene import ObjectKind, ObjectState, Scene
 from .scenery import SceneryTextures, build_scenery
@@ -43,7 +44,7 @@ class StereoImages:
     boxes_px: obj id -> (u0, v0, u1, v1) tight box of the object's unoccluded silhouette in the left image [px],
     u1 and v1 exclusive; visible: obj id -> fraction 0..1 of that silhouette not hidden by nearer things;
     inv_depth, emission: (left, right) (H, W) float32 maps of each camera: 1/z [1/m] (0 for sky) and the
-    fraction of each pixel that is a lamp."""
+    fraction of each pixel that is a lamp (each None when rendered without it)."""
 
     left: np.ndarray
     right: np.ndarray
@@ -64,6 +65,7 @@ class StereoRenderer:
         self.rig = rig
         self.road = road
         self.layers = {s: GroundLayer(rig, s, seed, palette) for s in (Side.LEFT, Side.RIGHT)}
+        self._winners = {s: WinnerMap((rig.camera.height, rig.camera.width)) for s in (Side.LEFT, Side.RIGHT)}
         self.road_index = self.layers[Side.LEFT].road_index(road)
         self.layers[Side.RIGHT]._index = (road, self.road_index)  # one road index for both cameras
         self.textures: list[np.ndarray] = [panel_texture(seed + 1), foliage_texture(seed + 2)]
@@ -185,26 +187,35 @@ class StereoRenderer:
 
     def render_side(self, scene: Scene, side: Side, patches: PatchBatch | None = None,
                     prepared_ground: GroundPaint | None = None, ids: bool = True,
-                    prepared: PreparedPatches | None = None, depth: bool = True) -> RenderTarget:
-        """One camera's image and, if asked, its depth, object ids and silhouettes (``ids``)."""
+                    prepared: PreparedPatches | None = None, depth: bool = True, emission: bool = True
+                    ) -> RenderTarget:
+        """One camera's image and, if asked, its depth, object ids and silhouettes (``ids``) and its lamp map
+        (``emission``)."""
         layer = self.layers[side]
-        img, depth = layer.paint(scene.ego, self.road, prepared_ground, depth=depth)
-        target = RenderTarget(img, depth, layer.ground_ids() if ids else None, layer.ground_inv_depth.copy(),
-                              layer.ground_inv_depth, np.zeros(img.shape[:2], np.float32))
+        img = layer.paint(scene.ego, self.road, prepared_ground)
+        target = RenderTarget(img, None, layer.ground_ids() if ids else None, layer.ground_inv_depth.copy(),
+                              layer.ground_inv_depth, np.zeros(img.shape[:2], np.float32) if emission else None,
+                              winner=self._winners[side])
         if prepared is None:
             patches = self.scene_patches(scene) if patches is None else patches
             prepared = prepare(patches, self.rig.camera, [self._cam_from_world(scene, side)], self.atlas, SUN_DIR)[0]
         if prepared is not None:
             rasterize_prepared(target, prepared, self.atlas, ids)
+        if depth:
+            # Z = 1 / (1/Z) wherever a patch won the z-test, the ground's elsewhere
+            target.depth = zbuffer_depth(target.inv_depth, target.base_inv_depth, layer.ground_depth)
         return target
 
-    def render(self, scene: Scene) -> StereoImages:
+    def render(self, scene: Scene, emission: bool = True) -> StereoImages:
+        """Both cameras' images, the left depth, ids and boxes, and each camera's z-buffer and (``emission``) lamp
+        map; without ``emission`` (nothing glows: only the night reads it) the images are the same."""
         patches = self.scene_patches(scene)
         ground = ground_paint(self.road_index, scene.ego, self.rig, self.layers[Side.LEFT].palette)
         sides = (Side.LEFT, Side.RIGHT)
         prep = prepare(patches, self.rig.camera, [self._cam_from_world(scene, s) for s in sides], self.atlas, SUN_DIR)
-        left = self.render_side(scene, Side.LEFT, prepared_ground=ground, prepared=prep[0])
-        right = self.render_side(scene, Side.RIGHT, prepared_ground=ground, ids=False, prepared=prep[1], depth=False)
+        left = self.render_side(scene, Side.LEFT, prepared_ground=ground, prepared=prep[0], emission=emission)
+        right = self.render_side(scene, Side.RIGHT, prepared_ground=ground, ids=False, prepared=prep[1], depth=False,
+                                 emission=emission)
         boxes, visible = {}, {}
         for oid in sorted(left.silhouettes):
             sil = left.silhouette(oid)
