@@ -8,7 +8,8 @@ plane, projected with the ground homography (Hartley & Zisserman, sec. 8.1) and 
 
 Cost per frame: one warp per band from a pre-tiled mip level (texture coordinates stay inside the
 image, OpenCV's fast path), the road surface as a mask OR-ed into the grain (grain values 0..127 are
-grass, 128..255 asphalt), one colour-map lookup, the paint polygons, and haze on the few far rows.
+grass, 128..255 asphalt) in the colour-map lookup (one compiled pass), the paint polygons, and haze on the
+few far rows.
 """
 
 from __future__ import annotations
@@ -125,13 +126,17 @@ class GroundLayer:
         # vehicle-frame ground point of every ground pixel, for the band footprints
         mips = mip_chain(ground_tile(seed, TILE_PX), MIP_LEVELS - 1)
         self.bands: list[_Band] = []
+        self.mean_rows: list[tuple[int, int]] = []
+        """Row ranges no band covers (too far for the coarsest level): they get the tile's mean."""
         r = r0
         while r < H:
             k = int(lvl[r])
             r1 = r
             while r1 < H and int(lvl[r1]) == k:
                 r1 += 1
-            if k < MIP_LEVELS:
+            if k >= MIP_LEVELS:
+                self.mean_rows.append((r, r1))
+            else:
                 # the ground homography maps the band's pixel rectangle to a quadrilateral: its corners bound it
                 pts = self.rig.image_to_ground(np.array([[0, r], [W - 1, r], [0, r1 - 1], [W - 1, r1 - 1]]), self.side)
                 centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
@@ -162,7 +167,9 @@ class GroundLayer:
         """World-locked 7-bit ground albedo (H - first_row, W) uint8 for the vehicle at ``pose``."""
         cam = self.rig.camera
         r0 = self.first_row
-        out = np.full((cam.height - r0, cam.width), 64, np.uint8)
+        out = np.empty((cam.height - r0, cam.width), np.uint8)
+        for a, b in self.mean_rows:
+            out[a - r0:b - r0] = 64
         c, s = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
         Rz = np.array([[c, -s], [s, c]])
         # world position modulo the tile, so texture coordinates stay small
@@ -206,20 +213,30 @@ class GroundLayer:
         if prepared is None:
             prepared = ground_paint(self.road_index(road), pose, self.rig, self.palette)
         surfaces, marks = prepared.project(self.Hg)
-        if surfaces:
-            mask = self._mask
-            mask[r0:] = 0
-            # one call per strip: fillPoly fills overlapping polygons of one call even-odd
-            for polys in surfaces:
-                cv2.fillPoly(mask, polys, 128, lineType=cv2.LINE_8, shift=4)
-            cv2.bitwise_or(grain, mask[r0:], dst=grain)
-        cv2.applyColorMap(grain, self.cmap, dst=img[r0:])
+        mask = self._mask
+        mask[r0:] = 0
+        # one call per strip: fillPoly fills overlapping polygons of one call even-odd
+        for polys in surfaces:
+            cv2.fillPoly(mask, polys, 128, lineType=cv2.LINE_8, shift=4)
+        _colour_map(img, grain, mask, self.cmap, r0)
         for polys, color in marks:
             cv2.fillPoly(img, polys, color, lineType=cv2.LINE_AA, shift=4)
         h0, h1 = self.haze_rows
         if h1 > h0:
             _haze(img, self._haze_keep, self._haze_add, h0)
         return img
+
+
+@kernel()
+def _colour_map(img, grain, mask, cmap, r0):  # pragma: no cover - compiled
+    """Rows r0.. of ``img`` (H, W, 3) uint8 = ``cmap`` (256, 1, 3) of (``grain`` (H - r0, W) | ``mask``'s rows r0..):
+    the road surface OR-ed into the grain and OpenCV's ``applyColorMap`` (grey to BGR, then a lookup per channel)
+    in one pass."""
+    for r in range(grain.shape[0]):
+        for x in range(grain.shape[1]):
+            g = grain[r, x] | mask[r0 + r, x]
+            for ch in range(3):
+                img[r0 + r, x, ch] = cmap[g, 0, ch]
 
 
 @kernel()

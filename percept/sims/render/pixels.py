@@ -110,14 +110,16 @@ def clear_boxes(winner, order, x0, x1, y0, ends):  # pragma: no cover - compiled
                 winner[y, x] = -1
 
 
-@kernel()
+@kernel(error_model="numpy")
 def zbuffer_depth(inv, base, background):  # pragma: no cover - compiled
     """Depth (H, W) float32 [m]: 1 / ``inv`` wherever a patch won the z-test (``inv`` differs from ``base``, what
-    the z-buffer held before any patch), else ``background``'s (float32 1/x, as numpy divides)."""
+    the z-buffer held before any patch), else ``background``'s (float32 1/x, as numpy divides; numpy's error model,
+    so that the loop is not held up by a test for division by zero, whose result is not taken)."""
     out = np.empty_like(background)
     for y in range(inv.shape[0]):
         for x in range(inv.shape[1]):
-            out[y, x] = f32(1.0) / inv[y, x] if inv[y, x] != base[y, x] else background[y, x]
+            d = f32(1.0) / inv[y, x]
+            out[y, x] = d if inv[y, x] != base[y, x] else background[y, x]
     return out
 
 
