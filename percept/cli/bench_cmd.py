@@ -109,6 +109,8 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
                       _spread(c.realtime_factor, c.realtime_factors),
                       _spread(c.realtime_factor_recording, c.realtime_factors_recording))
         console.print(t)
+        console.print("stereo pair alone on each scenario (clear, ms, the median of 20 frames; \"render\" above is "
+                      "the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}" for c in stacks))
         console.print("stereo pair with each condition (highway, ms): " + ", ".join(
             f"{k} {fmt(conditions[k])}" for k in CONDITIONS))
         out.update({"stack": [c.to_dict() for c in stacks],

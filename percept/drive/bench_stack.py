@@ -58,15 +58,18 @@ def middle(values, key=None):
 @dataclass(frozen=True)
 class StackCost:
     """scenario; frames: frames each closed loop ran; timing_ms: the run JSON's (render, each slot,
-    perception_total) [ms/frame] of the unrecorded drive with the median perception_total; peers_ms: the stock way
-    to do each job on the same scenario's frames (people, stereo, lanes) and highway-env's top-down render
-    [ms/frame]; realtime_factors, realtime_factors_recording: each drive's, without / with recording (the drives
+    perception_total) [ms/frame] of the unrecorded drive with the median perception_total (its ``render`` is the mean
+    of the loop's frames, each rendered after the slots have had the caches); stereo_pair_ms: the median cost of one
+    stereo pair alone (``SimWorld.observe``: the render and the ground truth) on the same scenario's autopilot
+    frames [ms]; peers_ms: the stock way to do each job on the same scenario's frames (people, stereo, lanes) and
+    highway-env's top-down render [ms/frame]; realtime_factors, realtime_factors_recording: each drive's, without / with recording (the drives
     alternate, so that a change in the machine's speed falls on both). The median of several is the middle one
     (``middle``), for the timings as for the realtime factors."""
 
     scenario: str
     frames: int
     timing_ms: dict
+    stereo_pair_ms: float
     peers_ms: dict
     realtime_factors: tuple[float, ...]
     realtime_factors_recording: tuple[float, ...]
@@ -95,7 +98,7 @@ class StackCost:
     def to_dict(self) -> dict:
         r = lambda x: None if x is None else round(float(x), 3)  # noqa: E731
         return {"scenario": self.scenario, "frames": self.frames,
-                "timing_ms": {k: r(v) for k, v in self.timing_ms.items()},
+                "timing_ms": {k: r(v) for k, v in self.timing_ms.items()}, "stereo_pair_ms": r(self.stereo_pair_ms),
                 "peers_ms": {k: r(v) for k, v in self.peers_ms.items()}, "stock_ms": r(self.stock_ms),
                 "speedup": r(self.speedup), "realtime_factor": r(self.realtime_factor),
                 "realtime_factor_recording": r(self.realtime_factor_recording),
@@ -144,18 +147,21 @@ class _Ticking:
             self.each_frame(frame.index)
 
 
-def _peer_frames(scenario: str, frames: int) -> tuple[list, float]:
-    """``frames`` frames of ``scenario`` (autopilot, seed 0) and highway-env's top-down render's median [ms]."""
+def _peer_frames(scenario: str, frames: int) -> tuple[list, float, float]:
+    """``frames`` frames of ``scenario`` (autopilot, seed 0), the median cost of observing each (the stereo pair and
+    the ground truth) and highway-env's top-down render's median [ms]."""
     from percept.sims import SimWorld, WorldConfig
 
     world = topdown_ready(SimWorld(WorldConfig(scenario, seed=0, autopilot=True)))
-    shots = []
+    shots, pair_ms = [], []
     for _ in range(frames):
+        t0 = time.perf_counter()
         shots.append(world.observe()[0])
+        pair_ms.append((time.perf_counter() - t0) * 1e3)
         world.step()
     top_ms = median_ms(world.env.render, min(frames, 10))
     world.env.close()
-    return shots, top_ms
+    return shots, float(np.median(pair_ms)), top_ms
 
 
 def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20, repeats: int = 3,
@@ -169,14 +175,14 @@ def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20, rep
             recorded.append(_drive(scenario, seconds, Path(tmp) / "bench.rrd", progress=progress))
     # the stage timings of the median unrecorded drive by perception_total, whole, so that they still add up
     typical = middle(runs, key=lambda r: r["timing_ms"]["perception_total"] or 0.0)
-    shots, top_ms = _peer_frames(scenario, peer_frames)
+    shots, pair_ms, top_ms = _peer_frames(scenario, peer_frames)
     peers, shot = {}, cycle(shots, None)
     for key, make in (("people", people_detector_full_frame), ("stereo", sgbm_full_frame),
                       ("lanes", lane_fit_full_frame)):
         _, fn = make(shots)
         peers[key] = median_ms(lambda: fn(shot()), len(shots))
     peers["render"] = top_ms
-    return StackCost(scenario, typical["frames"], typical["timing_ms"], peers,
+    return StackCost(scenario, typical["frames"], typical["timing_ms"], pair_ms, peers,
                      tuple(r["realtime_factor"] for r in runs), tuple(r["realtime_factor"] for r in recorded))
 
 

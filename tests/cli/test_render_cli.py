@@ -1,6 +1,7 @@
 """`percept scenarios`, `percept render` and `percept bench` through typer's CliRunner."""
 
 import json
+import re
 
 import cv2
 import numpy as np
@@ -110,6 +111,9 @@ def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_compos
         runs = c[each]  # two drives each: the median is one of them, the slower (never an average)
         assert len(runs) == 2 and c[key] == min(runs)
     assert set(d["render_conditions_ms"]) == {"clear", "night", "rain", "glare", "noise"}
+    # the stereo pair alone on the scenario, printed beside the closed loop's figure
+    printed = re.search(r"stereo pair alone on each scenario .*?: crossing ([0-9.]+)", " ".join(r.output.split()))
+    assert c["stereo_pair_ms"] > 0 and float(printed.group(1)) == pytest.approx(c["stereo_pair_ms"], abs=0.006)
     assert d["soak"]["frames"] == 45 and len(d["soak"]["rss_mb"]) == 2 and d["soak"]["peak_mb"] > 0
     assert d["soak"]["mb_per_minute"] is None  # no slope from a drive shorter than two minutes
 
