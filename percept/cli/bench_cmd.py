@@ -18,8 +18,9 @@ def bench(
                                                          "and peers: the median).")] = 30,
     stack: Annotated[bool, opt.flag("--stack", help="Also the whole stack: every vision slot in the closed loop on "
                                                     "each scenario beside the stock composition of the peers, the "
-                                                    "render cost per condition, the realtime factor with and "
-                                                    "without recording.")] = False,
+                                                    "stereo pair alone on each scenario, the render cost per "
+                                                    "condition, the realtime factor with and without "
+                                                    "recording.")] = False,
     scenario: Annotated[Optional[List[str]], typer.Option("--scenario", help="With --stack: only these scenarios "
                                                           "(repeat; default every one).")] = None,
     seconds: Annotated[float, typer.Option("--seconds", help="With --stack: simulated seconds of each closed loop, "
