@@ -15,15 +15,13 @@ import dataclasses
 import importlib
 import os
 import sys
+import tempfile
 import time
 import types
 from pathlib import Path
 
 import cv2
 import numpy as np
-
-from percept.sims import SimWorld, WorldConfig
-from percept.sims.snapshot import scene_from_road
 
 cv2.setNumThreads(1)
 FRAMES = 60
@@ -51,6 +49,13 @@ def convert(other, scene):
 def main() -> None:
     if len(sys.argv) < 2:
         sys.exit(__doc__)
+    # numba caches compiled kernels beside their sources, naming their module: the other checkout's, loaded here as
+    # ``othersims``, would then fail to import as ``percept`` ("No module named 'othersims'"). This tool keeps its
+    # own cache (set before numba is first imported, with percept)
+    os.environ.setdefault("NUMBA_CACHE_DIR", os.path.join(tempfile.gettempdir(), "percept-render-ab-numba"))
+    from percept.sims import SimWorld, WorldConfig
+    from percept.sims.snapshot import scene_from_road
+
     other = other_render(Path(sys.argv[1]))
     reps = int(os.environ.get("REPS", "5"))
 
