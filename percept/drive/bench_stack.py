@@ -62,9 +62,9 @@ class StackCost:
     of the loop's frames, each rendered after the slots have had the caches); stereo_pair_ms: the median cost of one
     stereo pair alone (``SimWorld.observe``: the render and the ground truth) on the same scenario's autopilot
     frames [ms]; peers_ms: the stock way to do each job on the same scenario's frames (people, stereo, lanes) and
-    highway-env's top-down render [ms/frame]; realtime_factors, realtime_factors_recording: each drive's, without / with recording (the drives
-    alternate, so that a change in the machine's speed falls on both). The median of several is the middle one
-    (``middle``), for the timings as for the realtime factors."""
+    highway-env's top-down render [ms/frame]; realtime_factors, realtime_factors_recording: each drive's, without /
+    with recording (the drives alternate, so that a change in the machine's speed falls on both). The median of
+    several is the middle one (``middle``), for the timings as for the realtime factors."""
 
     scenario: str
     frames: int
