@@ -2,7 +2,8 @@
 fragments) draw the same picture: the same scene forced through one path and then the other gives the same image,
 ids, lamp map and silhouettes; a patch cut by the near plane is drawn where its rays land. A renderer, once built,
 compiles nothing in a world's frames; Ctrl-C during a kernel is a KeyboardInterrupt; the pedestrians' figures
-built by compiled code are the interpreted ones to the byte."""
+built by compiled code are the interpreted ones to the byte, and so are the ground's colour lookup (OpenCV's) and
+the depth read off the z-buffer (numpy's)."""
 
 import os
 import subprocess
@@ -213,3 +214,42 @@ def test_a_silhouette_is_summarised_from_its_distinct_pixels():
     assert target.silhouette(8) is None
     no_ids = RenderTarget(target.image, target.depth, None, silhouettes={7: target.silhouettes[7]})
     assert no_ids.silhouette(7) == ((1, 2, 6, 5), 5, 0)
+
+
+def test_the_ground_colour_lookup_is_opencv_s_or_and_colour_map_to_the_byte():
+    """``_colour_map`` = ``cv2.bitwise_or`` of the grain and the road mask, then ``cv2.applyColorMap``, on the rows
+    below the horizon; the rows above are not touched."""
+    import cv2
+
+    from percept.sims.render.ground import _colour_map
+
+    rng = np.random.default_rng(3)
+    h, w, r0 = 40, 57, 9
+    grain = rng.integers(0, 128, (h - r0, w), dtype=np.uint8)
+    mask = np.where(rng.random((h, w)) < 0.4, 128, 0).astype(np.uint8)
+    cmap = rng.integers(0, 256, (256, 1, 3), dtype=np.uint8)
+    img = np.full((h, w, 3), 7, np.uint8)
+    _colour_map(img, grain, mask, cmap, r0)
+    expected = cv2.applyColorMap(cv2.bitwise_or(grain, mask[r0:]), cmap)
+    np.testing.assert_array_equal(img[r0:], expected)
+    assert (img[:r0] == 7).all()
+
+
+def test_the_depth_from_the_z_buffer_is_numpy_s_divide_to_the_bit():
+    """``zbuffer_depth``: float32 1 / (1/Z) where a patch changed the z-buffer, the background's depth elsewhere
+    (inf for the sky stays inf), equal to numpy's masked divide bit for bit."""
+    from percept.sims.render.pixels import zbuffer_depth
+
+    rng = np.random.default_rng(4)
+    base = rng.uniform(0.001, 0.5, (30, 41)).astype(np.float32)
+    base[:5] = 0.0  # sky: 1/Z = 0
+    background = np.where(base > 0, np.float32(1.0) / np.where(base > 0, base, 1), np.inf).astype(np.float32)
+    inv = base.copy()
+    won = rng.random(base.shape) < 0.3
+    inv[won] = rng.uniform(0.05, 2.0, won.sum()).astype(np.float32)
+    out = zbuffer_depth(inv, base, background)
+    expected = background.copy()
+    np.divide(np.float32(1.0), inv, out=expected, where=inv != base)
+    assert out.dtype == np.float32
+    np.testing.assert_array_equal(out.view(np.int32), expected.view(np.int32))
+    assert np.isinf(out[:5][~won[:5]]).all()
