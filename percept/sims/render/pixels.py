@@ -28,6 +28,36 @@ def _push(buf, n, value):  # pragma: no cover - compiled
     return buf
 
 
+@njit(cache=True)
+def _below(xa, xb, s, t, tol):  # pragma: no cover - compiled
+    """The columns [xa, xb) of [xa, xb) where s x + t <= tol could hold, widened by a column each way."""
+    if s > 0.0:
+        xb = min(xb, int(np.floor((tol - t) / s)) + 2)
+    elif s < 0.0:
+        xa = max(xa, int(np.ceil((tol - t) / s)) - 1)
+    elif t > tol:
+        xb = xa
+    return xa, xb
+
+
+@njit(cache=True)
+def _near_columns(xa, xb, ma0, ay, mb0, by, mc0, cy, inv_near):  # pragma: no cover - compiled
+    """The columns of [xa, xb) of one row of a patch crossing the near plane outside which its exact test (float32
+    a' = ma0 x + ay, b' likewise, c = mc0 x + cy: max(|a'|, |b'|) <= c, 0 < c < ``inv_near``) cannot pass: each of
+    a' - c, -a' - c, b' - c, -b' - c, -c and c - inv_near is linear in x, and the float32 rounding of the test is
+    below tol, 1e-5 of the terms' magnitudes (float32 rounds to 6e-8 of them), so no pixel the test would pass is
+    cut. A disc (a'^2 + b'^2 <= c^2) lies within the same bounds."""
+    m = float(max(abs(xa), abs(xb)))
+    a0, a, b0, b, c0, c = float(ma0), float(ay), float(mb0), float(by), float(mc0), float(cy)
+    for s, t in ((a0 - c0, a - c), (-a0 - c0, -a - c), (b0 - c0, b - c), (-b0 - c0, -b - c), (-c0, -c),
+                 (c0, c - float(inv_near))):
+        tol = 1e-5 * (m * (abs(a0) + abs(b0) + abs(c0)) + abs(a) + abs(b) + abs(c) + float(inv_near))
+        xa, xb = _below(xa, xb, s, t, tol)
+        if xb <= xa:
+            return xa, xa
+    return xa, xb
+
+
 @kernel()
 def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, ellipse, span_row, los, his,
                 obj_id, emissive, color, defer, want_sil, inv_near):  # pragma: no cover - compiled
@@ -64,6 +94,8 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
             xa, xb = x0[i], x1[i]
             if r >= 0:  # the row's span: every pixel in it is inside
                 xa, xb = max(xa, los[r + y - y0[i]]), min(xb, his[r + y - y0[i]] + 1)
+            else:  # the columns where the exact test can pass (a disc lies within its quad)
+                xa, xb = _near_columns(xa, xb, ma0, ay, mb0, by, mc0, cy, inv_near)
             for x in range(xa, xb):
                 fx = f32(x)
                 c = mc0 * fx + cy
