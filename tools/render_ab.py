@@ -15,7 +15,6 @@ import dataclasses
 import importlib
 import os
 import sys
-import tempfile
 import time
 import types
 from pathlib import Path
@@ -32,6 +31,13 @@ def other_render(checkout: Path):
     sims = checkout / "percept" / "sims"
     if not (sims / "render" / "renderer.py").is_file():
         sys.exit(f"{checkout} is not a percept checkout (no percept/sims/render/renderer.py)")
+    # numba caches a kernel beside its source under its module's name: cached as ``othersims``, the other
+    # checkout's kernels would no longer load when it runs as ``percept`` ("No module named 'othersims'"), so its
+    # kernels are compiled here without the disk cache (about 20 s)
+    from numba.core.dispatcher import Dispatcher
+
+    enable = Dispatcher.enable_caching
+    Dispatcher.enable_caching = lambda d: None if d.py_func.__module__.startswith("othersims") else enable(d)
     pkg = types.ModuleType("othersims")
     pkg.__path__ = [str(sims)]
     sys.modules["othersims"] = pkg
@@ -49,10 +55,6 @@ def convert(other, scene):
 def main() -> None:
     if len(sys.argv) < 2:
         sys.exit(__doc__)
-    # numba caches compiled kernels beside their sources, naming their module: the other checkout's, loaded here as
-    # ``othersims``, would then fail to import as ``percept`` ("No module named 'othersims'"). This tool keeps its
-    # own cache (set before numba is first imported, with percept)
-    os.environ.setdefault("NUMBA_CACHE_DIR", os.path.join(tempfile.gettempdir(), "percept-render-ab-numba"))
     from percept.sims import SimWorld, WorldConfig
     from percept.sims.snapshot import scene_from_road
 
