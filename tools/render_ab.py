@@ -22,6 +22,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from percept.sims import SimWorld, WorldConfig
+from percept.sims.snapshot import scene_from_road
+
 cv2.setNumThreads(1)
 FRAMES = 60
 
@@ -55,9 +58,6 @@ def convert(other, scene):
 def main() -> None:
     if len(sys.argv) < 2:
         sys.exit(__doc__)
-    from percept.sims import SimWorld, WorldConfig
-    from percept.sims.snapshot import scene_from_road
-
     other = other_render(Path(sys.argv[1]))
     reps = int(os.environ.get("REPS", "5"))
 

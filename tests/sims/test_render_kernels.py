@@ -282,3 +282,16 @@ def test_the_columns_kept_for_a_patch_crossing_the_near_plane_hold_every_pixel_i
         if len(xs):
             kept_share.append(kept.mean())
     assert np.mean(kept_share) < 0.5, "the bounds should cut most of the columns the test rejects"
+
+
+def test_the_near_plane_columns_keep_every_column_when_a_bound_cannot_be_told():
+    """A slope so shallow that the bound overflows any integer, or a coefficient that is not finite: every column
+    is kept, none is lost."""
+    from percept.sims.render.pixels import _near_columns
+
+    tiny = np.float32(1e-45)  # the smallest float32 step: the bound lies ~1e45 columns away
+    inv_near = np.float32(1.0 / 0.3)
+    assert _near_columns(0, 640, tiny, np.float32(0.0), np.float32(0.0), np.float32(0.0), np.float32(0.0),
+                         np.float32(1.0), inv_near) == (0, 640)
+    assert _near_columns(0, 640, np.float32(0.0), np.float32(np.nan), np.float32(0.0), np.float32(0.0),
+                         np.float32(0.0), np.float32(1.0), inv_near) == (0, 640)

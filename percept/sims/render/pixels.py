@@ -30,14 +30,18 @@ def _push(buf, n, value):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _below(xa, xb, s, t, tol):  # pragma: no cover - compiled
-    """The columns [xa, xb) of [xa, xb) where s x + t <= tol could hold, widened by a column each way."""
+    """Of the columns [xa, xb), the range where s x + t <= tol can hold, widened by a column each way; all of them
+    when that cannot be told (the bound is not finite)."""
+    if s == 0.0:
+        return (xa, xa) if t > tol else (xa, xb)
+    q = (tol - t) / s
+    if not np.isfinite(q):
+        return xa, xb
+    # clamped to the columns, so that the conversion to an integer cannot overflow
+    q = min(max(q, xa - 2.0), xb + 2.0)
     if s > 0.0:
-        xb = min(xb, int(np.floor((tol - t) / s)) + 2)
-    elif s < 0.0:
-        xa = max(xa, int(np.ceil((tol - t) / s)) - 1)
-    elif t > tol:
-        xb = xa
-    return xa, xb
+        return xa, min(xb, int(np.floor(q)) + 2)
+    return max(xa, int(np.ceil(q)) - 1), xb
 
 
 @njit(cache=True)
