@@ -83,7 +83,7 @@ def _scenarios(names: list[str] | None) -> list[str]:
 
 def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: float) -> dict:
     """The whole stack per scenario, the render per condition and the soak, printed and as the JSON's groups."""
-    from percept.drive.bench_stack import CONDITIONS, bench_stack, render_per_condition, soak
+    from percept.drive.bench_stack import CONDITIONS, PAIR_FRAMES, bench_stack, render_per_condition, soak
     from percept.sims.env import SIMULATION_HZ
 
     loop_frames = int(round(seconds * SIMULATION_HZ))
@@ -110,8 +110,9 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
                       _spread(c.realtime_factor, c.realtime_factors),
                       _spread(c.realtime_factor_recording, c.realtime_factors_recording))
         console.print(t)
-        console.print("stereo pair alone on each scenario (clear, ms, the median of 20 frames; \"render\" above is "
-                      "the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}" for c in stacks))
+        console.print(f"stereo pair alone on each scenario (clear, ms, the median of {PAIR_FRAMES} frames; \"render\" "
+                      "above is the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}"
+                                                                     for c in stacks))
         console.print("stereo pair with each condition (highway, ms): " + ", ".join(
             f"{k} {fmt(conditions[k])}" for k in CONDITIONS))
         out.update({"stack": [c.to_dict() for c in stacks],
