@@ -21,7 +21,7 @@ import numpy as np
 
 from percept.compiled import optional
 
-from .pixels import big_patches, clear_boxes, put_albedo, shade_winners, small_fragments, texel_coords
+from .pixels import big_patches, clear_boxes, put_albedo, shade_winners, small_fragments, texel_coords, zbuffer_depth
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
 
@@ -101,9 +101,9 @@ def rasterize_prepared(target, p: PreparedPatches, atlas: TextureAtlas, silhouet
         _small_patches(target, p, atlas, rp[nbig:], v[nbig:], first[nbig:], last[nbig:], sil)
     if antialias:
         smooth_edges(target, p, rp, v, lo, hi, first, last)
-    # Z = 1 / c wherever a patch won the z-test
     if target.depth is not None:
-        np.divide(np.float32(1.0), target.inv_depth, out=target.depth, where=target.inv_depth != target.base_inv_depth)
+        # Z = 1 / c wherever a patch won the z-test, what the depth held before elsewhere
+        target.depth = zbuffer_depth(target.inv_depth, target.base_inv_depth, target.depth)
 
 
 def _add_silhouettes(sil: dict[int, list[np.ndarray]] | None, pix: np.ndarray, oid: np.ndarray) -> None:

@@ -28,7 +28,7 @@ from percept.sensors import PinholeCamera, Transform
 from .cull import inverse_rows, project_patches
 from .fragments import NEAR_M, PreparedPatches, WinnerMap, rasterize_prepared
 from .patches import ELLIPSE, OUTLINES, QUAD, PatchBatch, PatchBuilder
-from .pixels import silhouette_stats, zbuffer_depth
+from .pixels import silhouette_stats
 from .textures import TextureAtlas
 from .vec3 import cross, dot
 
@@ -104,8 +104,8 @@ def warm_up() -> None:
     """Compile the rasteriser's kernels (numba: the first time after an install) or load them from numba's disk
     cache (about 0.5 s with the renderer's other kernels), once per process, by drawing a small synthetic scene
     through every path the renderer takes: large and small patches, textured and not, quads and discs, a lamp, a
-    patch cut by the near plane, into a left camera's targets (depth, ids, silhouettes, the depth taken from the
-    z-buffer) and a right one's, each with a reused winner map. The renderer calls it when it is built, so that no
+    patch cut by the near plane, into a left camera's targets (depth, read off the z-buffer, ids, silhouettes) and a
+    right one's, each with a reused winner map. The renderer calls it when it is built, so that no
     timed frame pays for it."""
     if _WARM:
         return
@@ -128,7 +128,6 @@ def warm_up() -> None:
                   silhouettes=left)
         if left:
             target.silhouette(1)
-            zbuffer_depth(target.inv_depth, target.base_inv_depth, target.depth)
     _WARM.append(True)
 
 
