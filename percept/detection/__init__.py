@@ -1,11 +1,13 @@
 """Detection: pedestrians (HOG features shared across windows, the image-pyramid search, scoring).
 
-``hog``: Dalal & Triggs HOG blocks computed once per image and scale (OpenCV's ``HOGDescriptor``) and a linear model
-scored over every window from them; ``pyramid``: the unconstrained search over every scale (``percept detect``);
+``hog``: Dalal & Triggs HOG blocks computed once per image and scale (OpenCV's gradients, summed into blocks by
+``hog_blocks``) and a linear model scored over every window from them; ``pyramid``: the unconstrained search over
+every scale (``percept detect``);
 ``metrics``: the scoring formulas; ``overlay``: drawings.
 """
 
 from .hog import DESCRIPTOR_LEN, WINDOW_PX, LinearModel, block_grid, hog_descriptor
+from .hog_blocks import hog_blocks
 from percept.sensors.boxes import iou, iou_matrix
 
 from .metrics import DetectionScore, FrameMatch, eligible, match_detections, score_frames
@@ -17,5 +19,5 @@ from .slot import PedestrianDebug, PedestrianSlot, window_of
 __all__ = ["ConstrainedSearch", "PedestrianDebug", "PedestrianSlot", "PersonTrack", "PersonTracker", "SearchConfig",
            "SearchStats", "TrackConfig", "person_box", "window_of",
            "DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",
-           "detect_multiscale", "eligible", "group", "hog_descriptor", "iou", "iou_matrix", "match_detections",
-           "pyramid_scales", "score_frames", "windows_at_scale"]
+           "detect_multiscale", "eligible", "group", "hog_blocks", "hog_descriptor", "iou", "iou_matrix",
+           "match_detections", "pyramid_scales", "score_frames", "windows_at_scale"]
