@@ -10,9 +10,10 @@ image, to float32 rounding, in two thirds of its time). A linear model w on a wi
 
     s(x, y) = b + sum_{i < 7, j < 15} w_ij . B(x + i, y + j)
 
-which is computed as one product of every block with all 105 weight vectors (BLAS), then the sums over j and i in
-one compiled pass (``_window_sums``: the float32 additions in the order numpy's strided sums made them, so the
-scores are the same to the bit).
+which is computed per row of windows y: one product (BLAS) of each block column's 15 blocks from row y (540
+values, contiguous) with the window's 7 columns of weights gives R(bx, y, i) = sum_j w_ij . B(bx, y + j), and one
+compiled pass adds s(x, y) = b + sum_i R(x + i, y, i). Only the products some window needs are made: a strip a few
+windows tall (the constrained search's) has most of its blocks in fewer than 15 windows' rows.
 """
 
 from __future__ import annotations
@@ -127,37 +128,35 @@ class LinearModel:
     def score_map(self, blocks: np.ndarray) -> np.ndarray:
         """Score of the window at every block position of ``blocks`` (nbx, nby, 36): (nbx - 6, nby - 14)."""
         nbx, nby, _ = blocks.shape
-        # every block against all 105 weight vectors in one product: P[bx, by, i, j] = w_ij . B(bx, by)
-        p = (blocks.reshape(-1, BLOCK_LEN) @ self._weights_t).reshape(nbx, nby, BLOCKS[0], BLOCKS[1])
-        return _window_sums(p, np.float32(self.bias))
+        ny = nby - BLOCKS[1] + 1
+        blocks = np.ascontiguousarray(blocks, np.float32)
+        # R[y, bx, i] = sum_j w_ij . B(bx, y + j): one product per row of windows, each block column's 15 blocks
+        # (contiguous in ``blocks``) against the 7 columns of the window's weights
+        r = np.empty((ny, nbx, BLOCKS[0]), np.float32)
+        for y in range(ny):
+            np.matmul(blocks[:, y:y + BLOCKS[1]].reshape(nbx, BLOCKS[1] * BLOCK_LEN), self._weights_by_column,
+                      out=r[y])
+        return _window_sums(r, np.float32(self.bias))
 
     @cached_property
-    def _weights_t(self) -> np.ndarray:
-        """The weights as a (36, 105) matrix, column i * 15 + j the vector w_ij of block (i, j) of a window."""
-        return np.ascontiguousarray(self.weights.reshape(BLOCKS[0] * BLOCKS[1], BLOCK_LEN).T)
+    def _weights_by_column(self) -> np.ndarray:
+        """The weights as a (15 * 36, 7) matrix: column i holds the blocks j = 0..14 of the window's block column
+        i in a row, w_ij at rows 36 j..36 j + 35."""
+        w = self.weights.reshape(BLOCKS[0], BLOCKS[1], BLOCK_LEN)
+        return np.ascontiguousarray(w.transpose(1, 2, 0).reshape(BLOCKS[1] * BLOCK_LEN, BLOCKS[0]))
 
 
 @kernel()
-def _window_sums(p, bias):  # pragma: no cover - compiled
-    """s(x, y) = b + sum_i Q[x + i, y, i] with Q[bx, y, i] = sum_j P[bx, y + j, i, j], from P (nbx, nby, 7, 15)
-    float32: (nbx - 6, nby - 14) float32, each sum accumulated in float32 from its first term on."""
-    nbx, nby, ni, nj = p.shape
-    nx, ny = nbx - ni + 1, nby - nj + 1
-    # Q[bx, y, i] = sum_j P[bx, y + j, i, j]
-    q = np.empty((nbx, ny, ni), np.float32)
-    for bx in range(nbx):
-        for y in range(ny):
-            for i in range(ni):
-                acc = p[bx, y, i, 0]
-                for j in range(1, nj):
-                    acc += p[bx, y + j, i, j]
-                q[bx, y, i] = acc
-    # s(x, y) = b + sum_i Q[x + i, y, i]
+def _window_sums(r, bias):  # pragma: no cover - compiled
+    """s(x, y) = b + sum_i R[y, x + i, i] from R (ny, nbx, 7) float32: (nbx - 6, ny) float32, accumulated in
+    float32 from the bias on."""
+    ny, nbx, ni = r.shape
+    nx = nbx - ni + 1
     s = np.empty((nx, ny), np.float32)
     for x in range(nx):
         for y in range(ny):
-            v = q[x, y, 0] + bias
+            v = r[y, x, 0] + bias
             for i in range(1, ni):
-                v += q[x + i, y, i]
+                v += r[y, x + i, i]
             s[x, y] = v
     return s
