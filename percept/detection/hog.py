@@ -24,6 +24,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from numpy.lib.stride_tricks import as_strided
 
 from percept.compiled import kernel
 
@@ -130,13 +131,11 @@ class LinearModel:
         nbx, nby, _ = blocks.shape
         ny = nby - BLOCKS[1] + 1
         blocks = np.ascontiguousarray(blocks, np.float32)
-        # R[y, bx, i] = sum_j w_ij . B(bx, y + j): one product per row of windows, each block column's 15 blocks
-        # (contiguous in ``blocks``) against the 7 columns of the window's weights
-        r = np.empty((ny, nbx, BLOCKS[0]), np.float32)
-        for y in range(ny):
-            np.matmul(blocks[:, y:y + BLOCKS[1]].reshape(nbx, BLOCKS[1] * BLOCK_LEN), self._weights_by_column,
-                      out=r[y])
-        return _window_sums(r, np.float32(self.bias))
+        # R[y, bx, i] = sum_j w_ij . B(bx, y + j): one product per row of windows y (numpy's stacked matmul), each
+        # block column's 15 blocks from row y (540 contiguous values) against the 7 columns of the window's weights
+        sx, sy, sk = blocks.strides
+        column_blocks = as_strided(blocks, (ny, nbx, BLOCKS[1] * BLOCK_LEN), (sy, sx, sk), writeable=False)
+        return _window_sums(np.matmul(column_blocks, self._weights_by_column), np.float32(self.bias))
 
     @cached_property
     def _weights_by_column(self) -> np.ndarray:
