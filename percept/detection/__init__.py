@@ -7,7 +7,7 @@ every scale (``percept detect``);
 """
 
 from .hog import DESCRIPTOR_LEN, WINDOW_PX, LinearModel, block_grid, hog_descriptor
-from .hog_blocks import hog_blocks
+from .blocks import hog_blocks
 from percept.sensors.boxes import iou, iou_matrix
 
 from .metrics import DetectionScore, FrameMatch, eligible, match_detections, score_frames

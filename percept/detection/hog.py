@@ -28,7 +28,7 @@ from numpy.lib.stride_tricks import as_strided
 
 from percept.compiled import kernel
 
-from .hog_blocks import hog_blocks
+from .blocks import hog_blocks
 
 WINDOW_PX = (64, 128)
 """Detection window (width, height) [px]."""

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from percept.detection.hog import hog_descriptor
-from percept.detection.hog_blocks import axis_weights, hog_blocks
+from percept.detection.blocks import axis_weights, hog_blocks
 
 
 def opencv_blocks(image: np.ndarray, c: int) -> np.ndarray:
