@@ -88,10 +88,15 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
     h, w = mag.shape[0], mag.shape[1]
     nbx, nby = (w - 2 * c) // c + 1, (h - 2 * c) // c + 1
     half = c // 2
-    # acc[by, cy, 18 bx + 9 cx + bin]: the blocks' unnormalised histograms, by the cell row cy
-    acc = np.zeros((nby, 2, nbx * 18), np.float32)
+    out = np.empty((nbx, nby, 36), np.float32)
+    # acc[by mod 2, cy, 18 bx + 9 cx + bin]: the unnormalised histograms of the two block rows a pixel row feeds,
+    # by the cell row cy; a block row is normalised into ``out`` as soon as its last pixel row is in
+    acc = np.empty((2, 2, nbx * 18), np.float32)
     row = np.empty(nbx * 18, np.float32)
     for y in range(nby * c + c):
+        by = y // c
+        if y % c == 0 and by < nby:
+            acc[by % 2] = 0
         # R[bx, cx, bin] = sum_dx X_cx(dx) m_bin(y, c bx + dx): pixel c j + e lies in blocks j (dx = e) and j - 1
         # (dx = e + c); X_1(e) is zero for e < c/2 and X_0(e + c) for e >= c/2
         row[:] = 0
@@ -118,7 +123,6 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
                     row[p + 9 + q0] += wt * g0
                     row[p + 9 + q1] += wt * g1
         # H[by, cy] += Y_cy(dy) R for the block rows by = y // c (dy = y mod c) and by - 1 (dy + c)
-        by = y // c
         for k in range(2):
             b = by - k
             if b < 0 or b >= nby:
@@ -127,15 +131,16 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
             for cy in range(2):
                 wt = wx[cy, dy]
                 for i in range(nbx * 18):
-                    acc[b, cy, i] += wt * row[i]
-    out = np.empty((nbx, nby, 36), np.float32)
-    for bx in range(nbx):
-        for by in range(nby):
-            for cx in range(2):
-                for cy in range(2):
-                    for q in range(9):
-                        out[bx, by, 18 * cx + 9 * cy + q] = acc[by, cy, 18 * bx + 9 * cx + q]
-    _l2hys(out.reshape(nbx * nby, 36), clip)
+                    acc[b % 2, cy, i] += wt * row[i]
+        # block row by - 1 is complete after the last pixel row of cell row by
+        done = by - 1
+        if y % c == c - 1 and 0 <= done < nby:
+            for bx in range(nbx):
+                for cx in range(2):
+                    for cy in range(2):
+                        for q in range(9):
+                            out[bx, done, 18 * cx + 9 * cy + q] = acc[done % 2, cy, 18 * bx + 9 * cx + q]
+            _l2hys(out[:, done], clip)
     return out
 
 
