@@ -63,11 +63,21 @@ def bench(
 def _stage_table(results) -> Table:
     t = Table(title="percept bench (one thread, ms per call: slots the median of 3 passes' means over consecutive "
                     "frames, the rest the median)")
-    for col in ("stage", "what", "ms", "target ms", "peer", "peer ms", "ratio"):
+    for col in ("stage", "what", "ms", "target ms", "peer", "peer ms", "ratio (ours / peer)"):
         t.add_column(col, justify="left" if col in ("stage", "what", "peer") else "right")
     for r in results:
-        t.add_row(r.stage, r.what, f"{r.ms:.2f}", fmt(r.target_ms), r.peer or "-", fmt(r.peer_ms), fmt(r.ratio))
+        t.add_row(r.stage, r.what, f"{r.ms:.2f}", fmt(r.target_ms), r.peer or "-", fmt(r.peer_ms),
+                  ratio_text(r.ratio))
     return t
+
+
+def ratio_text(ratio: float | None) -> str:
+    """The JSON's ratio (ours / peer) as a person reads it: '0.025 (40.0x faster)', '3.63 (3.6x slower)', 'n/a'."""
+    if ratio is None or not ratio > 0:
+        return "n/a"
+    if ratio < 1:
+        return f"{ratio:.3f} ({1 / ratio:.1f}x faster)"
+    return f"{ratio:.2f} ({ratio:.1f}x slower)"
 
 
 def _scenarios(names: list[str] | None) -> list[str]:

@@ -92,6 +92,22 @@ def test_bench_prints_the_render_ratio(tmp_path):
     assert lanes["ms"] > 0 and lanes["peer"] is None and lanes["ratio"] is None and lanes["target_ms"] == 3.0
 
 
+def test_the_bench_table_says_how_many_times_faster_or_slower():
+    from rich.console import Console
+
+    from percept.cli.bench_cmd import _stage_table, ratio_text
+    from percept.drive.bench import StageCost
+
+    assert ratio_text(2.314 / 92.568) == "0.025 (40.0x faster)"
+    assert ratio_text(6.461 / 1.778) == "3.63 (3.6x slower)"
+    assert ratio_text(None) == "n/a" and ratio_text(0.0) == "n/a"
+    console = Console(width=240, record=True)
+    console.print(_stage_table([StageCost("pedestrians", "slot", 2.314, "detectMultiScale", 92.568),
+                                StageCost("lanes", "slot", 1.1, target_ms=3.0)]))
+    text = console.export_text()
+    assert "0.025 (40.0x faster)" in text and "ratio (ours / peer)" in text
+
+
 def test_bench_stack_times_every_slot_in_the_closed_loop_beside_the_stock_composition(tmp_path):
     out = tmp_path / "bench.json"
     r = runner.invoke(app, ["bench", "--frames", "2", "--stack", "--scenario", "crossing", "--seconds", "1",
