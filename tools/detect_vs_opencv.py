@@ -66,8 +66,8 @@ def main() -> None:
     print(f"{len(ours_ms)} frames, model {model.name}: detectMultiScale {n_theirs} detections, {theirs_hit} matched "
           f"by percept's; percept {n_ours}, {ours_hit} matched by detectMultiScale's")
     print(f"ms a frame (mean / median): percept {np.mean(ours_ms):.1f} / {np.median(ours_ms):.1f}, detectMultiScale "
-          f"{np.mean(theirs_ms):.1f} / {np.median(theirs_ms):.1f}; percept {np.mean(theirs_ms) / np.mean(ours_ms):.2f}x "
-          f"as fast")
+          f"{np.mean(theirs_ms):.1f} / {np.median(theirs_ms):.1f}; percept "
+          f"{np.mean(theirs_ms) / np.mean(ours_ms):.2f}x as fast")
 
 
 if __name__ == "__main__":

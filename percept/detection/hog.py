@@ -28,13 +28,12 @@ from numpy.lib.stride_tricks import as_strided
 
 from percept.compiled import kernel
 
-from .blocks import hog_blocks
+from .blocks import BINS, L2HYS_CLIP, hog_blocks
 
 WINDOW_PX = (64, 128)
 """Detection window (width, height) [px]."""
 CELL_PX = 8
 BLOCK_PX = 16
-BINS = 9
 BLOCKS = ((WINDOW_PX[0] - BLOCK_PX) // CELL_PX + 1, (WINDOW_PX[1] - BLOCK_PX) // CELL_PX + 1)
 """Blocks across and down one window: (7, 15)."""
 BLOCK_LEN = 4 * BINS
@@ -49,8 +48,8 @@ def hog_descriptor(win_px: tuple[int, int] = WINDOW_PX, cell_px: int = CELL_PX) 
     correction, the block's Gaussian weighting. ``cell_px`` other than 8 scales cells, blocks and stride together
     (a 4-pixel cell sees what an 8-pixel cell sees in the image enlarged twice)."""
     c = int(cell_px)
-    return cv2.HOGDescriptor(win_px, (2 * c, 2 * c), (c, c), (c, c), BINS, 1, -1.0, cv2.HOGDescriptor_L2Hys, 0.2,
-                             True, 64, False)
+    return cv2.HOGDescriptor(win_px, (2 * c, 2 * c), (c, c), (c, c), BINS, 1, -1.0, cv2.HOGDescriptor_L2Hys,
+                             L2HYS_CLIP, True, 64, False)
 
 
 def block_grid(image: np.ndarray, cell_px: int = CELL_PX) -> np.ndarray:
