@@ -39,8 +39,6 @@ L2HYS_CLIP = 0.2
 EPS_L2 = np.float32(np.float32(0.1) * np.float32(4 * BINS))
 """OpenCV's epsilon of the first L2 norm: 0.1 per value of the block, in float32."""
 
-_GRADIENTS: dict[int, cv2.HOGDescriptor] = {}
-
 
 @lru_cache(maxsize=8)
 def axis_weights(cell_px: int) -> np.ndarray:
@@ -62,13 +60,15 @@ def axis_weights(cell_px: int) -> np.ndarray:
 def gradients(image: np.ndarray, cell_px: int) -> tuple[np.ndarray, np.ndarray]:
     """OpenCV's HOG gradient of ``image`` (grey or BGR uint8): magnitudes (h, w, 2) float32 split between the two
     bins (h, w, 2) uint8 they vote into."""
-    hog = _GRADIENTS.get(cell_px)
-    if hog is None:
-        from .hog import hog_descriptor  # hog imports this module
+    return _gradient_descriptor(int(cell_px)).computeGradient(image, None, None)
 
-        c = int(cell_px)
-        hog = _GRADIENTS.setdefault(c, hog_descriptor((2 * c, 2 * c), c))
-    return hog.computeGradient(image, None, None)
+
+@lru_cache(maxsize=8)
+def _gradient_descriptor(c: int) -> cv2.HOGDescriptor:
+    """OpenCV's HOG with the people detector's parameters at cells of c px (its window does not matter here)."""
+    from .hog import hog_descriptor  # hog imports this module
+
+    return hog_descriptor((2 * c, 2 * c), c)
 
 
 def hog_blocks(image: np.ndarray, cell_px: int) -> np.ndarray:

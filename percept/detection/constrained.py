@@ -28,7 +28,7 @@ import numpy as np
 
 from percept.sensors import EgoPath, StereoRig
 
-from .hog import BLOCK_LEN, BLOCKS, CELL_PX, WINDOW_PX, LinearModel, block_grid
+from .hog import CELL_PX, WINDOW_PX, LinearModel, block_grid
 from .pyramid import Detection, group, lone_windows
 
 PERSON_PX = 96
@@ -107,8 +107,11 @@ class ConstrainedSearch:
         # what a full pyramid over the same scales scores: every window at an 8-pixel stride, for the count
         self.full_windows = int(sum(max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0)
                                     * max(int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0) for s in self.scales))
-        # the window sums' compiled kernel loaded now (compiled once after an install), not in a timed frame
-        model.score_map(np.zeros((BLOCKS[0], BLOCKS[1], BLOCK_LEN), np.float32))
+        # the compiled kernels (the blocks' and the window sums', compiled once after an install) loaded now, on
+        # one window of the strips' kind (BGR uint8, cfg.cell_px cells), not in a timed frame
+        c = cfg.cell_px
+        window = np.zeros((WINDOW_PX[1] * c // CELL_PX, WINDOW_PX[0] * c // CELL_PX, 3), np.uint8)
+        model.score_map(block_grid(window, c))
 
     def region(self, level: int, path: EgoPath) -> tuple[int, int, int, int] | None:
         """The image region (u0, v0, u1, v1) that holds every plausible window at scale ``level``, or None."""
