@@ -15,7 +15,8 @@ Each image row is first summed along x into every block column (a pixel lies in 
 three of their four weights non-zero), then each row is added, weighted, into the two block rows that hold it;
 each pixel is read once instead of once per block holding it (four times). Each block is then normalised as
 OpenCV does (L2-Hys: L2 with an epsilon of 0.1 per value, clipped at 0.2, L2 again with 1e-3), its sums of
-squares in four interleaved partial sums as OpenCV's own. Only the order of the float32 additions differs from
+squares in four interleaved partial sums as OpenCV's own; a block row's histograms are kept value by value, the
+blocks side by side, so that its norms are taken over all its blocks at once (as vectors). Only the order of the float32 additions differs from
 OpenCV's, so the values differ from its by a few units of float32's last place
 (``tests/detection/test_hog_blocks.py``).
 
@@ -84,98 +85,98 @@ def hog_blocks(image: np.ndarray, cell_px: int) -> np.ndarray:
     return _blocks(mag, bins, c, axis_weights(c), np.float32(L2HYS_CLIP))
 
 
-@kernel()
+@kernel(error_model="numpy")
 def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
     """Blocks (nbx, nby, 36) from magnitudes (h, w, 2) and bins (h, w, 2); wx: ``axis_weights(c)``."""
     h, w = mag.shape[0], mag.shape[1]
     nbx, nby = (w - 2 * c) // c + 1, (h - 2 * c) // c + 1
     half = c // 2
     out = np.empty((nbx, nby, 36), np.float32)
-    # acc[by mod 2, cy, 18 bx + 9 cx + bin]: the unnormalised histograms of the two block rows a pixel row feeds,
-    # by the cell row cy; a block row is normalised into ``out`` as soon as its last pixel row is in
-    acc = np.empty((2, 2, nbx * 18), np.float32)
-    row = np.empty(nbx * 18, np.float32)
+    # acc[by mod 2, 36 i + bx]: value i (OpenCV's order, 18 cx + 9 cy + bin) of block bx, unnormalised, in the two
+    # block rows a pixel row feeds; a block row is normalised into ``out`` as soon as its last pixel row is in.
+    # Value-major (the blocks of a row side by side), so that the norms below run over the blocks as vectors
+    acc = np.empty((2, 36 * nbx), np.float32)
+    row = np.empty((18, nbx), np.float32)
+    scale1, scale2 = np.empty(nbx, np.float32), np.empty(nbx, np.float32)
     for y in range(nby * c + c):
         by = y // c
         if y % c == 0 and by < nby:
             acc[by % 2] = 0
-        # R[bx, cx, bin] = sum_dx X_cx(dx) m_bin(y, c bx + dx): pixel c j + e lies in blocks j (dx = e) and j - 1
-        # (dx = e + c); X_1(e) is zero for e < c/2 and X_0(e + c) for e >= c/2
+        # R[9 cx + bin, bx] = sum_dx X_cx(dx) m_bin(y, c bx + dx): pixel c j + e lies in blocks j (dx = e) and
+        # j - 1 (dx = e + c); X_1(e) is zero for e < c/2 and X_0(e + c) for e >= c/2
         row[:] = 0
         for j in range(nbx + 1):
-            o, p = 18 * j, 18 * j - 18
+            p = j - 1
             for e in range(c):
                 x = c * j + e
                 g0, g1 = mag[y, x, 0], mag[y, x, 1]
                 q0, q1 = np.int64(bins[y, x, 0]), np.int64(bins[y, x, 1])
                 if j < nbx:
                     wt = wx[0, e]
-                    row[o + q0] += wt * g0
-                    row[o + q1] += wt * g1
+                    row[q0, j] += wt * g0
+                    row[q1, j] += wt * g1
                     if e >= half:
                         wt = wx[1, e]
-                        row[o + 9 + q0] += wt * g0
-                        row[o + 9 + q1] += wt * g1
+                        row[9 + q0, j] += wt * g0
+                        row[9 + q1, j] += wt * g1
                 if j >= 1:
                     if e < half:
                         wt = wx[0, e + c]
-                        row[p + q0] += wt * g0
-                        row[p + q1] += wt * g1
+                        row[q0, p] += wt * g0
+                        row[q1, p] += wt * g1
                     wt = wx[1, e + c]
-                    row[p + 9 + q0] += wt * g0
-                    row[p + 9 + q1] += wt * g1
+                    row[9 + q0, p] += wt * g0
+                    row[9 + q1, p] += wt * g1
         # H[by, cy] += Y_cy(dy) R for the block rows by = y // c (dy = y mod c) and by - 1 (dy + c)
+        r = row.reshape(18 * nbx)
         for k in range(2):
             b = by - k
             if b < 0 or b >= nby:
                 continue
             dy = y - c * by + c * k
+            a = acc[b % 2]
             for cy in range(2):
                 wt = wx[cy, dy]
-                for i in range(nbx * 18):
-                    acc[b % 2, cy, i] += wt * row[i]
+                for cx in range(2):
+                    o, src = (18 * cx + 9 * cy) * nbx, 9 * cx * nbx
+                    for m in range(9 * nbx):
+                        a[o + m] += wt * r[src + m]
         # block row by - 1 is complete after the last pixel row of cell row by
         done = by - 1
         if y % c == c - 1 and 0 <= done < nby:
+            v = acc[done % 2].reshape(36, nbx)
+            _l2hys_scales(v, clip, scale1, scale2)
             for bx in range(nbx):
-                for cx in range(2):
-                    for cy in range(2):
-                        for q in range(9):
-                            out[bx, done, 18 * cx + 9 * cy + q] = acc[done % 2, cy, 18 * bx + 9 * cx + q]
-            _l2hys(out[:, done], clip)
+                s1, s2 = scale1[bx], scale2[bx]
+                for i in range(36):
+                    t = v[i, bx] * s1
+                    out[bx, done, i] = (t if t < clip else clip) * s2
     return out
 
 
-@njit(cache=True)
-def _l2hys(v, clip):
-    """L2-Hys in place on each block (row) of ``v`` (n, 36): v / (|v| + 0.1 * 36), clipped at ``clip``, then
-    v / (|v| + 1e-3); each sum of squares in four interleaved partial sums, (p0 + p1) + (p2 + p3). Each step runs
-    over every block before the next (the blocks' chains of additions, roots and divisions then overlap)."""
-    n = v.shape[0]
-    scale = np.empty(n, np.float32)
+@njit(cache=True, error_model="numpy", inline="always")
+def _l2hys_scales(v, clip, scale1, scale2):
+    """L2-Hys's two scales of each block (column) of ``v`` (36, n): scale1 = 1 / (|v| + 0.1 * 36), then, of the
+    values clipped, min(v scale1, clip), scale2 = 1 / (|.| + 1e-3); each sum of squares in four interleaved partial
+    sums, (p0 + p1) + (p2 + p3), OpenCV's order. Each loop runs over the blocks, as vectors."""
+    n = v.shape[1]
     for b in range(n):
-        scale[b] = np.float32(1) / (np.sqrt(_sum_squares(v, b)) + EPS_L2)
+        p0, p1, p2, p3 = v[0, b] * v[0, b], v[1, b] * v[1, b], v[2, b] * v[2, b], v[3, b] * v[3, b]
+        for i in range(4, 36, 4):
+            p0 += v[i, b] * v[i, b]
+            p1 += v[i + 1, b] * v[i + 1, b]
+            p2 += v[i + 2, b] * v[i + 2, b]
+            p3 += v[i + 3, b] * v[i + 3, b]
+        scale1[b] = np.float32(1) / (np.sqrt((p0 + p1) + (p2 + p3)) + EPS_L2)
     for b in range(n):
-        sc = scale[b]
-        for i in range(36):
-            t = v[b, i] * sc
-            v[b, i] = t if t < clip else clip
-    for b in range(n):
-        scale[b] = np.float32(1) / (np.sqrt(_sum_squares(v, b)) + np.float32(1e-3))
-    for b in range(n):
-        sc = scale[b]
-        for i in range(36):
-            v[b, i] *= sc
-
-
-@njit(cache=True, inline="always")
-def _sum_squares(v, b):
-    """sum_i v[b, i]^2 over the 36 values as (p0 + p1) + (p2 + p3), p_k the sum over i = k mod 4 (OpenCV's
-    order)."""
-    p0, p1, p2, p3 = v[b, 0] * v[b, 0], v[b, 1] * v[b, 1], v[b, 2] * v[b, 2], v[b, 3] * v[b, 3]
-    for i in range(4, 36, 4):
-        p0 += v[b, i] * v[b, i]
-        p1 += v[b, i + 1] * v[b, i + 1]
-        p2 += v[b, i + 2] * v[b, i + 2]
-        p3 += v[b, i + 3] * v[b, i + 3]
-    return (p0 + p1) + (p2 + p3)
+        s = scale1[b]
+        t0, t1, t2, t3 = min(v[0, b] * s, clip), min(v[1, b] * s, clip), min(v[2, b] * s, clip), min(v[3, b] * s, clip)
+        p0, p1, p2, p3 = t0 * t0, t1 * t1, t2 * t2, t3 * t3
+        for i in range(4, 36, 4):
+            t0, t1 = min(v[i, b] * s, clip), min(v[i + 1, b] * s, clip)
+            t2, t3 = min(v[i + 2, b] * s, clip), min(v[i + 3, b] * s, clip)
+            p0 += t0 * t0
+            p1 += t1 * t1
+            p2 += t2 * t2
+            p3 += t3 * t3
+        scale2[b] = np.float32(1) / (np.sqrt((p0 + p1) + (p2 + p3)) + np.float32(1e-3))

@@ -25,6 +25,11 @@ class Side(str, Enum):
     RIGHT = "right"
 
 
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
 def _default_camera() -> PinholeCamera:
     return PinholeCamera.from_hfov(640, 480, math.radians(60.0))
 
@@ -47,6 +52,15 @@ class StereoRig:
             raise ValueError(f"mount_height_m must be positive, got {self.mount_height_m}")
         if not abs(self.pitch_rad) < 0.5:
             raise ValueError(f"pitch_rad {self.pitch_rad} is outside (-0.5, 0.5)")
+        # the frame changes and ground homographies of both cameras, computed once (read-only: callers share them)
+        cache = {}
+        for side in Side:
+            R = self.rotation_cam_from_vehicle()
+            T = Transform(_read_only(R), _read_only(-R @ self.camera_position(side)))
+            # (u, v, 1) ~ K [r1 r2 t] (x, y, 1) for points with z_v = 0
+            H = self.camera.K @ np.column_stack([T.R[:, 0], T.R[:, 1], T.t])
+            cache[side] = (T, _read_only(H), _read_only(np.linalg.inv(H)))
+        object.__setattr__(self, "_frames", cache)
 
     def camera_position(self, side: Side = Side.LEFT) -> np.ndarray:
         """Optical centre in the vehicle frame (3,) [m]."""
@@ -63,19 +77,16 @@ class StereoRig:
         return rx @ r0
 
     def cam_from_vehicle(self, side: Side = Side.LEFT) -> Transform:
-        """Vehicle frame -> camera frame of ``side``: p_c = R (p_v - c)."""
-        R = self.rotation_cam_from_vehicle()
-        return Transform(R, -R @ self.camera_position(side))
+        """Vehicle frame -> camera frame of ``side``: p_c = R (p_v - c) (read-only arrays)."""
+        return self._frames[Side(side)][0]
 
     def ground_homography(self, side: Side = Side.LEFT) -> np.ndarray:
-        """3x3 H taking ground points (x_v, y_v, 1) of the vehicle frame (z = 0) to pixels (u, v, 1)."""
-        T = self.cam_from_vehicle(side)
-        # (u, v, 1) ~ K [r1 r2 t] (x, y, 1) for points with z_v = 0
-        return self.camera.K @ np.column_stack([T.R[:, 0], T.R[:, 1], T.t])
+        """3x3 H taking ground points (x_v, y_v, 1) of the vehicle frame (z = 0) to pixels (u, v, 1) (read-only)."""
+        return self._frames[Side(side)][1]
 
     def image_to_ground(self, uv: np.ndarray, side: Side = Side.LEFT) -> np.ndarray:
         """Pixels (N, 2) -> vehicle-frame ground points (N, 2) [m]; rows above the horizon give garbage."""
-        Hinv = np.linalg.inv(self.ground_homography(side))
+        Hinv = self._frames[Side(side)][2]
         p = np.column_stack([np.asarray(uv, dtype=np.float64), np.ones(len(uv))]) @ Hinv.T
         return p[:, :2] / p[:, 2:3]
 
