@@ -24,7 +24,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from numpy.lib.stride_tricks import as_strided
 
 from percept.compiled import kernel
 
@@ -133,7 +132,7 @@ class LinearModel:
         # R[y, bx, i] = sum_j w_ij . B(bx, y + j): one product per row of windows y (numpy's stacked matmul), each
         # block column's 15 blocks from row y (540 contiguous values) against the 7 columns of the window's weights
         sx, sy, sk = blocks.strides
-        column_blocks = as_strided(blocks, (ny, nbx, BLOCKS[1] * BLOCK_LEN), (sy, sx, sk), writeable=False)
+        column_blocks = np.ndarray((ny, nbx, BLOCKS[1] * BLOCK_LEN), np.float32, blocks, 0, (sy, sx, sk))
         return _window_sums(np.matmul(column_blocks, self._weights_by_column), np.float32(self.bias))
 
     @cached_property
