@@ -16,8 +16,8 @@ three of their four weights non-zero), then each row is added, weighted, into th
 each pixel is read once instead of once per block holding it (four times). Each block is then normalised as
 OpenCV does (L2-Hys: L2 with an epsilon of 0.1 per value, clipped at 0.2, L2 again with 1e-3), its sums of
 squares in four interleaved partial sums as OpenCV's own; a block row's histograms are kept value by value, the
-blocks side by side, so that its norms are taken over all its blocks at once (as vectors). Only the order of the float32 additions differs from
-OpenCV's, so the values differ from its by a few units of float32's last place
+blocks side by side, so that its norms are taken over all its blocks at once (as vectors). Only the order of the
+float32 additions differs from OpenCV's, so the values differ from its by a few units of float32's last place
 (``tests/detection/test_hog_blocks.py``).
 
 Dalal & Triggs, "Histograms of Oriented Gradients for Human Detection", CVPR 2005 (the Gaussian block window and

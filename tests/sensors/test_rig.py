@@ -25,6 +25,29 @@ def test_projection_and_ground_homography_agree():
         np.testing.assert_allclose(back, pts[:, :2], atol=1e-9)
 
 
+def test_the_rig_computes_its_frames_once_for_its_own_pitch_and_shares_them_read_only():
+    import dataclasses
+
+    rig = StereoRig(pitch_rad=0.03)
+    for side in Side:
+        T = rig.cam_from_vehicle(side)
+        assert T is rig.cam_from_vehicle(side.value)
+        # p_c = R (p_v - c), with R the pitched axes swap
+        np.testing.assert_array_equal(T.R, rig.rotation_cam_from_vehicle())
+        np.testing.assert_allclose(T.apply(rig.camera_position(side)), 0.0, atol=1e-12)
+        np.testing.assert_allclose(rig.ground_homography(side) @ np.linalg.inv(rig.ground_homography(side)),
+                                   np.eye(3), atol=1e-12)
+        for a in (T.R, T.t, rig.ground_homography(side)):
+            with pytest.raises(ValueError, match="read-only"):
+                a[0] = 0.0
+    # a rig made from another (dataclasses.replace) has its own pitch's frames
+    steeper = dataclasses.replace(rig, pitch_rad=0.1)
+    assert steeper.horizon_row < rig.horizon_row
+    uv, _ = steeper.project_vehicle_points(np.array([[1e6, 0.27, 1.4]]))
+    assert uv[0, 1] == pytest.approx(steeper.horizon_row, abs=1e-3)
+    assert rig == StereoRig(pitch_rad=0.03)
+
+
 def test_stereo_disparity_is_f_b_over_z():
     rig = StereoRig()
     p = np.array([[30.0, 0.0, 1.0]])
