@@ -6,7 +6,7 @@ and it raises Ctrl-C as KeyboardInterrupt: a SIGINT that lands while a kernel ru
 handler while numba boxes the kernel's results, which numba does not check, and CPython then reports the call as
 a chain of SystemErrors ("returned a result with an exception set") that ends in the KeyboardInterrupt, which the
 commands' Ctrl-C handling would not recognise. Functions only called from compiled code (helpers) are
-``numba.njit(cache=True)`` alone.
+``numba.njit(cache=True)`` alone (with ``error_model="numpy"`` as well where a helper's own loop divides).
 """
 
 from __future__ import annotations
@@ -25,11 +25,17 @@ def optional(a: np.ndarray | None, dtype, ndim: int = 2) -> np.ndarray:
 
 
 def kernel(**options) -> Callable[[Callable], Callable]:
-    """``@kernel(...)``: ``numba.njit(cache=True, **options)``, called through a wrapper that turns the SystemError
-    chain of an interrupted call back into KeyboardInterrupt. The dispatcher itself is ``.dispatcher``."""
+    """``@kernel(...)``: ``numba.njit(cache=True, error_model="numpy", **options)``, called through a wrapper that
+    turns the SystemError chain of an interrupted call back into KeyboardInterrupt. The dispatcher itself is
+    ``.dispatcher``.
+
+    numpy's error model, not numba's default (Python's): a float division by zero gives inf or nan as IEEE 754 says
+    instead of raising, so that a loop that divides has no test in it and can be vectorised (the renderer's depth
+    from the z-buffer, the HOG blocks' norms). Every kernel guards the divisions whose divisor can be zero itself;
+    where none is zero the results are the same under either model."""
 
     def wrap(fn: Callable) -> Callable:
-        dispatcher = njit(cache=True, **options)(fn)
+        dispatcher = njit(cache=True, **{"error_model": "numpy", **options})(fn)
 
         @functools.wraps(fn)
         def call(*args):

@@ -85,7 +85,7 @@ def hog_blocks(image: np.ndarray, cell_px: int) -> np.ndarray:
     return _blocks(mag, bins, c, axis_weights(c), np.float32(L2HYS_CLIP))
 
 
-@kernel(error_model="numpy")
+@kernel()
 def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
     """Blocks (nbx, nby, 36) from magnitudes (h, w, 2) and bins (h, w, 2); wx: ``axis_weights(c)``."""
     h, w = mag.shape[0], mag.shape[1]

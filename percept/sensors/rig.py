@@ -54,9 +54,9 @@ class StereoRig:
             raise ValueError(f"pitch_rad {self.pitch_rad} is outside (-0.5, 0.5)")
         # the frame changes and ground homographies of both cameras, computed once (read-only: callers share them)
         cache = {}
+        R = _read_only(self.rotation_cam_from_vehicle())
         for side in Side:
-            R = self.rotation_cam_from_vehicle()
-            T = Transform(_read_only(R), _read_only(-R @ self.camera_position(side)))
+            T = Transform(R, _read_only(-R @ self.camera_position(side)))
             # (u, v, 1) ~ K [r1 r2 t] (x, y, 1) for points with z_v = 0
             H = self.camera.K @ np.column_stack([T.R[:, 0], T.R[:, 1], T.t])
             cache[side] = (T, _read_only(H), _read_only(np.linalg.inv(H)))

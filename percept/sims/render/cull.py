@@ -15,7 +15,7 @@ from percept.compiled import kernel
 from .vec3 import cross, dot
 
 
-@kernel(error_model="numpy")
+@kernel()
 def project_patches(O, E1, E2, two_sided, fx, fy, cx, cy, W, H, near):  # pragma: no cover - compiled
     """Patches (origin ``O``, sides ``E1``, ``E2``: (P, 3) in the camera frame) seen from the front
     (or ``two_sided``) and not wholly behind the ``near`` plane: their indices and, per kept patch, the pixel box
@@ -94,7 +94,7 @@ def project_patches(O, E1, E2, two_sided, fx, fy, cx, cy, W, H, near):  # pragma
     return idx[:m], box[:m], zmin[:m], crossing[:m], area[:m], width[:m]
 
 
-@kernel(error_model="numpy")
+@kernel()
 def inverse_rows(o, e1, e2, drawable, fx, fy, cx, cy):  # pragma: no cover - compiled
     """Per patch (camera frame, (P, 3)) with ``drawable``: A = K [e1 e2 o] and the affine rows of a' = 2 s/Z - 1/Z,
     b' = 2 t/Z - 1/Z, c = 1/Z from A^-1 = (a2 x a3, a3 x a1, a1 x a2) / det; patches whose A is singular are

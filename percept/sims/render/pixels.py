@@ -146,11 +146,11 @@ def clear_boxes(winner, order, x0, x1, y0, ends):  # pragma: no cover - compiled
                 winner[y, x] = -1
 
 
-@kernel(error_model="numpy")
+@kernel()
 def zbuffer_depth(inv, base, background):  # pragma: no cover - compiled
     """Depth (H, W) float32 [m]: 1 / ``inv`` wherever a patch won the z-test (``inv`` differs from ``base``, what
-    the z-buffer held before any patch), else ``background``'s (float32 1/x, as numpy divides; numpy's error model,
-    so that the loop is not held up by a test for division by zero, whose result is not taken)."""
+    the z-buffer held before any patch), else ``background``'s (float32 1/x, as numpy divides; every pixel divided, no
+    test for zero in the loop: ``kernel``'s numpy error model, and the quotient is not taken where inv is base's)."""
     out = np.empty_like(background)
     for y in range(inv.shape[0]):
         for x in range(inv.shape[1]):

@@ -34,7 +34,7 @@ def span_bounds(p, idx: np.ndarray) -> tuple[np.ndarray, ...]:
     return rp, v, lo, hi, first, last
 
 
-@kernel(error_model="numpy")
+@kernel()
 def _bounds(idx, x0, x1, y0, y1, ma, mb, mc, ellipse, rp, v, lo, hi, first, last):  # pragma: no cover - compiled
     r = 0
     for i in idx:
@@ -95,7 +95,7 @@ def smooth_edges(target, p, rp: np.ndarray, v: np.ndarray, lo: np.ndarray, hi: n
             hi_px)
 
 
-@kernel(error_model="numpy")
+@kernel()
 def _smooth(img, inv, em, W, mc, rp, v, lo, hi, lo_px, hi_px):  # pragma: no cover - compiled
     n = len(rp)
     tgt = np.empty(2 * n, np.int64)
