@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import cv2
@@ -61,12 +61,15 @@ SLOT_PASSES = 3
 def slot_ms(slot, shots: list, passes: int = SLOT_PASSES, progress: Callable[[], None] | None = None) -> float:
     """Mean cost per frame [ms] of a stateful slot stepped through consecutive ``shots`` ((frame, upstream)
     pairs) from ``reset()``: one warm-up pass (caches, first allocations), then the median over ``passes`` passes
-    of each pass's mean, so that one stall of the machine in one pass does not move the figure."""
+    of each pass's mean, so that one stall of the machine in one pass does not move the figure. Each pass gets
+    fresh copies of the frames: what a frame converts once for every slot (its grey images) is paid in every pass,
+    as the first slot to read it pays it in the loop."""
     means = []
     for i in range(passes + 1):
+        fresh = [(replace(frame), upstream) for frame, upstream in shots]
         slot.reset()
         t0 = time.perf_counter()
-        for frame, upstream in shots:
+        for frame, upstream in fresh:
             slot.step(frame, upstream)
             if progress:
                 progress()

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
@@ -125,8 +124,7 @@ class LongitudinalSlot:
         ob = ref = z = contact = expansion = None
         used: tuple[str, ...] = ()
         if not frame.dropped:
-            left = cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY)
-            right = cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY)
+            left, right = frame.left_gray, frame.right_gray
             ob, _ = self.finder.find(left, right, path)
             if ob is not None:
                 ref = self._refine(left, right, ob)

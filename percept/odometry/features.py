@@ -44,16 +44,6 @@ def check_intrinsics(K) -> np.ndarray:
     return K
 
 
-def to_gray(image: np.ndarray) -> np.ndarray:
-    """(H, W, 3) BGR or (H, W) grey uint8 -> (H, W) grey uint8."""
-    img = np.asarray(image)
-    if img.ndim == 3 and img.shape[2] == 3:
-        return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-    if img.ndim == 2:
-        return img if img.dtype == np.uint8 else np.clip(img, 0, 255).astype(np.uint8)
-    raise ValueError(f"expected an (H, W) or (H, W, 3) image, got shape {img.shape}")
-
-
 def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], threshold: int,
                    mask: np.ndarray | None = None, noise: float | None = None) -> np.ndarray:
     """FAST corners, the strongest few per grid cell so that they cover the image: (N, 2) float32 [px]. The

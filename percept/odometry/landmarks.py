@@ -15,9 +15,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from percept.sensors import LandmarkMap, Pose2D, Side, StereoRig
+from percept.sensors import LandmarkMap, Pose2D, Side, StereoRig, to_gray
 
-from .features import to_gray
 
 ARUCO_DICTIONARY = cv2.aruco.DICT_4X4_50
 

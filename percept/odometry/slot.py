@@ -15,7 +15,6 @@ import numpy as np
 from percept.sensors import (Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig, as_sample, plausible_speed,
                              plausible_yaw_rate)
 
-from .features import to_gray
 from .fusion import FusionNoise, PoseFilter
 from .landmarks import LandmarkFinder, LandmarkSighting
 from .stereo_vo import StereoVO
@@ -98,8 +97,8 @@ class OdometrySlot:
                 f.predict(w, a, self.dt_s)
             f.update_wheel(v)
         self._frames += 1
-        # the left image in grey once, for VO and the sign search
-        left = None if frame.left is None else to_gray(frame.left)
+        # the left image in grey, shared with the other slots, for VO and the sign search
+        left = frame.left_gray
         vo = self._visual_odometry(frame, left, upstream, self._prior(w, v))
         sightings: list[LandmarkSighting] = []
         fixes = 0

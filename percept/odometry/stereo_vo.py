@@ -17,7 +17,9 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from .features import check_intrinsics, detect_corners, noise_sigma, pose_covariance, to_gray, track
+from percept.sensors import to_gray
+
+from .features import check_intrinsics, detect_corners, noise_sigma, pose_covariance, track
 from .types import VOStep
 
 

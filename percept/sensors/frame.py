@@ -3,8 +3,30 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
+import cv2
 import numpy as np
+
+
+def to_gray(image: np.ndarray) -> np.ndarray:
+    """(H, W, 3) BGR or (H, W) grey uint8 -> (H, W) grey uint8 (OpenCV's BGR weights; other grey types clipped)."""
+    img = np.asarray(image)
+    if img.ndim == 3 and img.shape[2] == 3:
+        return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    if img.ndim == 2:
+        return img if img.dtype == np.uint8 else np.clip(img, 0, 255).astype(np.uint8)
+    raise ValueError(f"expected an (H, W) or (H, W, 3) image, got shape {img.shape}")
+
+
+def _read_only_gray(image: np.ndarray | None) -> np.ndarray | None:
+    if image is None:
+        return None
+    out = to_gray(image)
+    if out is image:
+        out = out.view()
+    out.flags.writeable = False
+    return out
 
 
 @dataclass(frozen=True)
@@ -33,6 +55,8 @@ class Frame:
     left, right: (H, W, 3) uint8 BGR images, or None when the frame was dropped;
     timestamp_s: time since the run started [s]; index: frame counter;
     imu: IMU sample; wheel_speed_mps: speed from the wheel encoders [m/s].
+    ``left_gray`` / ``right_gray``: the images in grey, converted on first use and then shared by every slot that
+    reads them (read-only; None when dropped).
     """
 
     index: int
@@ -45,3 +69,13 @@ class Frame:
     @property
     def dropped(self) -> bool:
         return self.left is None or self.right is None
+
+    @cached_property
+    def left_gray(self) -> np.ndarray | None:
+        """(H, W) uint8, read-only: ``left`` in grey, converted once."""
+        return _read_only_gray(self.left)
+
+    @cached_property
+    def right_gray(self) -> np.ndarray | None:
+        """(H, W) uint8, read-only: ``right`` in grey, converted once."""
+        return _read_only_gray(self.right)
