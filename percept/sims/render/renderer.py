@@ -20,6 +20,7 @@ import numpy as np
 from percept.sensors import Pose2D, Side, StereoRig
 
 from ..road_geometry import RoadGeometry
+from .grid import GroundGrid
 from .ground import GroundLayer, Palette
 from .fragments import PreparedPatches, WinnerMap, rasterize_prepared
 from .paint import GroundPaint, ground_paint
@@ -34,6 +35,10 @@ from .textures import TextureAtlas, building_texture, foliage_texture, marker_te
 from .vehicles import vehicle_patches
 
 SCENERY_RANGE_M = 260.0
+SCENERY_CELL_M = 50.0
+"""Side of the cells the scenery is bucketed in for the per-frame view-cone test [m]."""
+VIEW_MARGIN_RAD = 0.05
+"""How far beyond half the horizontal field of view the view-cone test reaches [rad]."""
 _TEMPLATE_CACHE = 1024
 
 
@@ -85,6 +90,16 @@ class StereoRenderer:
         self._scenery_radius = (l1 + l2) / 2
         # beyond f min(|e1|, |e2|) / LOD_PX a patch is narrower than LOD_PX on screen, so the rasteriser skips it
         self._scenery_reach = rig.camera.fx * np.minimum(l1, l2) / LOD_PX
+        self._scenery_grid = GroundGrid(self._scenery_centre, SCENERY_CELL_M)
+        # the view-cone test (``_scenery_in_view``) passes only patches with -r < x < RANGE + r (x = d_x - mount_x)
+        # and |d_y| < (x + r) slope + r + b, r at most the largest radius: a box in the vehicle frame (1 m wider)
+        slope = math.tan(rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
+        r_max = float(self._scenery_radius.max()) if len(self._scenery_radius) else 0.0
+        y_max = ((SCENERY_RANGE_M + 2 * r_max) * slope + r_max + rig.baseline_m + 1.0 if 0 < slope < math.inf
+                 else math.inf)
+        self._cone_box = np.array([[rig.mount_x_m - r_max - 1.0, -y_max], [rig.mount_x_m - r_max - 1.0, y_max],
+                                   [rig.mount_x_m + SCENERY_RANGE_M + r_max + 1.0, -y_max],
+                                   [rig.mount_x_m + SCENERY_RANGE_M + r_max + 1.0, y_max]])
         self._templates: dict[tuple, np.ndarray] = {}
         # the compiled kernels loaded (or compiled, once after an install) now, not in a timed frame: every path of
         # the rasteriser on a synthetic scene, then one frame of this road with a person on it (the road paint, the
@@ -165,15 +180,17 @@ class StereoRenderer:
         return PatchBatch.unpack(np.concatenate(parts)) if parts else PatchBatch.empty()
 
     def _scenery_in_view(self, scene: Scene) -> np.ndarray:
-        """Indices of scenery whose bounding circle meets the rig's horizontal view cone, within range and
-        within its level-of-detail reach."""
-        d = scene.ego.to_vehicle_xy(self._scenery_centre)
-        r = self._scenery_radius
+        """Indices (ascending) of scenery whose bounding circle meets the rig's horizontal view cone, within range
+        and within its level-of-detail reach; only the scenery in the grid's cells near the car is tested."""
+        box = scene.ego.world_from_vehicle().apply(np.column_stack([self._cone_box, np.zeros(4)]))
+        near = self._scenery_grid.within(*box[:, :2].min(axis=0), *box[:, :2].max(axis=0))
+        d = scene.ego.to_vehicle_xy(self._scenery_centre[near])
+        r = self._scenery_radius[near]
         x = d[:, 0] - self.rig.mount_x_m
         # |y| <= (x + r) tan(hfov/2 + margin) + r + baseline
-        slope = math.tan(self.rig.camera.hfov_rad / 2 + 0.05)
-        return np.flatnonzero((x + r > 0) & (x - r < np.minimum(SCENERY_RANGE_M, self._scenery_reach))
-                              & (np.abs(d[:, 1]) - r < (x + r) * slope + self.rig.baseline_m))
+        slope = math.tan(self.rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
+        return near[(x + r > 0) & (x - r < np.minimum(SCENERY_RANGE_M, self._scenery_reach[near]))
+                    & (np.abs(d[:, 1]) - r < (x + r) * slope + self.rig.baseline_m)]
 
     def scene_patches(self, scene: Scene) -> PatchBatch:
         """Scenery in view and every object, as one batch for both cameras."""
