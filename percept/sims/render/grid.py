@@ -26,9 +26,6 @@ class GroundGrid:
         self._order = np.argsort(key, kind="stable")
         self._starts = np.searchsorted(key[self._order], np.arange(int(np.prod(self._shape)) + 1))
 
-    def __len__(self) -> int:
-        return len(self._order)
-
     def within(self, x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
         if not all(math.isfinite(c) for c in (x0, y0, x1, y1)):
             return np.arange(len(self._order))
