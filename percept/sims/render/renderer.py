@@ -93,7 +93,7 @@ class StereoRenderer:
         self._scenery_grid = GroundGrid(self._scenery_centre, SCENERY_CELL_M)
         # the view-cone test (``_scenery_in_view``) passes only patches with -r < x < RANGE + r (x = d_x - mount_x)
         # and |d_y| < (x + r) slope + r + b, r at most the largest radius: a box in the vehicle frame (1 m wider)
-        slope = math.tan(rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
+        self._cone_slope = slope = math.tan(rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
         r_max = float(self._scenery_radius.max()) if len(self._scenery_radius) else 0.0
         y_max = ((SCENERY_RANGE_M + 2 * r_max) * slope + r_max + rig.baseline_m + 1.0 if 0 < slope < math.inf
                  else math.inf)
@@ -188,9 +188,8 @@ class StereoRenderer:
         r = self._scenery_radius[near]
         x = d[:, 0] - self.rig.mount_x_m
         # |y| <= (x + r) tan(hfov/2 + margin) + r + baseline
-        slope = math.tan(self.rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
         return near[(x + r > 0) & (x - r < np.minimum(SCENERY_RANGE_M, self._scenery_reach[near]))
-                    & (np.abs(d[:, 1]) - r < (x + r) * slope + self.rig.baseline_m)]
+                    & (np.abs(d[:, 1]) - r < (x + r) * self._cone_slope + self.rig.baseline_m)]
 
     def scene_patches(self, scene: Scene) -> PatchBatch:
         """Scenery in view and every object, as one batch for both cameras."""
