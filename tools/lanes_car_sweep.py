@@ -39,9 +39,10 @@ def frame_path(name: str) -> Path:
     return SAMPLES / name if not Path(name).exists() and (SAMPLES / name).exists() else Path(name)
 
 
-def sweep(path: Path, frame: np.ndarray, lanes: FootageLanes, out: Path | None) -> tuple[int, int]:
-    """Placements tried on ``frame`` (as the fit sees it: undistorted) and those that moved a boundary by more than
-    TOLERANCE_PX below the car."""
+def sweep(path: Path, frame: np.ndarray, lanes: FootageLanes, out: Path | None,
+          sides: tuple[str, ...] = ("left", "right"), ranges: tuple[int, ...] = RANGES_M) -> tuple[int, int]:
+    """Placements tried on ``frame`` (as the fit sees it: undistorted), over each line of ``sides`` at each of
+    ``ranges`` [m], and those that moved a boundary by more than TOLERANCE_PX below the car."""
     u, v, w, h = cv2.boundingRect(CAR_OUTLINE_PX)
     car = read_image(SAMPLES / "3.jpg")[v:v + h, u:u + w]
     outline = cv2.fillPoly(np.zeros((h, w), np.uint8), [CAR_OUTLINE_PX - [u, v]], 255)
@@ -53,8 +54,8 @@ def sweep(path: Path, frame: np.ndarray, lanes: FootageLanes, out: Path | None) 
     print(f"{path.name} at {height_m:.2f} m, no car: curvature {e.curvature_1pm:+.5f} 1/m, heading "
           f"{math.degrees(e.heading_rad):+.2f} deg, width {e.width_m:.2f} m")
     tried = moved = 0
-    for side in ("left", "right"):
-        for x in RANGES_M:
+    for side in sides:
+        for x in ranges:
             # bottom row v = horizon + f h / x; width f W / x [px]
             v_bottom = int(round(plain.rig.horizon_row + plain.rig.camera.fx * height_m / x))
             w_px = int(round(plain.rig.camera.fx * CAR_WIDTH_M / x))

@@ -10,7 +10,7 @@ Yellow and white both score high on max(R, G).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 
 import cv2
@@ -19,6 +19,7 @@ import numpy as np
 from percept.sensors import Side, StereoRig
 
 from .types import MarkingEvidence
+from .vehicles import VehicleConfig, find_vehicles, mask_evidence
 
 
 class Brightness(str, Enum):
@@ -44,7 +45,8 @@ class EvidenceConfig:
     min_contrast: absolute top-hat threshold [grey levels]; rel_contrast: threshold relative to the frame's strong
     responses; brightness: the paint measure; max_row_px: image rows below this are not road (a car's hood),
     None = all rows; row_step_px: None = grid rows every dx_m; else every row_step_px image rows where that is
-    closer (near the camera, where a dx_m step skips many image rows), never further apart than dx_m."""
+    closer (near the camera, where a dx_m step skips many image rows), never further apart than dx_m; vehicles:
+    None = keep all evidence, else the evidence a vehicle covers is dropped (``vehicles.find_vehicles``)."""
 
     x_near_m: float = 6.0
     x_far_m: float = 50.0
@@ -58,6 +60,7 @@ class EvidenceConfig:
     brightness: Brightness = Brightness.MAX_RG
     max_row_px: float | None = None
     row_step_px: float | None = None
+    vehicles: VehicleConfig | None = None
 
     def __post_init__(self) -> None:
         if not 0 < self.x_near_m < self.x_far_m:
@@ -152,4 +155,8 @@ class MarkingExtractor:
         keep = (v >= resp[r, c - 1]) & (v > resp[r, c + 1])
         r, c = r[keep], c[keep]
         pts = np.column_stack([self.x[r], self.y[c]])
-        return MarkingEvidence(pts, v[keep], self.uv[r, c], self.row_weight[r])
+        ev = MarkingEvidence(pts, v[keep], self.uv[r, c], self.row_weight[r])
+        if self.cfg.vehicles is None:
+            return ev
+        boxes = find_vehicles(image, self.rig, self.cfg.max_row_px, self.cfg.vehicles)
+        return replace(mask_evidence(ev, boxes, self.rig.horizon_row, self.cfg.vehicles.pad), vehicles=tuple(boxes))

@@ -1,7 +1,8 @@
 """Overlay of a lane result on the camera image: both boundaries, the lane area, the evidence and the values.
 
 Boundaries are projected from the vehicle frame with the rig (see ``realworld.boundary_points_px``); the
-evidence dots are the top-hat stripe centres (green: fitted left, magenta: fitted right, grey: outliers).
+evidence dots are the top-hat stripe centres (green: fitted left, magenta: fitted right, grey: outliers); a red
+frame marks each vehicle whose evidence was dropped (its shade's width, 1.5 m tall at its range).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from .realworld import LaneResult
 LEFT_BGR = (0, 220, 255)  # yellow-orange
 RIGHT_BGR = (255, 160, 0)  # blue
 TEXT_BGR = (255, 255, 255)
+VEHICLE_BGR = (0, 0, 255)
 
 
 def _text_block(img: np.ndarray, lines: list[str], scale: float) -> np.ndarray:
@@ -47,6 +49,10 @@ def draw_overlay(image: np.ndarray, result: LaneResult, label: str = "", evidenc
             cv2.line(out, (u, hz), (min(u + 12, w - 1), hz), (200, 200, 200), 1, cv2.LINE_AA)
     ev = result.debug.evidence
     fit = result.debug.fit
+    for box in () if ev is None else ev.vehicles:
+        tall = int(round(result.rig.camera.fx * 1.5 / box.range_m))
+        cv2.rectangle(out, (box.u0_px, box.bottom_px - tall), (box.u1_px - 1, box.bottom_px), VEHICLE_BGR,
+                      max(1, lw // 2), cv2.LINE_AA)
     if evidence and ev is not None and len(ev.uv_px):
         side = fit.side if fit is not None else np.zeros(len(ev.uv_px), int)
         colours = {1: (0, 255, 0), -1: (255, 0, 255), 0: (160, 160, 160)}

@@ -24,6 +24,7 @@ from .horizon import VanishingPoint
 from .evidence import Brightness, EvidenceConfig
 from .fit import FitConfig
 from .types import LaneEstimate
+from .vehicles import VehicleConfig
 
 
 def _real_lane_config() -> LaneConfig:
@@ -31,9 +32,9 @@ def _real_lane_config() -> LaneConfig:
     # rows near the camera (a 0.25 m step there skips 20 rows of a 720-row frame: a near dash gave 2-3 points and
     # the far evidence placed the near boundary). Freeway geometry (radius >= ~500 m, spirals >= ~100 m at
     # 100 km/h) changes curvature by at most ~2e-5 per metre, and a single frame seen to 40 m cannot tell a cubic
-    # from a quadratic: the curvature-rate prior is that tight.
+    # from a quadratic: the curvature-rate prior is that tight. A vehicle over a marking masks it (``vehicles.py``).
     return LaneConfig(evidence=EvidenceConfig(min_contrast=6.0, rel_contrast=0.2, brightness=Brightness.MAX_RG_YELLOW,
-                                              row_step_px=4.0),
+                                              row_step_px=4.0, vehicles=VehicleConfig()),
                       fit=FitConfig(curvature_rate_sigma_1pm2=3e-5, straight_seeds=True))
 
 

@@ -14,12 +14,13 @@ class MarkingEvidence:
     """Marking pixels mapped to the ground. points_m: (N, 2) vehicle-frame (x, y) [m]; strength: (N,) top-hat
     response; uv_px: (N, 2) where they are in the image (u, v); weight: (N,) how much independent image evidence
     each point carries, 0..1 (far grid rows re-sample the same image rows, and a far pixel spans more ground);
-    None = all 1."""
+    None = all 1; vehicles: the ``vehicles.VehicleBox`` es whose evidence was dropped (footage only)."""
 
     points_m: np.ndarray
     strength: np.ndarray
     uv_px: np.ndarray
     weight: np.ndarray | None = None
+    vehicles: tuple = ()
 
 
 @dataclass(frozen=True)
