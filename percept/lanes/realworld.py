@@ -157,7 +157,9 @@ class LaneResult:
                 "vanishing_point_px": None if vp is None else [round(vp.u, 1), round(vp.v, 1)],
                 "horizon_source": "assumed" if vp is None else vp.source,
                 "mount_height_m": round(self.rig.mount_height_m, 3), "mount_height_source": g.height_source,
-                "hood_row_px": g.hood_row_px, "bottom_row_px": g.bottom_row_px}
+                "hood_row_px": g.hood_row_px, "bottom_row_px": g.bottom_row_px,
+                "vehicles_px": [[b.u0_px, b.u1_px, b.bottom_px] for b in ev.vehicles] if (ev := self.debug.evidence)
+                else []}
 
 
 def _drawn_ranges(det: LaneDetector, dbg: LaneDebug) -> dict[str, tuple[float, float]]:

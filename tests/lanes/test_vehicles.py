@@ -114,6 +114,8 @@ def test_the_suv_in_tusimple_3_is_found():
     # the SUV left of the ego lane: columns ~180-366, its shade's bottom row ~376 (CAR_OUTLINE_PX in the sweep)
     hits = [b for b in r.debug.evidence.vehicles if b.u0_px < 300 and b.u1_px > 250 and 365 <= b.bottom_px <= 385]
     assert len(hits) == 1, r.debug.evidence.vehicles
+    b = hits[0]
+    assert [b.u0_px, b.u1_px, b.bottom_px] in r.to_dict()["vehicles_px"]
 
 
 def test_udacity_tree_shade_is_not_a_vehicle():
