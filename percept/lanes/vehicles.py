@@ -70,7 +70,7 @@ class VehicleBox:
 
 def _runs(row: np.ndarray) -> list[tuple[int, int]]:
     """(start, end) of the True runs of a bool row."""
-    idx = np.flatnonzero(np.diff(np.r_[0, row.view(np.int8), 0]))
+    idx = np.flatnonzero(np.diff(row.view(np.int8), prepend=0, append=0))
     return list(zip(idx[::2].tolist(), idx[1::2].tolist()))
 
 
@@ -87,12 +87,17 @@ def find_vehicles(image: np.ndarray, rig: StereoRig, bottom_row_px: float | None
     top = int(math.ceil(hz + fx * h / cfg.max_range_m))
     if last - 4 <= top:
         return []
-    level = np.percentile(g[:, W // 10:W - W // 10], 60, axis=1)
+    # the rows below the horizon only (a body's window above the farthest bottom starts below it too)
+    r0 = max(int(hz), 0)
+    level = np.full(H, np.inf)
+    level[r0:] = np.percentile(g[r0:, W // 10:W - W // 10], 60, axis=1)
     shade = g < cfg.dark_ratio * level[:, None]
     lit = g > cfg.lit_ratio * level[:, None]
     bottom = np.zeros_like(shade)
     bottom[:-3] = shade[:-3] & lit[3:]
-    mag = cv2.magnitude(cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3))
+    mag = np.zeros_like(g)
+    below = g[r0:]
+    mag[r0:] = cv2.magnitude(cv2.Sobel(below, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(below, cv2.CV_32F, 0, 1, ksize=3))
     taken = np.zeros(W, bool)
     out = []
     for v in range(last - 4, top - 1, -1):  # bottom up: the nearest first, which hides what is behind it
