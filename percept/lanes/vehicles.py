@@ -10,7 +10,7 @@ it and few of those pixels have the road's brightness.
 
 A vehicle hides the markings behind it and its own edges pass the stripe test: the evidence in the columns of each
 vehicle (10 % wider), from the horizon down to its bottom row, is dropped (``mask_evidence``). Tried on footage only
-(``EvidenceConfig.mask_vehicles``); the simulator's fit is unchanged.
+(``EvidenceConfig.vehicles``); the simulator's fit is unchanged.
 """
 
 from __future__ import annotations
@@ -89,7 +89,7 @@ def find_vehicles(image: np.ndarray, rig: StereoRig, bottom_row_px: float | None
         return []
     # the rows below the horizon only (a body's window above the farthest bottom starts below it too)
     r0 = max(int(hz), 0)
-    level = np.full(H, np.inf)
+    level = np.full(H, np.nan)
     level[r0:] = np.percentile(g[r0:, W // 10:W - W // 10], 60, axis=1)
     shade = g < cfg.dark_ratio * level[:, None]
     lit = g > cfg.lit_ratio * level[:, None]
