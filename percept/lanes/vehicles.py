@@ -68,10 +68,16 @@ class VehicleBox:
         return (u >= self.u0_px - m) & (u <= self.u1_px + m) & (v >= horizon_px - 1) & (v <= self.bottom_px + 2)
 
 
-def _runs(row: np.ndarray) -> list[tuple[int, int]]:
-    """(start, end) of the True runs of a bool row."""
-    idx = np.flatnonzero(np.diff(row.view(np.int8), prepend=0, append=0))
-    return list(zip(idx[::2].tolist(), idx[1::2].tolist()))
+def _closed(starts: np.ndarray, ends: np.ndarray, k: int) -> list[tuple[int, int]]:
+    """The runs [start, end) of a bool row after a morphological closing by a 1 x k segment: neighbouring runs
+    merged where the gap between them is shorter than k."""
+    out = []
+    for a, b in zip(starts.tolist(), ends.tolist()):
+        if out and a - out[-1][1] < k:
+            out[-1] = (out[-1][0], b)
+        else:
+            out.append((a, b))
+    return out
 
 
 def find_vehicles(image: np.ndarray, rig: StereoRig, bottom_row_px: float | None = None,
@@ -98,17 +104,19 @@ def find_vehicles(image: np.ndarray, rig: StereoRig, bottom_row_px: float | None
     mag = np.zeros_like(g)
     below = g[r0:]
     mag[r0:] = cv2.magnitude(cv2.Sobel(below, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(below, cv2.CV_32F, 0, 1, ksize=3))
+    # every row's runs of shade bottom at once: where each starts and ends (row-major order)
+    rows, cols = np.nonzero(np.diff(bottom.view(np.int8), axis=1, prepend=0, append=0))
+    first = np.searchsorted(rows, np.arange(H + 1))
     taken = np.zeros(W, bool)
     out = []
     for v in range(last - 4, top - 1, -1):  # bottom up: the nearest first, which hides what is behind it
-        if not bottom[v].any():
+        i, j = first[v], first[v + 1]
+        if i == j:
             continue
         x = fx * h / (v - hz)
         ppm = fx / x
         # the shade's gaps closed (the wheels, a bright plate's reflection)
-        k = max(int(cfg.gap_m * ppm), 1)
-        row = cv2.morphologyEx(bottom[v].view(np.uint8)[None], cv2.MORPH_CLOSE, np.ones((1, k), np.uint8))[0] > 0
-        for a, b in _runs(row):
+        for a, b in _closed(cols[i:j:2], cols[i + 1:j:2], max(int(cfg.gap_m * ppm), 1)):
             if not cfg.width_m[0] <= (b - a) / ppm <= cfg.width_m[1] or taken[a:b].mean() > 0.3:
                 continue
             body = max(int(cfg.body_m * ppm), 3)

@@ -141,3 +141,13 @@ def test_a_car_pasted_over_tusimple_2s_left_line_no_longer_pulls_the_boundary(tm
                           RealLaneConfig().lane, evidence=replace(FOOTAGE, vehicles=None))))):
         moved[name] = sweep(TUSIMPLE / "2.jpg", frame, FootageLanes(cfg), None, sides=("left",), ranges=(25,))
     assert moved["unmasked"] == (1, 1) and moved["masked"] == (1, 0), moved
+
+
+def test_a_shades_gaps_shorter_than_the_kernel_close_and_its_runs_stay_in_place():
+    from percept.lanes.vehicles import _closed
+
+    # runs [10, 15) and [17, 22): a gap of 2 columns
+    starts, ends = np.array([10, 17]), np.array([15, 22])
+    assert _closed(starts, ends, 2) == [(10, 15), (17, 22)]
+    assert _closed(starts, ends, 3) == [(10, 22)]
+    assert _closed(np.array([], int), np.array([], int), 3) == []
