@@ -19,6 +19,9 @@ from percept.sensors import LandmarkMap, Pose2D, Side, StereoRig, to_gray
 
 
 ARUCO_DICTIONARY = cv2.aruco.DICT_4X4_50
+MIN_PERIMETER_RATE = 0.03
+"""OpenCV's default ``minMarkerPerimeterRate``: the least share of the image's longer side a marker's perimeter
+needs."""
 
 
 @dataclass(frozen=True)
@@ -39,7 +42,9 @@ class SightingConfig:
     """min_range_m, max_range_m: camera depths at which a sign is looked for; corner_sigma_px: a refined marker
     corner's error at the least (a sighting whose corners disagree between the images gets more); face_sigma_m:
     how far the face centre may lie from the mapped point (face offset, survey); margin_px: added around a
-    predicted window; sigma_window: pose-uncertainty sigmas the window covers."""
+    predicted window; sigma_window: pose-uncertainty sigmas the window covers; marker_side_m: the side of a sign's
+    marker (its black square) [m]; min_perimeter_share: ArUco skips candidates whose perimeter is under this share
+    of the marker's expected one (at its predicted range, face on): most of its cost is in the small ones."""
 
     min_range_m: float = 4.0
     max_range_m: float = 32.0
@@ -47,6 +52,8 @@ class SightingConfig:
     face_sigma_m: float = 0.06
     margin_px: int = 12
     sigma_window: float = 3.0
+    marker_side_m: float = 0.63
+    min_perimeter_share: float = 0.25
 
 
 class LandmarkFinder:
@@ -54,13 +61,14 @@ class LandmarkFinder:
 
     def __init__(self, rig: StereoRig, landmarks: LandmarkMap, config: SightingConfig = SightingConfig()):
         self.rig, self.map, self.config = rig, landmarks, config
-        params = cv2.aruco.DetectorParameters()
-        params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
-        self.detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(ARUCO_DICTIONARY), params)
+        self._params = cv2.aruco.DetectorParameters()
+        self._params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
+        self.detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(ARUCO_DICTIONARY), self._params)
         self._v_from_c = rig.cam_from_vehicle(Side.LEFT).inverse()
 
-    def expected(self, pose: Pose2D, pose_cov: np.ndarray) -> list[tuple[int, tuple[int, int, int, int]]]:
-        """Mapped signs that should be in view at ``pose``: (marker id, left-image window (u0, v0, u1, v1))."""
+    def expected(self, pose: Pose2D, pose_cov: np.ndarray) -> list[tuple[int, tuple[int, int, int, int], float]]:
+        """Mapped signs that should be in view at ``pose``: (marker id, left-image window (u0, v0, u1, v1), the
+        smallest candidate perimeter worth checking there as a share of the window's longer side)."""
         if not len(self.map):
             return []
         c = self.config
@@ -78,12 +86,19 @@ class LandmarkFinder:
             box = (int(max(u - half, 0)), int(max(v - half, 0)), int(min(u + half, cam.width)),
                    int(min(v + half, cam.height)))
             if box[2] - box[0] >= 16 and box[3] - box[1] >= 16:
-                out.append((self.map.ids[k], box))
+                # the marker's perimeter face on: 4 f s / Z
+                perimeter = 4.0 * cam.fx * c.marker_side_m / z[k]
+                rate = c.min_perimeter_share * perimeter / max(box[2] - box[0], box[3] - box[1])
+                out.append((self.map.ids[k], box, float(np.clip(rate, MIN_PERIMETER_RATE, 1.0))))
         return out
 
-    def _find(self, image: np.ndarray, box: tuple[int, int, int, int], marker_id: int) -> np.ndarray | None:
-        """The marker's corners (4, 2) in ``box`` of the image (BGR or grey: only the box is made grey), or None."""
+    def _find(self, image: np.ndarray, box: tuple[int, int, int, int], marker_id: int,
+              perimeter_rate: float = MIN_PERIMETER_RATE) -> np.ndarray | None:
+        """The marker's corners (4, 2) in ``box`` of the image (BGR or grey: only the box is made grey), or None;
+        candidates with a perimeter under ``perimeter_rate`` x the box's longer side are not checked."""
         u0, v0, u1, v1 = box
+        self._params.minMarkerPerimeterRate = perimeter_rate
+        self.detector.setDetectorParameters(self._params)
         corners, ids, _ = self.detector.detectMarkers(to_gray(image[v0:v1, u0:u1]))
         if ids is None:
             return None
@@ -100,12 +115,14 @@ class LandmarkFinder:
         out = []
         # in the right image a sign is shifted left by its disparity: up to f b / min_range
         d_max = self.rig.disparity_px(self.config.min_range_m)
-        for marker_id, box in wanted:
-            cl = self._find(left, box, marker_id)
+        for marker_id, box, rate in wanted:
+            cl = self._find(left, box, marker_id, rate)
             if cl is None:
                 continue
             rbox = (int(max(box[0] - d_max, 0)), box[1], box[2], box[3])
-            cr = self._find(right, rbox, marker_id)
+            # the right window is wider by the disparity range: the same perimeter, a smaller share of it
+            cr = self._find(right, rbox, marker_id, rate * max(box[2] - box[0], box[3] - box[1]) / max(
+                rbox[2] - rbox[0], rbox[3] - rbox[1]))
             if cr is not None:
                 s = self._measure(marker_id, cl, cr)
                 if s is not None:
