@@ -26,9 +26,8 @@ from .types import VOStep
 @dataclass(frozen=True)
 class StereoVOConfig:
     """max_features: corners per keyframe; grid: cells (columns, rows) the corners are spread over;
-    fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels (prior_win_px and
-    prior_levels when a motion prior says where to start: a point starts within a pixel or two of where it is, and
-    a smaller window on the full image alone finds it, at about half the cost);
+    fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels (prior_levels when
+    a motion prior says where to start: a shallow pyramid suffices and costs less);
     max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
     point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
     ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
@@ -40,8 +39,7 @@ class StereoVOConfig:
     fast_threshold: int = 5
     win_px: int = 15
     levels: int = 3
-    prior_win_px: int = 11
-    prior_levels: int = 0
+    prior_levels: int = 1
     max_row_err_px: float = 0.7
     min_disparity_px: float = 0.5
     min_inliers: int = 12
@@ -53,10 +51,8 @@ class StereoVOConfig:
     def __post_init__(self) -> None:
         if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:
             raise ValueError("need max_features >= 20, min_inliers >= 6 and keyframe_inliers >= min_inliers")
-        if not (min(self.win_px, self.prior_win_px) >= 5 and min(self.levels, self.prior_levels) >= 0
-                and self.ransac_px > 0 and self.min_disparity_px > 0):
-            raise ValueError("win_px and prior_win_px >= 5, levels and prior_levels >= 0, ransac_px > 0 and "
-                             "min_disparity_px > 0 are required")
+        if not (self.win_px >= 5 and self.levels >= 0 and self.ransac_px > 0 and self.min_disparity_px > 0):
+            raise ValueError("win_px >= 5, levels >= 0, ransac_px > 0 and min_disparity_px > 0 are required")
 
 
 def _inverse(T: np.ndarray) -> np.ndarray:
@@ -181,8 +177,8 @@ class StereoVO:
     def _track(self, gl: np.ndarray, T_kf_pred: np.ndarray | None) -> VOStep:
         c = self.config
         expected = None if T_kf_pred is None else self._project(T_kf_pred)
-        win, levels = (c.win_px, c.levels) if expected is None else (c.prior_win_px, c.prior_levels)
-        moved, ok = track(self._prev, gl, self._pixels, win, levels, expected)
+        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels if expected is None else c.prior_levels,
+                          expected)
         ok &= self._static(moved)
         self._kf_points, self._pixels, self._kf_pixels = self._kf_points[ok], moved[ok], self._kf_pixels[ok]
         n = len(self._pixels)
