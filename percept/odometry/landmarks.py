@@ -43,8 +43,9 @@ class SightingConfig:
     corner's error at the least (a sighting whose corners disagree between the images gets more); face_sigma_m:
     how far the face centre may lie from the mapped point (face offset, survey); margin_px: added around a
     predicted window; sigma_window: pose-uncertainty sigmas the window covers; marker_side_m: the side of a sign's
-    marker (its black square) [m]; min_perimeter_share: ArUco skips candidates whose perimeter is under this share
-    of the marker's expected one (at its predicted range, face on): most of its cost is in the small ones."""
+    marker, its black square [m] (0.7 of the simulator's 0.9 m panel); min_perimeter_share: ArUco skips candidates
+    whose perimeter is under this share of the marker's expected one (at its predicted range, face on): most of its
+    cost is in the small ones."""
 
     min_range_m: float = 4.0
     max_range_m: float = 32.0
