@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from percept.sensors import StereoRig
+from percept.sensors import StereoRig, to_gray
 
 from .types import MarkingEvidence
 
@@ -84,8 +84,7 @@ def find_vehicles(image: np.ndarray, rig: StereoRig, bottom_row_px: float | None
                   cfg: VehicleConfig = VehicleConfig()) -> list[VehicleBox]:
     """Vehicles standing on the road in ``image`` (BGR or grey, the rig's size), nearest first; rows below
     ``bottom_row_px`` (a hood) are not road. The range of a row: x = fx h / (v - v_horizon)."""
-    grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
-    g = grey.astype(np.float32)
+    g = to_gray(image).astype(np.float32)
     H, W = g.shape
     hz, fx, h = rig.horizon_row, rig.camera.fx, rig.mount_height_m
     last = H - 1 if bottom_row_px is None else int(min(bottom_row_px, H - 1))
