@@ -77,6 +77,30 @@ def test_height_from_the_lane_width_over_a_folder(folder):
         assert (r.geometry.hood_row_px is not None) == (folder == LANES)
 
 
+# TuSimple 0.jpg: centres of the raised markers on the line left of the ego lane's left line, picked by hand [px]
+NEIGHBOUR_MARKERS_0 = np.array([[17.2, 432.2], [50.5, 420.0], [84.8, 409.4], [285.3, 340.3], [363.8, 314.2]])
+
+
+@needs["tusimple"]
+def test_the_wide_lane_of_tusimple_0_is_the_lane_not_the_calibration():
+    """0.jpg's lane reads over 4 m (its right line diverges towards an exit). With the same camera height and
+    horizon, the lane to its left, from its markers to the ego lane's left boundary at the same rows, reads as a
+    freeway lane, and the ego lane is 1.2-1.3 times it: the width is the lane's, not the calibration's."""
+    images = [read_image(p) for p in sorted(TUSIMPLE.glob("*.jpg"))]
+    lanes = FootageLanes(RealLaneConfig())
+    lanes.calibrate(images)
+    r = lanes.still(images[0])
+    rows = NEIGHBOUR_MARKERS_0[:, 1]
+    u = r.u_at_rows(rows)
+    side_m = {k: r.rig.image_to_ground(np.column_stack([v, rows]))[:, 1] for k, v in u.items()}
+    markers_m = r.rig.image_to_ground(NEIGHBOUR_MARKERS_0)[:, 1]
+    neighbour_m = markers_m - side_m["left"]
+    ego_m = side_m["left"] - side_m["right"]
+    assert np.all((3.3 <= neighbour_m) & (neighbour_m <= 3.8)), neighbour_m
+    assert np.all((1.15 <= ego_m / neighbour_m) & (ego_m / neighbour_m <= 1.35)), ego_m / neighbour_m
+    assert ego_m.min() > 4.0 and abs(r.estimate.width_m - ego_m.mean()) < 0.1
+
+
 def test_a_given_height_is_kept_and_a_bad_lane_width_refused():
     lanes = FootageLanes(RealLaneConfig(mount_height_m=1.5))
     assert lanes.calibrate([np.full((360, 640, 3), 90, np.uint8)]) is None and lanes.height_m == 1.5
