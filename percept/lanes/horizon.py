@@ -76,29 +76,33 @@ def estimate_vanishing_point(image: np.ndarray, roi_top_frac: float = 0.5, botto
     lines = np.cross(np.hstack([s[:, :2], ones]), np.hstack([s[:, 2:], ones]))
     lines /= np.hypot(lines[:, 0], lines[:, 1])[:, None] + 1e-12
     mid = (s[:, :2] + s[:, 2:]) / 2
-    left = [i for i in np.argsort(-length) if lean[i] < 0][:30]
-    right = [i for i in np.argsort(-length) if lean[i] > 0][:30]
+    order = np.argsort(-length)
+    left, right = order[lean[order] < 0][:30], order[lean[order] > 0][:30]
+    # every (left, right) pair, left-major: intersection of two lines x = l_i x l_j (H&Z sec. 2.2.1)
+    pi, pj = np.repeat(left, len(right)), np.tile(right, len(left))
+    x = np.cross(lines[pi], lines[pj])
+    ok = np.abs(x[:, 2]) >= 1e-9
+    pi, pj, x = pi[ok], pj[ok], x[ok, :2] / x[ok, 2:3]
+    ok = (0 <= x[:, 0]) & (x[:, 0] < w) & (0 <= x[:, 1]) & (x[:, 1] < h)
+    pi, pj, x = pi[ok], pj[ok], x[ok]
     best = None
-    for i in left:
-        for j in right:
-            # intersection of two lines: x = l_i x l_j (H&Z sec. 2.2.1)
-            x = np.cross(lines[i], lines[j])
-            if abs(x[2]) < 1e-9:
-                continue
-            x = x[:2] / x[2]
-            if not (0 <= x[0] < w and 0 <= x[1] < h):
-                continue
-            to = x - mid
-            dist = np.hypot(to[:, 0], to[:, 1]) + 1e-9
-            # |cos| of the angle between a segment and the ray from its midpoint to x
-            cos = np.abs(np.sum(to * d, axis=1)) / (dist * length)
-            inl = (cos > math.cos(max_angle_err_rad)) & (to[:, 1] < 0)
-            # both leans must be seen by at least two segments each (one stray mark does not make a lane line)
-            if not (inl[i] and inl[j]) or (inl & (lean < 0)).sum() < 2 or (inl & (lean > 0)).sum() < 2:
-                continue
-            score = float(length[inl].sum())
+    # pairs in chunks of at most ~2e5 pair-segment tests
+    step = max(1, 200_000 // max(len(s), 1))
+    for a in range(0, len(x), step):
+        to_u = x[a:a + step, None, 0] - mid[None, :, 0]
+        to_v = x[a:a + step, None, 1] - mid[None, :, 1]
+        dist = np.hypot(to_u, to_v) + 1e-9
+        # |cos| of the angle between a segment and the ray from its midpoint to x
+        cos = np.abs(to_u * d[:, 0] + to_v * d[:, 1]) / (dist * length)
+        inl = (cos > math.cos(max_angle_err_rad)) & (to_v < 0)
+        # both leans must be seen by at least two segments each (one stray mark does not make a lane line)
+        rows = np.arange(len(inl))
+        good = (inl[rows, pi[a:a + step]] & inl[rows, pj[a:a + step]] & ((inl & (lean < 0)).sum(axis=1) >= 2)
+                & ((inl & (lean > 0)).sum(axis=1) >= 2))
+        for k in np.flatnonzero(good):
+            score = float(length[inl[k]].sum())
             if best is None or score > best[0]:
-                best = (score, inl)
+                best = (score, inl[k])
     if best is None:
         return None
     score, inl = best
