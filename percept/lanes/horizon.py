@@ -139,8 +139,9 @@ def marking_vanishing_point(evidence: MarkingEvidence, fit: LaneFit, span_m: flo
 
 
 def make_rig(camera: PinholeCamera, horizon_row_px: float, mount_height_m: float) -> StereoRig:
-    """Monocular rig: the camera at the vehicle origin (mount_x_m = 0), pitched so that the ground's horizon
-    falls on ``horizon_row_px``: pitch = atan((cy - v_h) / fy) [rad]."""
+    """Monocular rig: the camera (the rig's left) level with the frame's origin (mount_x_m = 0) and half the nominal
+    baseline left of it (``LaneResult.offset_m`` reports the offset at the camera), pitched so that the ground's
+    horizon falls on ``horizon_row_px``: pitch = atan((cy - v_h) / fy) [rad]."""
     pitch = math.atan((camera.cy - horizon_row_px) / camera.fy)
     pitch = float(np.clip(pitch, -0.45, 0.45))
     return StereoRig(camera=camera, baseline_m=0.54, mount_height_m=mount_height_m, pitch_rad=pitch, mount_x_m=0.0)

@@ -69,7 +69,7 @@ def draw_overlay(image: np.ndarray, result: LaneResult, label: str = "", evidenc
     lines = [label] if label else []
     if e.valid:
         radius = "inf" if abs(e.curvature_1pm) < 1e-5 else f"{1.0 / e.curvature_1pm:+.0f} m"
-        lines += [f"offset {e.offset_m:+.2f} m   heading {math.degrees(e.heading_rad):+.2f} deg",
+        lines += [f"offset {result.offset_m:+.2f} m   heading {math.degrees(e.heading_rad):+.2f} deg",
                   f"curvature {e.curvature_1pm:+.5f} 1/m (R {radius})",
                   f"width {e.width_m:.2f} m   confidence {e.confidence:.2f}"]
     else:

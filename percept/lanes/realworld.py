@@ -133,6 +133,14 @@ class LaneResult:
         return self.geometry.vanishing_point
 
     @property
+    def offset_m(self) -> float:
+        """The camera's lateral offset from the lane centre [m] (+ left), which footage reports as the car's (a dash
+        camera sits on the car's centreline). The fit's frame (``horizon.make_rig``) has its origin half the rig's
+        nominal baseline right of the camera, so its offset is the origin's: offset_cam = offset + y_cam (the lane
+        centre at the car is y_c = -offset)."""
+        return self.estimate.offset_m + float(self.rig.camera_position()[1])
+
+    @property
     def both_found(self) -> bool:
         f = self.debug.fit
         return bool(self.estimate.valid and f is not None and f.inliers_left >= 5 and f.inliers_right >= 5)
@@ -149,7 +157,7 @@ class LaneResult:
         vp = g.vanishing_point
         num = (lambda v: float(v) if e.valid else None)
         return {"lanes": [{"side": k, "points_px": np.round(v, 1).tolist()} for k, v in self.boundaries_px.items()],
-                "offset_m": num(e.offset_m), "heading_rad": num(e.heading_rad), "curvature_1pm": num(e.curvature_1pm),
+                "offset_m": num(self.offset_m), "heading_rad": num(e.heading_rad), "curvature_1pm": num(e.curvature_1pm),
                 "width_m": num(e.width_m), "confidence": float(e.confidence) if e.valid else 0.0,
                 "ambiguity": None if self.debug.fit is None else round(self.debug.fit.ambiguity, 3),
                 "both_boundaries": self.both_found, "pitch_rad": self.rig.pitch_rad,

@@ -101,6 +101,23 @@ def test_the_wide_lane_of_tusimple_0_is_the_lane_not_the_calibration():
     assert ego_m.min() > 4.0 and abs(r.estimate.width_m - ego_m.mean()) < 0.1
 
 
+@needs["tusimple"]
+@needs["p1"]
+@pytest.mark.parametrize("folder", [TUSIMPLE, P1], ids=["tusimple", "p1"])
+def test_a_mirrored_still_gives_the_opposite_offset(folder):
+    """The offset is the camera's (a dash camera on the car's centreline): a still mirrored left to right shows the
+    car as far right of its lane's centre as it was left. (The fit's frame has its origin half a nominal baseline
+    right of the camera; reported from there, the pairs differed by 0.54 m.)"""
+    images = [read_image(p) for p in sorted(folder.glob("*.jpg"))]
+    offsets = []
+    for ims in (images, [np.ascontiguousarray(im[:, ::-1]) for im in images]):
+        lanes = FootageLanes(RealLaneConfig())
+        lanes.calibrate(ims)
+        offsets.append(np.array([lanes.still(im).offset_m for im in ims]))
+    assert np.all(np.abs(offsets[0] + offsets[1]) < 0.12), offsets
+    assert np.abs(offsets[0]).max() > 0.25
+
+
 def test_a_given_height_is_kept_and_a_bad_lane_width_refused():
     lanes = FootageLanes(RealLaneConfig(mount_height_m=1.5))
     assert lanes.calibrate([np.full((360, 640, 3), 90, np.uint8)]) is None and lanes.height_m == 1.5
