@@ -158,7 +158,8 @@ class LaneResult:
         num = (lambda v: float(v) if e.valid else None)
         return {"lanes": [{"side": k, "points_px": np.round(v, 1).tolist()} for k, v in self.boundaries_px.items()],
                 "offset_m": num(self.offset_m), "heading_rad": num(e.heading_rad),
-                "curvature_1pm": num(e.curvature_1pm), "width_m": num(e.width_m), "confidence": float(e.confidence) if e.valid else 0.0,
+                "curvature_1pm": num(e.curvature_1pm), "width_m": num(e.width_m),
+                "confidence": float(e.confidence) if e.valid else 0.0,
                 "ambiguity": None if self.debug.fit is None else round(self.debug.fit.ambiguity, 3),
                 "both_boundaries": self.both_found, "pitch_rad": self.rig.pitch_rad,
                 "horizon_row_px": self.rig.horizon_row,
