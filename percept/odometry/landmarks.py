@@ -19,8 +19,8 @@ from percept.sensors import LandmarkMap, Pose2D, Side, StereoRig, to_gray
 
 
 ARUCO_DICTIONARY = cv2.aruco.DICT_4X4_50
-MIN_PERIMETER_RATE = 0.03
-"""OpenCV's default ``minMarkerPerimeterRate``: the least share of the image's longer side a marker's perimeter
+MIN_PERIMETER_RATE = float(cv2.aruco.DetectorParameters().minMarkerPerimeterRate)
+"""OpenCV's default ``minMarkerPerimeterRate`` (0.03): the least share of the image's longer side a marker's perimeter
 needs."""
 
 
