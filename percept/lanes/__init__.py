@@ -5,11 +5,11 @@ from .evidence import Brightness, EvidenceConfig, MarkingExtractor, marking_brig
 from .fit import FitConfig, fit_lane
 from .footage_geometry import FootageGeometry, footage_geometry
 from .hood import hood_row
-from .slot import LaneSlot
+from .slot import STANDING_MPS, LaneSlot
 from .tracker import LaneTracker
 from .tusimple import h_samples, tusimple_record
 from .types import LaneEstimate, LaneFit, MarkingEvidence
 
-__all__ = ["Brightness", "EvidenceConfig", "FitConfig", "FootageGeometry", "LaneConfig", "LaneDebug", "LaneDetector",
-           "LaneEstimate", "LaneFit", "LaneSlot", "LaneTracker", "MarkingEvidence", "MarkingExtractor", "fit_lane",
-           "footage_geometry", "h_samples", "hood_row", "marking_brightness", "tusimple_record"]
+__all__ = ["STANDING_MPS", "Brightness", "EvidenceConfig", "FitConfig", "FootageGeometry", "LaneConfig", "LaneDebug",
+           "LaneDetector", "LaneEstimate", "LaneFit", "LaneSlot", "LaneTracker", "MarkingEvidence", "MarkingExtractor",
+           "fit_lane", "footage_geometry", "h_samples", "hood_row", "marking_brightness", "tusimple_record"]

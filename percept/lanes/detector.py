@@ -40,8 +40,15 @@ class LaneDetector:
         self.tracker.reset()
 
     def process(self, image: np.ndarray | None, speed_mps: float = 0.0, yaw_rate_rps: float = 0.0,
-                dt: float = 1.0 / 15) -> tuple[LaneEstimate, LaneDebug]:
-        """Track the lane through one frame; ``image`` None (dropped frame) only predicts."""
+                dt: float = 1.0 / 15, standing: bool = False) -> tuple[LaneEstimate, LaneDebug]:
+        """Track the lane through one frame; ``image`` None (dropped frame) only predicts.
+
+        ``standing``: the car stands still, so a tracked lane is held as it is (no prediction, no fit; the evidence
+        is still extracted for review). A lane cannot move relative to a car that does not move, while fits of the
+        few metres of road a standing car sees (behind a stopped lead, in rain) can lie a lane apart. A detector
+        with no lane yet fits as usual."""
+        if standing and self.tracker.initialised:
+            return self.tracker.estimate, LaneDebug(None if image is None else self.extractor.extract(image), None)
         if self.tracker.initialised:
             self.tracker.predict(speed_mps, yaw_rate_rps, dt)
         if image is None:
