@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import Enum
 
 import numpy as np
 
@@ -12,6 +13,16 @@ from .evidence import EvidenceConfig, MarkingExtractor
 from .fit import FitConfig, fit_lane
 from .tracker import LaneTracker
 from .types import LaneEstimate, LaneFit, MarkingEvidence
+
+
+class Pace(Enum):
+    """How the car moves over the road it sees (the lateral slot tells it from the wheel speed): DRIVING; CRAWLING,
+    at walking pace or less, where the tracked lane neither drifts nor restarts; STANDING, where it does not move
+    at all (no prediction: the gyro's bias must not turn the lane of a car that stands)."""
+
+    DRIVING = "driving"
+    CRAWLING = "crawling"
+    STANDING = "standing"
 
 
 @dataclass(frozen=True)
@@ -40,23 +51,25 @@ class LaneDetector:
         self.tracker.reset()
 
     def process(self, image: np.ndarray | None, speed_mps: float = 0.0, yaw_rate_rps: float = 0.0,
-                dt: float = 1.0 / 15, standing: bool = False) -> tuple[LaneEstimate, LaneDebug]:
+                dt: float = 1.0 / 15, pace: Pace = Pace.DRIVING) -> tuple[LaneEstimate, LaneDebug]:
         """Track the lane through one frame; ``image`` None (dropped frame) only predicts.
 
-        ``standing``: the car stands still, so a tracked lane is held as it is (no prediction, no fit; the evidence
-        is still extracted for review). A lane cannot move relative to a car that does not move, while fits of the
-        few metres of road a standing car sees (behind a stopped lead, in rain) can lie a lane apart. A detector
-        with no lane yet fits as usual."""
-        if standing and self.tracker.initialised:
-            return self.tracker.estimate, LaneDebug(None if image is None else self.extractor.extract(image), None)
-        if self.tracker.initialised:
-            self.tracker.predict(speed_mps, yaw_rate_rps, dt)
+        ``pace`` CRAWLING or STANDING: the lane moves relative to the car by the car's own motion alone (none when
+        standing), so the tracked lane is predicted without the per-second drift (not at all when standing) and is
+        not searched for afresh: each fit is taken around it and averaged into it, never restarting it. Behind a
+        stopped lead (in rain above all) the few metres of road the camera sees give fits that can lie a lane
+        apart, and a fresh search took them outright: the lane, the steering and the corridor that holds the lead
+        swung under a car that was not moving."""
+        held = pace is not Pace.DRIVING and self.tracker.initialised
+        if self.tracker.initialised and pace is not Pace.STANDING:
+            self.tracker.predict(speed_mps, yaw_rate_rps, dt, drift=not held)
         if image is None:
             return self.tracker.estimate, LaneDebug(None, None)
         ev = self.extractor.extract(image)
-        prior = self.tracker.estimate if self.tracker.initialised and self.tracker.confidence > 0.05 else None
+        tracked = self.tracker.initialised and (held or self.tracker.confidence > 0.05)
+        prior = self.tracker.estimate if tracked else None
         fit = fit_lane(ev, prior, self.cfg.fit)
-        if prior is not None and (fit is None or fit.estimate.confidence < 0.3):
+        if prior is not None and not held and (fit is None or fit.estimate.confidence < 0.3):
             # lost the lane around the prediction: search afresh
             fresh = fit_lane(ev, None, self.cfg.fit)
             if fresh is not None and (fit is None or fresh.estimate.confidence > fit.estimate.confidence):

@@ -38,7 +38,10 @@ class LaneTracker:
         self.initialised = False
         self.confidence = 0.0
 
-    def predict(self, speed_mps: float, yaw_rate_rps: float, dt: float) -> None:
+    def predict(self, speed_mps: float, yaw_rate_rps: float, dt: float, drift: bool = True) -> None:
+        """Move the lane by the car's motion over ``dt``; ``drift`` False leaves out the per-second process noise
+        and the confidence's decay (a car that crawls does not drift, and a lane seen a moment ago a metre back is
+        still there)."""
         # a bad sample (percept.sensors' rule) predicts no motion
         v = speed_mps if plausible_speed(speed_mps) else 0.0
         r = yaw_rate_rps if plausible_yaw_rate(yaw_rate_rps) else 0.0
@@ -50,8 +53,9 @@ class LaneTracker:
         # lateral drift, heading, curvature, curvature rate (spirals begin and end), width
         per_m = np.diag([0.0, 0.0, 2e-5 ** 2, 2e-5 ** 2, 0.0]) * max(d, 1e-3)
         per_s = np.diag([0.02 ** 2, 0.004 ** 2, 1e-4 ** 2, 0.0, 0.01 ** 2]) * max(dt, 1e-3) * 15
-        self.kf.predict(u=np.array([r]), B=B, F=F, Q=per_m + per_s)
-        self.confidence *= 0.85
+        self.kf.predict(u=np.array([r]), B=B, F=F, Q=per_m + per_s if drift else per_m)
+        if drift:
+            self.confidence *= 0.85
 
     def update(self, fit: LaneFit) -> None:
         e = fit.estimate

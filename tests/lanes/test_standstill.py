@@ -1,13 +1,14 @@
-"""A car that stands still holds its lane: a lane cannot move relative to a car that does not move.
+"""A car that stands or crawls holds its lane to its own motion: a lane cannot move relative to a car that does not.
 
 Standing a few metres behind a stopped lead in rain, the camera sees a few metres of wet road; fits of those frames
-lie metres apart, and a tracker that kept following them swung the lane (and the steering, and the corridor the
+lie metres apart, and a tracker that restarted on them swung the lane (and the steering, and the corridor the
 longitudinal slot holds its lead in) under a car that was not moving.
 """
 
 import numpy as np
+import pytest
 
-from percept.lanes import STANDING_MPS, LaneDetector, LaneSlot
+from percept.lanes import CRAWL_MPS, STANDING_MPS, LaneDetector, LaneSlot, Pace
 from percept.sensors import Frame, ImuSample, StereoRig
 
 
@@ -23,43 +24,64 @@ def _highway_frames(n: int):
     return w, frames
 
 
-def test_standing_holds_the_estimate_and_moving_fits_again():
-    w, frames = _highway_frames(8)
+def _tracked(w, frames) -> LaneDetector:
     det = LaneDetector(w.cfg.rig)
     for f in frames:
         est, _ = det.process(f.left, 20.0, 0.0, w.dt)
     assert est.valid and est.confidence > 0.5
-    # the same road seen 120 px to the side: a fit would move the lane by metres
+    return det
+
+
+@pytest.mark.parametrize("pace", [Pace.STANDING, Pace.CRAWLING])
+def test_a_slow_car_does_not_restart_its_lane_on_a_frame_that_shows_another(pace):
+    w, frames = _highway_frames(8)
+    # the same road seen 120 px to the side: around the tracked lane there is little to fit, and a fresh search
+    # finds a lane metres away
     rolled = np.roll(frames[-1].left, 120, axis=1)
-    held, dbg = det.process(rolled, 0.0, 0.0, w.dt, standing=True)
-    assert held == est and dbg.fit is None and dbg.evidence is not None   # the evidence is still there to review
-    held, dbg = det.process(None, 0.0, 0.0, w.dt, standing=True)          # a dropped frame while standing
-    assert held == est and dbg.evidence is None
-    moved, dbg = det.process(rolled, 0.0, 0.0, w.dt)                      # moving: the frame is fitted
-    assert dbg.fit is not None and moved != est
+    driving, slow = _tracked(w, frames), _tracked(w, frames)
+    before = driving.tracker.estimate
+    for _ in range(15):
+        moved, _ = driving.process(rolled, 20.0, 0.0, w.dt)
+        held, dbg = slow.process(rolled, 0.0, 0.0, w.dt, pace=pace)
+        assert dbg.evidence is not None
+    # driving, the tracker loses the lane around its prediction and restarts on what the frame shows
+    assert abs(moved.offset_m - before.offset_m) > 1.0
+    assert abs(held.offset_m - before.offset_m) < 0.3 and abs(held.heading_rad - before.heading_rad) < 0.02
+
+
+def test_a_standing_car_does_not_turn_its_lane_with_the_gyro():
+    w, frames = _highway_frames(8)
+    det = _tracked(w, frames)
+    before = det.tracker.estimate
+    for _ in range(30):   # 2 s of dropped frames and a gyro bias of 0.05 rad/s
+        held, _ = det.process(None, 0.0, 0.05, w.dt, pace=Pace.STANDING)
+    assert held == before
+    crawled, _ = det.process(None, 0.5, 0.05, w.dt, pace=Pace.CRAWLING)   # crawling, the car turns with it
+    assert crawled.heading_rad > before.heading_rad
 
 
 def test_a_fresh_detector_fits_even_while_standing():
     # a car that starts at a standstill has no lane to hold: it takes the first fit
     w, frames = _highway_frames(1)
-    est, dbg = LaneDetector(w.cfg.rig).process(frames[0].left, 0.0, 0.0, w.dt, standing=True)
+    est, dbg = LaneDetector(w.cfg.rig).process(frames[0].left, 0.0, 0.0, w.dt, pace=Pace.STANDING)
     assert dbg.fit is not None and est.valid
 
 
-def test_the_slot_calls_the_car_standing_below_the_threshold_only(monkeypatch):
+def test_the_slot_tells_the_pace_from_the_wheel_speed(monkeypatch):
     slot = LaneSlot(StereoRig(), 1 / 15)
     calls, process = [], slot.detector.process
 
-    def spy(*args, standing=False, **kwargs):
-        calls.append(standing)
-        return process(*args, standing=standing, **kwargs)
+    def spy(*args, pace=Pace.DRIVING, **kwargs):
+        calls.append(pace)
+        return process(*args, pace=pace, **kwargs)
 
     monkeypatch.setattr(slot.detector, "process", spy)
     black = np.zeros((480, 640, 3), np.uint8)
-    for v in (20.0, STANDING_MPS * 1.5, STANDING_MPS * 0.5, 0.0, -0.1, float("nan")):
+    for v in (20.0, CRAWL_MPS * 1.01, CRAWL_MPS * 0.99, STANDING_MPS * 1.01, STANDING_MPS * 0.99, 0.0, float("nan")):
         slot.step(Frame(0, 0.0, black, black, ImuSample(np.zeros(3), np.zeros(3)), v), {})
-    # a bad sample (NaN) is held at the last plausible one (-0.1 m/s: standing)
-    assert calls == [False, False, True, True, True, True]
+    # a bad sample (NaN) is held at the last plausible one (0 m/s: standing)
+    D, C, S = Pace.DRIVING, Pace.CRAWLING, Pace.STANDING
+    assert calls == [D, D, C, C, S, S, S]
 
 
 def test_standing_behind_a_stopped_lead_in_rain_keeps_the_lane_and_the_lead():
