@@ -23,9 +23,10 @@ HIGHER_IS_BETTER = frozenset({
     "longitudinal.time_gap_mean_s", "longitudinal.time_gap_min_s", "longitudinal.time_gap_steady_s",
     "odometry.consistency_3sigma", "odometry.consistency_3sigma_fused", "odometry.landmark_fixes",
     "odometry.landmark_sightings", "odometry.path_length_m"})
-SAFETY = ("collisions", "pedestrian_collisions", "lane_departures", "phantom_brakes", "missed_stops")
-"""Counts summed per scenario x condition: the three of every run, the longitudinal phantom brakes and the
-crossing pedestrians the car did not stop for."""
+SAFETY = ("collisions", "pedestrian_collisions", "lane_departures", "phantom_brakes", "missed_stops", "false_stops",
+          "brakes_for_no_one")
+"""Counts summed per scenario x condition: the three of every run, the longitudinal phantom brakes, the crossing
+pedestrians the car did not stop for, its stops that nothing called for and its hard brakings for no one."""
 UNSAFE = ("collisions", "pedestrian_collisions", "lane_departures")
 """What makes a run fail ``--strict``."""
 
@@ -36,6 +37,8 @@ def run_metrics(run: dict) -> dict[str, float]:
     stops = run.get("pedestrians", {}).get("stops")
     out["phantom_brakes"] = float(run.get("longitudinal", {}).get("phantom_brakes") or 0)
     out["missed_stops"] = float(sum(1 for s in stops if not s)) if stops else 0.0
+    for k in ("false_stops", "brakes_for_no_one"):
+        out[k] = float(run.get("pedestrians", {}).get(k) or 0)
     for g in GROUPS:
         for k, v in (run.get(g) or {}).items():
             if isinstance(v, (int, float)) and not isinstance(v, bool):
@@ -120,7 +123,8 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
              f"{_seed_text(plan.seeds)}; slots: {slots}; percept {settings.get('percept')}.", "",
              "## Safety (totals over the seeds)", "",
              "| scenario | condition | runs | failed | collisions | pedestrian collisions | lane departures | "
-             "phantom brakes | missed stops |", "|---|---|---|---|---|---|---|---|---|"]
+             "phantom brakes | missed stops | false stops | brakes for no one |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for sc in plan.scenarios:
         for c in plan.conditions:
             n = sum(1 for r in ok if r["scenario"] == sc and r["condition"] == c)

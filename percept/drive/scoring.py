@@ -22,6 +22,9 @@ from .privileged import InPath, Obstacle, true_centre_y
 from .rows import Rows
 
 STOP_SPEED_MPS = 0.5
+"""Below this speed the car has stopped [m/s]."""
+HALTING_VEHICLE_MPS = 2.0
+"""A vehicle in the path slower than this halts the car behind it: a stop behind it is not a false stop [m/s]."""
 PHANTOM_DECEL_MPS2 = -3.0
 """A commanded deceleration below this with nothing in the path to justify it is a phantom brake [m/s²]."""
 PHANTOM_MIN_SPEED_MPS = 2.0
@@ -165,7 +168,10 @@ class PedestrianScorer:
     half visible) inside the searched domain (the search's depths and corridor about the true lane centre); the
     others are ignore regions. ``verge_brakes``: hard brakings (below -3 m/s², above a walking pace) that begin on a
     braking request for a person who is not crossing (the request's person: the truth's id for the privileged slot,
-    the true pedestrian nearest the requesting track for the vision slot)."""
+    the true pedestrian nearest the requesting track for the vision slot, within 3 m); ``brakes_for_no_one``: those
+    that begin on a request for no true person at all. ``false_stops``: stops that nothing in the path calls for (no
+    crossing person within 40 m ahead, no vehicle in the path slower than HALTING_VEHICLE_MPS). The last two are
+    scored in every scenario: the pedestrian slot can stop the car for a person who is not there, on any road."""
 
     def __init__(self, ctx: ScoreContext):
         self.ctx = ctx
@@ -175,6 +181,7 @@ class PedestrianScorer:
         self.crossing_stopped: dict = {}
         self.false_stops = 0
         self.verge_brakes = 0
+        self.brakes_for_no_one = 0
         self._stopped = False
         self._braking = False
 
@@ -189,15 +196,18 @@ class PedestrianScorer:
                 near_crossing = True
                 if stopped:
                     self.crossing_stopped[o.obj_id] = True
-        # a stop with no crossing pedestrian near is a false stop (e.g. for a roadside one), unless a vehicle halts us
-        if stopped and not self._stopped and not near_crossing and not (
-                obstacle and obstacle.kind is ObjectKind.VEHICLE):
+        # a stop with no crossing pedestrian near is a false stop (for a roadside one, or for no one), unless a
+        # vehicle in the path halts us (a lead driving on ahead does not)
+        halted = (obstacle is not None and obstacle.kind is ObjectKind.VEHICLE
+                  and obstacle.speed_mps < HALTING_VEHICLE_MPS)
+        if stopped and not self._stopped and not near_crossing and not halted:
             self.false_stops += 1
         self._stopped = stopped
         braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
         if braking and not self._braking and request is not None:
             person = self._requested_person(request, debug, gt)
             self.verge_brakes += int(person is not None and not person.crossing)
+            self.brakes_for_no_one += int(person is None)
         self._braking = braking
         if self.tally is not None and debug is not None:
             self._score_detections(debug, gt)
@@ -240,6 +250,6 @@ class PedestrianScorer:
                 if det else None,
                 "first_detection_range_m": det.get("first_detection_range_m"),
                 "stops": stops if self.ctx.crossing_pedestrians else None,
-                # false stops (for a person on the verge, or for nothing) are scored where there are pedestrians
-                "false_stops": self.false_stops if self.ctx.pedestrians else None,
-                "verge_brakes": self.verge_brakes if self.ctx.pedestrians else None}
+                "false_stops": self.false_stops,
+                "verge_brakes": self.verge_brakes if self.ctx.pedestrians else None,
+                "brakes_for_no_one": self.brakes_for_no_one}

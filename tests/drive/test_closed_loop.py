@@ -56,6 +56,8 @@ def test_same_seed_same_metrics():
 
 def test_metrics_that_do_not_apply_are_null():
     r = drive("lead-brake", 0, duration=3.0)
-    assert r["pedestrians"]["stops"] is None and r["pedestrians"]["false_stops"] is None  # no pedestrians
+    assert r["pedestrians"]["stops"] is None and r["pedestrians"]["verge_brakes"] is None  # no pedestrians
+    # but a stop for no one can happen on any road: counted everywhere
+    assert r["pedestrians"]["false_stops"] == 0 and r["pedestrians"]["brakes_for_no_one"] == 0
     assert r["lane"]["offset_rmse_m"] is None  # privileged lateral: no estimate to score
     assert r["odometry"]["ate_rmse_fused_m"] is None
