@@ -7,7 +7,8 @@ Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over t
 frame, the two levels around each tracked person's predicted window. A lone window (one that grouping would
 drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
 its feet touch the road. Only confirmed tracks act, and only once the stereo pair has seen them stand where their
-feet touch the road (``STEREO_HITS``); a track walking sideways counts as walking only when it has ``WALK_HITS``
+feet touch the road (``STEREO_HITS``), and only while they move over the ground at a person's speed
+(``PERSON_MAX_MPS``); a track walking sideways counts as walking only when it has ``WALK_HITS``
 detections and its lateral speed is a person's and clear of its own uncertainty (``WALK_SIGMAS`` standard
 deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
 braking. The conflict rule is the privileged slot's (``percept.sensors.conflict``).
@@ -15,6 +16,7 @@ braking. The conflict rule is the privileged slot's (``percept.sensors.conflict`
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from percept.sensors import BrakingRequest, EgoMotionGate, EgoPath, Frame, ObjectKind, StereoRig
@@ -36,6 +38,10 @@ WALK_HITS = 8
 """Detections a track needs before its speed is trusted (about half a second)."""
 WALK_SIGMAS = 2.5
 """A track's lateral speed must stand this many of its standard deviations clear of zero to count as walking."""
+PERSON_MAX_MPS = 4.0
+"""A track moving over the ground faster than this is no person on foot and asks for no braking [m/s]: at night the
+tail light and wheel of a car in the next lane can read as legs, and that car drives on at the ego's speed (the
+people crossing in front of the car were tracked at 2.5 m/s at most)."""
 STEREO_HITS = 1
 """Detections a track needs whose stereo depth agreed with their ground contact before it may ask for braking: a
 person stands where their feet touch the road; lane paint under dark scenery at night, which the detector can take
@@ -116,7 +122,7 @@ class PedestrianSlot:
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M
         best = None
         for t in tracks:
-            if not t.confirmed or t.stereo_hits < STEREO_HITS:
+            if not t.confirmed or t.stereo_hits < STEREO_HITS or math.hypot(*t.velocity_mps) > PERSON_MAX_MPS:
                 continue
             vy = t.velocity_mps[1]
             # walking sideways only when the track is old enough to have a speed, the speed is a person's and it

@@ -70,9 +70,10 @@ def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
     assert p["recall_by_height"]["24-40"] >= 0.7 and p["fppi"] <= 0.02, p
 
 
-def track(tid: int, x: float, y: float, vy: float = 0.0, stereo_hits: int = 5, standing=None, hits: int = 20):
-    """A confirmed, seen track of a person at (x, y) walking sideways at vy [m/s] (sigma 0.1 m/s)."""
-    return PersonTrack(tid, (x, y), (0.0, vy), 0.1, 1.75, (300.0, 200.0, 320.0, 260.0), 1.0, hits, 0, True, True,
+def track(tid: int, x: float, y: float, vy: float = 0.0, stereo_hits: int = 5, standing=None, hits: int = 20,
+          vx: float = 0.0):
+    """A confirmed, seen track of a person at (x, y) walking at (vx, vy) [m/s] (sigma of vy 0.1 m/s)."""
+    return PersonTrack(tid, (x, y), (vx, vy), 0.1, 1.75, (300.0, 200.0, 320.0, 260.0), 1.0, hits, 0, True, True,
                        standing if standing is not None else (x, y), stereo_hits)
 
 
@@ -83,6 +84,18 @@ def test_only_tracks_the_stereo_pair_has_placed_on_the_road_ask_for_braking():
     assert rid == 2 and request.reason == "pedestrian in the path"
     assert request.stop_before_m == pytest.approx(25.0 - slot.cam_x)
     assert slot._request([track(1, 15.0, 0.5, stereo_hits=0)], path, 10.0) == (None, None)
+
+
+def test_a_track_faster_than_a_person_asks_for_no_braking():
+    # curves seed 0 at night: a car's lamp and wheel in the next lane, tracked as a person 30 m ahead that moved
+    # with the car; its filter's speed rose towards the car's while it coasted into the path, and the car braked at
+    # -8 m/s^2 to a standstill on a road with nobody on it
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(20.0)
+    assert slot._request([track(1, 17.8, 1.8, vx=5.0, vy=-1.1)], path, 20.0) == (None, None)
+    # a person running across at 3 m/s is still one
+    request, rid = slot._request([track(1, 17.8, 1.8, vx=0.5, vy=-3.0)], path, 20.0)
+    assert rid == 1
 
 
 def test_a_track_not_walking_is_judged_where_it_was_last_seen():
