@@ -149,11 +149,25 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
     return "\n".join(lines)
 
 
+def needless_stop_runs(results: list[dict]) -> list[tuple[dict, str]]:
+    """Runs that stopped when nothing called for it, or braked hard for no one (``pedestrians.false_stops``,
+    ``pedestrians.brakes_for_no_one``): (run, what happened). Not unsafe by ``--strict``'s rule, but worth a look."""
+    out = []
+    for r in sorted((r for r in results if "error" not in r), key=lambda r: (r["scenario"], r["condition"],
+                                                                              r["seed"])):
+        ped = r.get("pedestrians") or {}
+        what = [f"{ped[k]} {k.replace('_', ' ')}" for k in ("false_stops", "brakes_for_no_one") if ped.get(k)]
+        if what:
+            out.append((r, ", ".join(what)))
+    return out
+
+
 def _problems_md(results: list[dict], settings: dict) -> list[str]:
-    bad = unsafe_runs(results)
+    bad = unsafe_runs(results) + needless_stop_runs(results)
     errors = [r for r in results if "error" in r]
     if not bad and not errors:
-        return ["No run had a collision, a pedestrian collision or a lane departure, and none failed.", ""]
+        return ["No run had a collision, a pedestrian collision, a lane departure, a false stop or a hard braking "
+                "for no one, and none failed.", ""]
     lines = ["## Runs to look at", ""]
     lines += [f"- {r['scenario']} / {r['condition']} / seed {r['seed']}: {what} — `{reproduce_command(r, settings)}`"
               for r, what in bad]

@@ -11,7 +11,8 @@ from typer.testing import CliRunner
 from percept.cli import app
 from percept.drive import TASKS
 from percept.drive import batch as ev
-from percept.drive.report import metric_rows, reproduce_command, summary_csv, unsafe_runs, write_reports
+from percept.drive.report import (metric_rows, needless_stop_runs, reproduce_command, summary_csv, unsafe_runs,
+                                  write_reports)
 
 runner = CliRunner()
 SETTINGS = {"percept": "0.1.0", "duration_s": 12.0, "detector": None,
@@ -63,11 +64,25 @@ def test_unsafe_runs_come_with_the_command_that_reproduces_them():
     assert reproduce_command(bad[0][0], vision).endswith("--condition clear --duration 12 --detector inria")
 
 
+def test_stops_for_no_one_are_listed_and_summed_but_do_not_fail_strict(tmp_path):
+    ghost = run(1)
+    ghost["pedestrians"].update(false_stops=1, brakes_for_no_one=2)
+    runs = [run(0), ghost]
+    assert unsafe_runs(runs) == []
+    assert [(r["seed"], what) for r, what in needless_stop_runs(runs)] == [(1, "1 false stops, 2 brakes for no one")]
+    rows = {r["metric"]: r for r in metric_rows(PLAN, runs)}
+    assert rows["false_stops"]["total"] == 1 and rows["brakes_for_no_one"]["total"] == 2
+    write_reports(PLAN, runs, SETTINGS, tmp_path, TASKS)
+    md = (tmp_path / "summary.md").read_text()
+    assert "| highway | clear | 2 | 0 | 0 | 0 | 0 | 0 | 0 | 1 | 2 |" in md
+    assert "seed 1: 1 false stops, 2 brakes for no one — `percept drive --scenario highway --seed 1" in md
+
+
 def test_reports_are_written_and_readable(tmp_path):
     runs = [run(k, recall=0.8, traj=k < 2, ate=0.5 if k == 1 else 0.1) for k in range(4)] + [run(4, collisions=1)]
     written = write_reports(PLAN, runs, SETTINGS, tmp_path, TASKS)
     md = (tmp_path / "summary.md").read_text()
-    assert "| highway | clear | 5 | 0 | 1 | 0 | 0 | 0 | 0 |" in md  # the safety totals
+    assert "| highway | clear | 5 | 0 | 1 | 0 | 0 | 0 | 0 | 0 | 0 |" in md  # the safety totals
     assert "seed 4: 1 collisions" in md and "`percept drive --scenario highway --seed 4" in md
     pngs = [p for p in written if p.suffix == ".png"]
     names = {p.name for p in pngs}
