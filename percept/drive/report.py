@@ -23,8 +23,9 @@ HIGHER_IS_BETTER = frozenset({
     "longitudinal.time_gap_mean_s", "longitudinal.time_gap_min_s", "longitudinal.time_gap_steady_s",
     "odometry.consistency_3sigma", "odometry.consistency_3sigma_fused", "odometry.landmark_fixes",
     "odometry.landmark_sightings", "odometry.path_length_m"})
-SAFETY = ("collisions", "pedestrian_collisions", "lane_departures", "phantom_brakes", "missed_stops", "false_stops",
-          "brakes_for_no_one")
+NEEDLESS = ("false_stops", "brakes_for_no_one")
+"""The pedestrians group's counts of stops nothing called for and hard brakings for no one: listed, not failing."""
+SAFETY = ("collisions", "pedestrian_collisions", "lane_departures", "phantom_brakes", "missed_stops") + NEEDLESS
 """Counts summed per scenario x condition: the three of every run, the longitudinal phantom brakes, the crossing
 pedestrians the car did not stop for, its stops that nothing called for and its hard brakings for no one."""
 UNSAFE = ("collisions", "pedestrian_collisions", "lane_departures")
@@ -37,7 +38,7 @@ def run_metrics(run: dict) -> dict[str, float]:
     stops = run.get("pedestrians", {}).get("stops")
     out["phantom_brakes"] = float(run.get("longitudinal", {}).get("phantom_brakes") or 0)
     out["missed_stops"] = float(sum(1 for s in stops if not s)) if stops else 0.0
-    for k in ("false_stops", "brakes_for_no_one"):
+    for k in NEEDLESS:
         out[k] = float(run.get("pedestrians", {}).get(k) or 0)
     for g in GROUPS:
         for k, v in (run.get(g) or {}).items():
@@ -87,15 +88,26 @@ def reproduce_command(run: dict, settings: dict) -> str:
     return " ".join(cmd)
 
 
-def unsafe_runs(results: list[dict]) -> list[tuple[dict, str]]:
-    """Runs with a collision, a pedestrian collision or a lane departure: (run, what happened)."""
+def _runs_with(results: list[dict], counts) -> list[tuple[dict, str]]:
+    """Finished runs, in job order, with any of ``counts(run)`` (name -> value) non-zero: (run, what happened)."""
     out = []
     for r in sorted((r for r in results if "error" not in r), key=lambda r: (r["scenario"], r["condition"],
                                                                               r["seed"])):
-        what = [f"{r[k]} {k.replace('_', ' ')}" for k in UNSAFE if r.get(k)]
+        what = [f"{v} {k.replace('_', ' ')}" for k, v in counts(r).items() if v]
         if what:
             out.append((r, ", ".join(what)))
     return out
+
+
+def unsafe_runs(results: list[dict]) -> list[tuple[dict, str]]:
+    """Runs with a collision, a pedestrian collision or a lane departure: (run, what happened)."""
+    return _runs_with(results, lambda r: {k: r.get(k) for k in UNSAFE})
+
+
+def needless_stop_runs(results: list[dict]) -> list[tuple[dict, str]]:
+    """Runs that stopped when nothing called for it, or braked hard for no one (``pedestrians.false_stops``,
+    ``pedestrians.brakes_for_no_one``): (run, what happened). Not unsafe by ``--strict``'s rule, but worth a look."""
+    return _runs_with(results, lambda r: {k: (r.get("pedestrians") or {}).get(k) for k in NEEDLESS})
 
 
 def summary_csv(rows: list[dict]) -> str:
@@ -147,19 +159,6 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
     if plots:
         lines += ["## Plots", ""] + [f"![{Path(p).stem}]({p})" for p in plots] + [""]
     return "\n".join(lines)
-
-
-def needless_stop_runs(results: list[dict]) -> list[tuple[dict, str]]:
-    """Runs that stopped when nothing called for it, or braked hard for no one (``pedestrians.false_stops``,
-    ``pedestrians.brakes_for_no_one``): (run, what happened). Not unsafe by ``--strict``'s rule, but worth a look."""
-    out = []
-    for r in sorted((r for r in results if "error" not in r), key=lambda r: (r["scenario"], r["condition"],
-                                                                              r["seed"])):
-        ped = r.get("pedestrians") or {}
-        what = [f"{ped[k]} {k.replace('_', ' ')}" for k in ("false_stops", "brakes_for_no_one") if ped.get(k)]
-        if what:
-            out.append((r, ", ".join(what)))
-    return out
 
 
 def _problems_md(results: list[dict], settings: dict) -> list[str]:
