@@ -4,7 +4,8 @@ Takes the following law's command and lowers it where stopping demands: the cons
 short of a person, a = -v^2 / (2 s) over the room s left; an emergency brake when the deceleration needed to
 cancel the closing speed before the margin, a_req = closing^2 / (2 s), exceeds a trigger (braking 30 % harder
 than needed); a hold at standstill. Yielding to a pedestrian is a commitment: the car stops before their line
-and goes once stopped and clear. Then the command limits.
+and goes once stopped and clear, or at once when the pedestrian slot withdraws its request (what it asked to stop
+for has turned out to be no person). Then the command limits.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from percept.sensors.conflict import PERSON_STOP_MARGIN_M
 from percept.sensors.vehicle import MAX_BRAKE_MPS2
 
 from .base import Controller, limiting
@@ -38,7 +40,7 @@ class EmergencyBraking(Controller):
     """standstill_m: margin kept to a vehicle [m]; ped_margin_m: margin kept to a pedestrian [m];
     trigger_mps2: required deceleration that triggers an emergency brake; gain: braking / required."""
 
-    def __init__(self, standstill_m: float = 4.0, ped_margin_m: float = 4.0, trigger_mps2: float = 2.0,
+    def __init__(self, standstill_m: float = 4.0, ped_margin_m: float = PERSON_STOP_MARGIN_M, trigger_mps2: float = 2.0,
                  gain: float = 1.3):
         self.d0, self.ped_margin, self.trigger, self.gain = standstill_m, ped_margin_m, trigger_mps2, gain
         self.reset()
@@ -47,10 +49,13 @@ class EmergencyBraking(Controller):
         self.travelled_m = 0.0
         self.stop_at_m: float | None = None  # odometer reading to stop at while yielding to a pedestrian
 
-    def update(self, target: Target | None, speed_mps: float, follow_mps2: float,
-               dt: float = 1.0 / 15) -> tuple[float, EmergencyBrakingDebug]:
+    def update(self, target: Target | None, speed_mps: float, follow_mps2: float, dt: float = 1.0 / 15,
+               withdrawn: bool = False) -> tuple[float, EmergencyBrakingDebug]:
+        """withdrawn: the pedestrian slot has withdrawn its request this frame (releases a commitment)."""
         v = speed_mps
         self.travelled_m += v * dt
+        if withdrawn:
+            self.stop_at_m = None
         self._commit(target, v)
         terms: dict[str, float | None] = {"follow": follow_mps2}
         if target is not None:

@@ -7,20 +7,24 @@ Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over t
 frame, the two levels around each tracked person's predicted window. A lone window (one that grouping would
 drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
 its feet touch the road. Only confirmed tracks act, and only once the stereo pair has seen them stand where their
-feet touch the road (``STEREO_HITS``), and only while they move over the ground at a person's speed
-(``PERSON_MAX_MPS``); a track walking sideways counts as walking only when it has ``WALK_HITS``
+feet touch the road (``STEREO_HITS``), and never once their detections have shown them moving over the ground
+faster than a person (``PersonTrack.too_fast``); a track walking sideways counts as walking only when it has ``WALK_HITS``
 detections and its lateral speed is a person's and clear of its own uncertainty (``WALK_SIGMAS`` standard
 deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
-braking. The conflict rule is the privileged slot's (``percept.sensors.conflict``).
+braking. A track too young for its motion to be known (fewer than ``WALK_HITS`` detections) asks only once the
+car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2``. When a track the slot asked
+to stop for turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so
+that the stop committed to for it is dropped. The conflict rule is the privileged slot's
+(``percept.sensors.conflict``).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from percept.sensors import BrakingRequest, EgoMotionGate, EgoPath, Frame, ObjectKind, StereoRig
-from percept.sensors.conflict import person_conflict
+from percept.sensors.conflict import PERSON_STOP_MARGIN_M, person_conflict
+from percept.sensors.vehicle import bumper_gap_m
 
 from .constrained import FEET_MARGIN_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
 from .hog import WINDOW_PX, LinearModel
@@ -38,10 +42,13 @@ WALK_HITS = 8
 """Detections a track needs before its speed is trusted (about half a second)."""
 WALK_SIGMAS = 2.5
 """A track's lateral speed must stand this many of its standard deviations clear of zero to count as walking."""
-PERSON_MAX_MPS = 4.0
-"""A track moving over the ground faster than this is no person on foot and asks for no braking [m/s]: at night the
-tail light and wheel of a car in the next lane can read as legs, and that car drives on at the ego's speed (the
-people crossing in front of the car were tracked at 2.5 m/s at most)."""
+YOUNG_STOP_MPS2 = 6.5
+"""A track with fewer than ``WALK_HITS`` detections asks for braking only once waiting one more frame would leave
+less room than a stop at this deceleration needs [m/s²]: in its first detections a vehicle's corner read as a
+person cannot be told from one (the free motion's speed is known to +-15 m/s after three), and a request commits
+the car to stop."""
+STANDING_MPS = 0.3
+"""At or below this speed the car stands, and what the slot has asked for is settled [m/s]."""
 STEREO_HITS = 1
 """Detections a track needs whose stereo depth agreed with their ground contact before it may ask for braking: a
 person stands where their feet touch the road; lane paint under dark scenery at night, which the detector can take
@@ -87,10 +94,12 @@ class PedestrianSlot:
         self.sweep_frames = sweep_frames
         self.cam_x = float(rig.camera_position()[0])
         self.motion = EgoMotionGate()
+        self.asked: set[int] = set()  # the tracks asked for since the car last stood
 
     def reset(self) -> None:
         self.tracker.reset()
         self.motion.reset()
+        self.asked = set()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
         motion = self.motion.update(frame)
@@ -109,6 +118,12 @@ class PedestrianSlot:
             tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame) if boxes else None,
                                          verify=[d.windows < 2 for d in dets])
         request, rid = self._request(tracks, path, speed)
+        if rid is not None:
+            self.asked.add(rid)
+        elif speed <= STANDING_MPS:
+            self.asked = set()
+        else:
+            request = self._withdrawal(tracks, speed)
         return request, PedestrianDebug(tuple(dets), tuple(tracks), levels, stats, rid)
 
     def _stereo(self, frame: Frame):
@@ -122,7 +137,7 @@ class PedestrianSlot:
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M
         best = None
         for t in tracks:
-            if not t.confirmed or t.stereo_hits < STEREO_HITS or math.hypot(*t.velocity_mps) > PERSON_MAX_MPS:
+            if not t.confirmed or t.stereo_hits < STEREO_HITS or t.too_fast:
                 continue
             vy = t.velocity_mps[1]
             # walking sideways only when the track is old enough to have a speed, the speed is a person's and it
@@ -132,6 +147,8 @@ class PedestrianSlot:
             # a person taken to stand is where they were last seen, not carried on by a speed not trusted
             x, y = t.position_m if walking else t.standing_m
             c = person_conflict(x, y, vy if walking else 0.0, float(path.centre_y(x)), lane_w, speed)
+            if c.any and t.hits < WALK_HITS and self._can_wait(x, speed):
+                continue
             if c.any and (best is None or x < best[0]):
                 best = (x, t, c)
         if best is None:
@@ -141,3 +158,20 @@ class PedestrianSlot:
         # range: the left camera's depth of the feet; its rate: the person's own x speed less the ego's
         return BrakingRequest(x - self.cam_x, t.velocity_mps[0] - speed, why, ObjectKind.PEDESTRIAN,
                               t.track_id), t.track_id
+
+    def _can_wait(self, x_m: float, speed_mps: float) -> bool:
+        """Whether the car could drive one more frame towards a person at x_m and still stop short of them."""
+        room = bumper_gap_m(x_m - self.cam_x) - PERSON_STOP_MARGIN_M - speed_mps * self.tracker.dt_s
+        # the distance a stop at a takes: v^2 / (2 a)
+        return room > speed_mps * speed_mps / (2 * YOUNG_STOP_MPS2)
+
+    def _withdrawal(self, tracks: list[PersonTrack], speed: float) -> BrakingRequest | None:
+        """With nothing to ask for: the request withdrawn when every track asked for since the car last stood moves
+        like a vehicle (a person asked for and since lost from view keeps the stop committed to for them)."""
+        fast = {t.track_id: t for t in tracks if t.too_fast}
+        if not self.asked or not self.asked <= fast.keys():
+            return None
+        t = fast[max(self.asked)]
+        self.asked = set()
+        return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed, "moves like a vehicle, not a person",
+                              ObjectKind.PEDESTRIAN, t.track_id, withdrawn=True)

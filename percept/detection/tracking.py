@@ -37,6 +37,10 @@ class TrackConfig:
     person's height; col_sigma_frac: column noise as a fraction of the height; iou_gate: smallest overlap of a
     detection with a track's predicted box that pairs them; gate_chi2: squared Mahalanobis gate on the ground (2
     degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s);
+    free_sigma_v0_mps: the same for the track's free motion, which assumes no person (a vehicle's speed);
+    person_max_mps: a track whose free motion is faster than this by ``too_fast_sigmas`` of its standard deviation
+    is no person on foot, for good (a vehicle's tail light and wheel can read as legs; the people crossing in front
+    of the car were tracked at 2.5 m/s at most);
     verify_chi2: a detection that must be verified (a lone window) is kept only when its stereo depth and its
     ground contact's agree within this squared number of standard deviations (one degree of freedom)."""
 
@@ -49,6 +53,9 @@ class TrackConfig:
     iou_gate: float = 0.3
     gate_chi2: float = 9.21
     sigma_v0_mps: float = 1.0
+    free_sigma_v0_mps: float = 30.0
+    person_max_mps: float = 4.0
+    too_fast_sigmas: float = 2.5
     verify_chi2: float = 9.0
 
 
@@ -61,7 +68,11 @@ class PersonTrack:
     seen: confirmed and detected within the last ``report_misses`` frames (what the slot reports as seen);
     standing_m: (x, y) where the person would be had they stood still since their last detection [m] (the
     position then, moved by the ego's own motion only); stereo_hits: detections whose stereo depth agreed with
-    their ground contact's (``TrackConfig.verify_chi2``)."""
+    their ground contact's (``TrackConfig.verify_chi2``); free_speed_mps, sigma_free_speed_mps: the speed over the
+    ground [m/s] and its standard deviation as the detections alone tell it, without the prior that a person barely
+    moves (``velocity_mps`` lags a vehicle's corner taken for a person by seconds; this one does not); too_fast:
+    the free motion has once been a vehicle's (``TrackConfig.person_max_mps``): whatever it is, no person on foot
+    (kept, since one detection on another part of the vehicle can pull the free motion back for a frame)."""
 
     track_id: int
     position_m: tuple[float, float]
@@ -76,43 +87,65 @@ class PersonTrack:
     seen: bool
     standing_m: tuple[float, float]
     stereo_hits: int
+    free_speed_mps: float
+    sigma_free_speed_mps: float
+    too_fast: bool
 
 
 class _Track:
     def __init__(self, tid: int, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float,
                  stereo_ok: bool, cfg: TrackConfig):
+        # two filters on the same detections: the person's (a person barely moves: a tight prior on the speed) and
+        # the free motion's (anything from standing to a vehicle's speed), which tells whether it is a person at all
+        self.kf, self.free = (self._filter(xy, r, s0) for s0 in (cfg.sigma_v0_mps, cfg.free_sigma_v0_mps))
+        self.id, self.height_m, self.box, self.score = tid, height_m, box, score
+        self.hits, self.misses, self.stereo_hits, self.cfg = 1, 0, int(stereo_ok), cfg
+        self.too_fast = False
+        self.predicted = box  # the person box predicted for the current frame
+        self.standing = xy.copy()  # the last detection's position, moved by the ego's motion since
+
+    @staticmethod
+    def _filter(xy: np.ndarray, r: np.ndarray, sigma_v0_mps: float) -> KalmanFilter:
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([xy[0], xy[1], 0.0, 0.0])
         kf.H = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
-        kf.P = np.diag([0.0, 0.0, cfg.sigma_v0_mps ** 2, cfg.sigma_v0_mps ** 2])
+        kf.P = np.diag([0.0, 0.0, sigma_v0_mps ** 2, sigma_v0_mps ** 2])
         kf.P[:2, :2] = r
-        self.kf, self.id, self.height_m, self.box, self.score = kf, tid, height_m, box, score
-        self.hits, self.misses, self.stereo_hits, self.cfg = 1, 0, int(stereo_ok), cfg
-        self.predicted = box  # the person box predicted for the current frame
-        self.standing = kf.x[:2].copy()  # the last detection's position, moved by the ego's motion since
+        return kf
 
     def predict(self, dt: float, ego_speed_mps: float, yaw_rate_rps: float) -> None:
-        kf = self.kf
         th = yaw_rate_rps * dt
         c, s = np.cos(th), np.sin(th)
         rt = np.array([[c, s], [-s, c]])  # R(th)^T: the old vehicle frame's vectors in the new one
         # p_k+1 = R^T (p_k + v_k dt - t), v_k+1 = R^T v_k, with the ego's travel t = v_ego dt (cos th/2, sin th/2)
         # (the chord of its arc): the ego's own motion moves and turns everything the other way
-        kf.F = np.block([[rt, rt * dt], [np.zeros((2, 2)), rt]])
-        kf.Q = Q_discrete_white_noise(2, dt, self.cfg.accel_mps2 ** 2, block_size=2, order_by_dim=False)
+        f = np.block([[rt, rt * dt], [np.zeros((2, 2)), rt]])
+        q = Q_discrete_white_noise(2, dt, self.cfg.accel_mps2 ** 2, block_size=2, order_by_dim=False)
         travel = ego_speed_mps * dt * np.array([np.cos(th / 2), np.sin(th / 2)])
-        kf.predict(u=travel, B=np.vstack([-rt, np.zeros((2, 2))]))
+        for kf in (self.kf, self.free):
+            kf.predict(u=travel, B=np.vstack([-rt, np.zeros((2, 2))]), F=f, Q=q)
         self.standing = rt @ (self.standing - travel)
 
     def update(self, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float, stereo_ok: bool) -> None:
         self.kf.update(xy, R=r)
+        self.free.update(xy, R=r)
         self.standing = self.kf.x[:2].copy()
         # the height: a running mean of the per-frame estimates
         self.height_m += (height_m - self.height_m) / min(self.hits + 1, 10)
         self.box, self.score = box, score
         self.hits += 1
         self.stereo_hits += int(stereo_ok)
+        speed, sigma = self.free_speed()
+        self.too_fast |= speed - self.cfg.too_fast_sigmas * sigma > self.cfg.person_max_mps
         self.misses = 0
+
+    def free_speed(self) -> tuple[float, float]:
+        """The free motion's speed over the ground and its standard deviation along the motion [m/s]."""
+        v, p = self.free.x[2:], self.free.P[2:, 2:]
+        speed = float(np.hypot(*v))
+        # sigma_|v| = sqrt(n^T P_v n), n = v / |v| (the trace's mean at a standstill, where there is no direction)
+        var = float(v @ p @ v) / speed ** 2 if speed > 1e-9 else float(np.trace(p)) / 2
+        return speed, float(np.sqrt(max(var, 0.0)))
 
 
 class PersonTracker:
@@ -258,4 +291,4 @@ class PersonTracker:
                            tuple(float(c) for c in box), float(t.score), t.hits, t.misses,
                            t.hits >= self.cfg.confirm_hits,
                            t.hits >= self.cfg.confirm_hits and t.misses <= self.cfg.report_misses,
-                           (float(t.standing[0]), float(t.standing[1])), t.stereo_hits)
+                           (float(t.standing[0]), float(t.standing[1])), t.stereo_hits, *t.free_speed(), t.too_fast)

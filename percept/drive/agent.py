@@ -56,6 +56,8 @@ class Agent:
         speed = estimates["odometry"].speed_mps
         target = nearest_target(estimates["longitudinal"], estimates["pedestrians"])
         follow, following = self.following.update(target, speed)
-        accel, braking = self.braking.update(target, speed, follow, self.dt_s)
+        request = estimates["pedestrians"]
+        accel, braking = self.braking.update(target, speed, follow, self.dt_s,
+                                             withdrawn=request is not None and request.withdrawn)
         return AgentStep(accel, steer, estimates, debug, timing,
                          {"lane_keeping": keeping, "following": following, "emergency_braking": braking})

@@ -204,7 +204,7 @@ class PedestrianScorer:
             self.false_stops += 1
         self._stopped = stopped
         braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
-        if braking and not self._braking and request is not None:
+        if braking and not self._braking and request is not None and not request.withdrawn:
             person = self._requested_person(request, debug, gt)
             self.verge_brakes += int(person is not None and not person.crossing)
             self.brakes_for_no_one += int(person is None)

@@ -16,6 +16,8 @@ CORRIDOR_MARGIN_M = 0.4
 """Clearance kept either side of the ego's body [m]."""
 PERSON_CORRIDOR_HALF_M = EGO_WIDTH_M / 2 + CORRIDOR_MARGIN_M + PERSON_HALF_M
 """A person's centre closer than this to the path's centre line touches the ego's corridor [m]."""
+PERSON_STOP_MARGIN_M = 4.0
+"""The car stops this far short of a person in its path (front bumper to person) [m]."""
 
 
 @dataclass(frozen=True)

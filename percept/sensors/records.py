@@ -117,13 +117,16 @@ class Lead:
 @dataclass(frozen=True)
 class BrakingRequest:
     """Stop before ``stop_before_m`` (left-camera range of the conflict point, e.g. a person stepping into the
-    path) [m]; range_rate_mps: its d(range)/dt [m/s]; reason: why, for review; kind: what is there; obj_id."""
+    path) [m]; range_rate_mps: its d(range)/dt [m/s]; reason: why, for review; kind: what is there; obj_id;
+    withdrawn: True withdraws what was asked for ``obj_id`` (it has turned out to be no person): brake for nothing,
+    and drop a stop committed to for it."""
 
     stop_before_m: float
     range_rate_mps: float
     reason: str
     kind: ObjectKind = ObjectKind.PEDESTRIAN
     obj_id: int | None = None
+    withdrawn: bool = False
 
 
 @dataclass(frozen=True)

@@ -110,6 +110,24 @@ def test_emergency_braking_commits_to_stop_before_a_pedestrian_and_releases_once
     assert dbg.stop_in_m is None and a == 1.0  # released: free to go
 
 
+def test_a_withdrawn_request_releases_the_commitment_while_driving():
+    # a car's corner read as a person 40 m ahead: the car commits to stop; half a second later the pedestrian slot
+    # has seen it move like a vehicle and withdraws the request
+    law = EmergencyBraking()
+    v, dt = 20.0, 1 / 15
+    a, dbg = law.update(Target(36.0, 20.0, ObjectKind.PEDESTRIAN, "request"), v, follow_mps2=0.5, dt=dt)
+    assert a < -2.0 and dbg.stop_in_m is not None
+    a, dbg = law.update(None, v, follow_mps2=0.5, dt=dt)
+    assert dbg.stop_in_m is not None and a < -2.0  # the commitment holds without a request
+    a, dbg = law.update(None, v, follow_mps2=0.5, dt=dt, withdrawn=True)
+    assert dbg.stop_in_m is None and a == 0.5 and "commitment" not in dbg.terms
+
+
+def test_a_withdrawn_request_is_no_target():
+    lead = Lead(30.0, -2.0, ObjectKind.VEHICLE)
+    req = BrakingRequest(20.0, -8.0, "moves like a vehicle, not a person", obj_id=3, withdrawn=True)
+    assert nearest_target(lead, req).source == "lead" and nearest_target(None, req) is None
+
 def test_nearest_target_compares_bumper_gaps_of_the_lead_and_the_request():
     offset = EGO_LENGTH_M / 2 - CAMERA_MOUNT_X_M
     lead = Lead(30.0, -2.0, ObjectKind.VEHICLE)

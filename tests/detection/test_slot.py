@@ -71,10 +71,12 @@ def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
 
 
 def track(tid: int, x: float, y: float, vy: float = 0.0, stereo_hits: int = 5, standing=None, hits: int = 20,
-          vx: float = 0.0):
-    """A confirmed, seen track of a person at (x, y) walking at (vx, vy) [m/s] (sigma of vy 0.1 m/s)."""
+          vx: float = 0.0, too_fast: bool = False):
+    """A confirmed, seen track of a person at (x, y) walking at (vx, vy) [m/s] (sigma of vy 0.1 m/s; its free motion
+    the same, sigma 0.3 m/s); too_fast: its detections have shown a vehicle's speed."""
     return PersonTrack(tid, (x, y), (vx, vy), 0.1, 1.75, (300.0, 200.0, 320.0, 260.0), 1.0, hits, 0, True, True,
-                       standing if standing is not None else (x, y), stereo_hits)
+                       standing if standing is not None else (x, y), stereo_hits, float(np.hypot(vx, vy)), 0.3,
+                       too_fast)
 
 
 def test_only_tracks_the_stereo_pair_has_placed_on_the_road_ask_for_braking():
@@ -86,17 +88,70 @@ def test_only_tracks_the_stereo_pair_has_placed_on_the_road_ask_for_braking():
     assert slot._request([track(1, 15.0, 0.5, stereo_hits=0)], path, 10.0) == (None, None)
 
 
-def test_a_track_faster_than_a_person_asks_for_no_braking():
-    # curves seed 0 at night: a car's lamp and wheel in the next lane, tracked as a person 30 m ahead that moved
-    # with the car; its filter's speed rose towards the car's while it coasted into the path, and the car braked at
-    # -8 m/s^2 to a standstill on a road with nobody on it
+def test_a_track_that_has_shown_a_vehicles_speed_asks_for_no_braking():
+    # highway seed 1 at night: a car's corner 35 m ahead in the path, its person filter at 1.9 m/s, its detections
+    # at 21 m/s: the car braked from 26 m/s to a standstill for it
     slot = PedestrianSlot(StereoRig(), 1 / 15)
-    path = EgoPath.straight(20.0)
-    assert slot._request([track(1, 17.8, 1.8, vx=5.0, vy=-1.1)], path, 20.0) == (None, None)
+    path = EgoPath.straight(26.0)
+    assert slot._request([track(1, 36.0, 0.5, vx=1.9, too_fast=True)], path, 26.0) == (None, None)
     # a person running across at 3 m/s is still one
     request, rid = slot._request([track(1, 17.8, 1.8, vx=0.5, vy=-3.0)], path, 20.0)
-    assert rid == 1
+    assert rid == 1 and request.reason == "pedestrian stepping into the path"
 
+
+def test_a_young_track_far_ahead_waits_for_its_motion_and_a_near_one_does_not():
+    # curves seed 4: a car's corner 40 m ahead in the path, confirmed after three detections with its free motion at
+    # 29 +- 15 m/s; at 20 m/s the car can wait for the motion: a stop at 6.5 m/s^2 takes 31 m (and the 4 m margin),
+    # a frame 1.3 m
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(20.0)
+    far = slot.cam_x + 40.0
+    assert slot._request([track(1, far, 0.3, hits=3)], path, 20.0) == (None, None)
+    assert slot._request([track(1, far, 0.3, hits=8)], path, 20.0)[1] == 1  # its motion known: a person
+    near = slot.cam_x + 30.0
+    assert slot._request([track(1, near, 0.3, hits=3)], path, 20.0)[1] == 1  # no room left to wait
+
+
+class _Tracks:
+    """A stand-in tracker whose tracks the test sets each frame."""
+
+    def __init__(self, rig, dt_s):
+        self.rig, self.dt_s, self.now = rig, dt_s, []
+
+    def predict(self, speed, yaw_rate):
+        return []
+
+    def update(self, *args, **kwargs):
+        return self.now
+
+
+def test_the_request_is_withdrawn_once_the_track_asked_for_moves_like_a_vehicle():
+    rig = StereoRig()
+    slot = PedestrianSlot(rig, 1 / 15)
+    slot.tracker = _Tracks(rig, 1 / 15)
+    black = np.zeros((rig.camera.height, rig.camera.width, 3), np.uint8)
+    x = slot.cam_x + 30.0
+    slot.tracker.now = [track(7, x, 0.3)]
+    request, dbg = slot.step(frame(0, black, speed=20.0), {})
+    assert request.obj_id == 7 and not request.withdrawn and dbg.request_track == 7
+    slot.tracker.now = [track(7, x, 0.3, vx=18.0, too_fast=True)]
+    request, dbg = slot.step(frame(1, black, speed=20.0), {})
+    assert request.withdrawn and request.obj_id == 7 and dbg.request_track is None
+    request, _ = slot.step(frame(2, black, speed=20.0), {})
+    assert request is None  # withdrawn once
+
+
+def test_no_withdrawal_while_a_person_asked_for_is_out_of_sight():
+    rig = StereoRig()
+    slot = PedestrianSlot(rig, 1 / 15)
+    slot.tracker = _Tracks(rig, 1 / 15)
+    black = np.zeros((rig.camera.height, rig.camera.width, 3), np.uint8)
+    slot.tracker.now = [track(1, slot.cam_x + 20.0, 0.0)]
+    assert slot.step(frame(0, black, speed=10.0), {})[0].obj_id == 1
+    slot.tracker.now = [track(2, slot.cam_x + 35.0, 0.2)]  # the person lost from view; a corner asked for
+    assert slot.step(frame(1, black, speed=10.0), {})[0].obj_id == 2
+    slot.tracker.now = [track(2, slot.cam_x + 35.0, 0.2, vx=15.0, too_fast=True)]
+    assert slot.step(frame(2, black, speed=10.0), {})[0] is None  # the stop committed to for the person stays
 
 def test_a_track_not_walking_is_judged_where_it_was_last_seen():
     slot = PedestrianSlot(StereoRig(), 1 / 15)

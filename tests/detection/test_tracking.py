@@ -140,3 +140,48 @@ def test_a_coasting_track_stands_where_it_was_last_seen():
         assert t.standing_m[0] == pytest.approx(seen[0] - ego * DT * k)
         assert t.standing_m[1] == pytest.approx(seen[1])
     assert t.position_m[1] < seen[1] - 0.3
+
+
+def test_a_vehicle_corner_taken_for_a_person_shows_its_speed_in_the_free_motion():
+    # highway seed 1 at night: a car's corner 35 m ahead in the next lane, read as a person, held its range for
+    # 0.6 s while the ego drove at 26 m/s; the person filter read 1.9 m/s over the ground and the car braked hard
+    rig = StereoRig()
+    tr = PersonTracker(rig, DT)
+    ego, lead = 26.0, 22.0
+    x = 37.0
+    for _ in range(8):
+        tr.predict(ego)
+        x += (lead - ego) * DT
+        (t,) = tr.update([person_box(rig, x, 3.0)], [1.0])
+    assert np.hypot(*t.velocity_mps) < 5.0  # the person filter's prior still holds it near a standstill
+    assert t.free_speed_mps == pytest.approx(lead, abs=2.5)
+    assert t.free_speed_mps - 2.5 * t.sigma_free_speed_mps > 4.0 and t.too_fast
+
+
+def test_a_standing_person_approached_at_speed_is_not_given_a_vehicles_speed():
+    rig = StereoRig()
+    tr = PersonTracker(rig, DT)
+    ego, x = 26.0, 45.0
+    for k in range(12):
+        tr.predict(ego)
+        x -= ego * DT
+        (t,) = tr.update([person_box(rig, x, 1.0)], [1.0])
+        assert t.free_speed_mps - 2.5 * t.sigma_free_speed_mps < 4.0, (k, t)
+    assert t.free_speed_mps < 1.0 and not t.too_fast
+
+
+def test_one_detection_on_another_part_of_the_vehicle_does_not_make_it_a_person_again():
+    # highway seed 1 at night: after 0.5 s of the corner at 21 m/s over the ground, one taller window on the same car
+    # put its feet 16 m nearer; the free motion fell to 6.5 +- 2.2 m/s for that frame
+    rig = StereoRig()
+    tr = PersonTracker(rig, DT)
+    x = 37.0
+    for _ in range(8):
+        tr.predict(26.0)
+        x -= 4.0 * DT
+        (t,) = tr.update([person_box(rig, x, 3.0)], [1.0])
+    assert t.too_fast
+    tr.predict(26.0)
+    u0, v0, u1, v1 = person_box(rig, x, 3.0)
+    (t,) = tr.update([(u0, v0, u1, v1 + 0.6 * (v1 - v0))], [1.0])
+    assert t.hits == 9 and t.too_fast

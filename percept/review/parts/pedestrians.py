@@ -46,9 +46,11 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, request, debug, truth) -> No
     obstacle = truth.in_path
     true_m = (ctx.range_from_gap_m(obstacle.gap_m)
               if obstacle is not None and obstacle.kind is ObjectKind.PEDESTRIAN else None)
-    ctx.scalars("stop_before_m", truth=true_m, estimate=request.stop_before_m if request else None)
-    if request is None:
-        log_on_change(rec, ctx, LOG, None, "braking request ended")
+    asked = request is not None and not request.withdrawn
+    ctx.scalars("stop_before_m", truth=true_m, estimate=request.stop_before_m if asked else None)
+    if not asked:
+        log_on_change(rec, ctx, LOG, None if request is None else "withdrawn",
+                      "braking request ended" if request is None else f"braking request withdrawn: {request.reason}")
         ctx.buffer.clear(ctx.around_ego("stop"))
         if ctx.image:
             ctx.buffer.clear(ctx.on_image("stop"))
