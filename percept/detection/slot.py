@@ -14,7 +14,9 @@ deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking a
 braking. A track too young for its motion to be known (fewer than ``WALK_HITS`` detections) asks only once the
 car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2``. When a track the slot asked
 to stop for turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so
-that the stop committed to for it is dropped. The conflict rule is the privileged slot's
+that the stop committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with its
+free motion a standard deviation faster than a person's: a real person lost from view keeps the stop committed to
+for them. The conflict rule is the privileged slot's
 (``percept.sensors.conflict``).
 """
 
@@ -94,12 +96,13 @@ class PedestrianSlot:
         self.sweep_frames = sweep_frames
         self.cam_x = float(rig.camera_position()[0])
         self.motion = EgoMotionGate()
-        self.asked: set[int] = set()  # the tracks asked for since the car last stood
+        self.person_max_mps = tracking.person_max_mps
+        self.asked: dict[int, PersonTrack] = {}  # the tracks asked for since the car last stood, as last seen
 
     def reset(self) -> None:
         self.tracker.reset()
         self.motion.reset()
-        self.asked = set()
+        self.asked = {}
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
         motion = self.motion.update(frame)
@@ -118,11 +121,10 @@ class PedestrianSlot:
             tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame) if boxes else None,
                                          verify=[d.windows < 2 for d in dets])
         request, rid = self._request(tracks, path, speed)
-        if rid is not None:
-            self.asked.add(rid)
-        elif speed <= STANDING_MPS:
-            self.asked = set()
-        else:
+        self.asked.update({t.track_id: t for t in tracks if t.track_id in self.asked or t.track_id == rid})
+        if rid is None and speed <= STANDING_MPS:
+            self.asked = {}
+        elif rid is None:
             request = self._withdrawal(tracks, speed)
         return request, PedestrianDebug(tuple(dets), tuple(tracks), levels, stats, rid)
 
@@ -147,7 +149,8 @@ class PedestrianSlot:
             # a person taken to stand is where they were last seen, not carried on by a speed not trusted
             x, y = t.position_m if walking else t.standing_m
             c = person_conflict(x, y, vy if walking else 0.0, float(path.centre_y(x)), lane_w, speed)
-            if c.any and t.hits < WALK_HITS and self._can_wait(x, speed):
+            # (once asked, a track is asked for until it is withdrawn)
+            if c.any and t.hits < WALK_HITS and t.track_id not in self.asked and self._can_wait(x, speed):
                 continue
             if c.any and (best is None or x < best[0]):
                 best = (x, t, c)
@@ -167,11 +170,19 @@ class PedestrianSlot:
 
     def _withdrawal(self, tracks: list[PersonTrack], speed: float) -> BrakingRequest | None:
         """With nothing to ask for: the request withdrawn when every track asked for since the car last stood moves
-        like a vehicle (a person asked for and since lost from view keeps the stop committed to for them)."""
-        fast = {t.track_id: t for t in tracks if t.too_fast}
-        if not self.asked or not self.asked <= fast.keys():
+        like a vehicle: shown so (``too_fast``) or, lost from view before ``WALK_HITS`` detections, a standard
+        deviation faster than a person (a person asked for and since lost from view keeps the stop committed to for
+        them)."""
+        now = {t.track_id for t in tracks}
+
+        def vehicle(t: PersonTrack) -> bool:
+            if t.track_id in now:
+                return t.too_fast
+            return t.hits < WALK_HITS and t.free_speed_mps - t.sigma_free_speed_mps > self.person_max_mps
+
+        if not self.asked or not all(vehicle(t) for t in self.asked.values()):
             return None
-        t = fast[max(self.asked)]
-        self.asked = set()
+        t = self.asked[max(self.asked)]
+        self.asked = {}
         return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed, "moves like a vehicle, not a person",
                               ObjectKind.PEDESTRIAN, t.track_id, withdrawn=True)

@@ -2,6 +2,7 @@
 scored against the truth; dropped frames, a black frame and a NaN wheel speed or yaw rate degrade gracefully."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -152,6 +153,37 @@ def test_no_withdrawal_while_a_person_asked_for_is_out_of_sight():
     assert slot.step(frame(1, black, speed=10.0), {})[0].obj_id == 2
     slot.tracker.now = [track(2, slot.cam_x + 35.0, 0.2, vx=15.0, too_fast=True)]
     assert slot.step(frame(2, black, speed=10.0), {})[0] is None  # the stop committed to for the person stays
+
+
+def young(tid, x, free_mps, sigma_mps):
+    """A track three detections old whose free motion reads free_mps +- sigma_mps."""
+    return replace(track(tid, x, 0.2, hits=3), free_speed_mps=free_mps, sigma_free_speed_mps=sigma_mps)
+
+
+def test_a_young_track_asked_for_and_lost_is_withdrawn_only_if_it_moved_like_a_vehicle():
+    # curves seed 8: a corner 36 m ahead asked for after four detections (free motion 16 +- 8 m/s), then lost from
+    # view on the bend: the stop committed to for it brought the car from 19.5 m/s to a standstill
+    rig = StereoRig()
+    black = np.zeros((rig.camera.height, rig.camera.width, 3), np.uint8)
+    for free, withdrawn in (((16.3, 8.3), True), ((3.0, 8.3), False)):
+        slot = PedestrianSlot(rig, 1 / 15)
+        slot.tracker = _Tracks(rig, 1 / 15)
+        slot.tracker.now = [young(7, slot.cam_x + 30.0, *free)]
+        assert slot.step(frame(0, black, speed=19.5), {})[0].obj_id == 7
+        slot.tracker.now = []
+        request = slot.step(frame(1, black, speed=19.0), {})[0]
+        assert (request is not None and request.withdrawn) == withdrawn, free
+
+
+def test_a_young_track_once_asked_for_does_not_go_back_to_waiting():
+    rig = StereoRig()
+    slot = PedestrianSlot(rig, 1 / 15)
+    slot.tracker = _Tracks(rig, 1 / 15)
+    black = np.zeros((rig.camera.height, rig.camera.width, 3), np.uint8)
+    slot.tracker.now = [young(7, slot.cam_x + 35.0, 16.0, 10.0)]
+    assert slot.step(frame(0, black, speed=19.5), {})[0].obj_id == 7  # no room left to wait at 19.5 m/s
+    # braking, the car has room again at 17 m/s: the track stays asked for
+    assert slot.step(frame(1, black, speed=17.0), {})[0].obj_id == 7
 
 def test_a_track_not_walking_is_judged_where_it_was_last_seen():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
