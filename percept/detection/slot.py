@@ -8,14 +8,14 @@ frame, the two levels around each tracked person's predicted window. A lone wind
 drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
 its feet touch the road. Only confirmed tracks act, and only once the stereo pair has seen them stand where their
 feet touch the road (``STEREO_HITS``), and never once their detections have shown them moving over the ground
-faster than a person (``PersonTrack.too_fast``); a track walking sideways counts as walking only when it has ``WALK_HITS``
+like a vehicle (``PersonTrack.too_fast``); a track walking sideways counts as walking only when it has ``WALK_HITS``
 detections and its lateral speed is a person's and clear of its own uncertainty (``WALK_SIGMAS`` standard
 deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
 braking. A track too young for its motion to be known (fewer than ``WALK_HITS`` detections) asks only once the
 car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2``. When a track the slot asked
 to stop for turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so
 that the stop committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with its
-free motion a standard deviation faster than a person's: a real person lost from view keeps the stop committed to
+free motion a standard deviation faster than ``TrackConfig.vehicle_min_mps``: a real person lost from view keeps the stop committed to
 for them. The conflict rule is the privileged slot's
 (``percept.sensors.conflict``).
 """
@@ -96,7 +96,7 @@ class PedestrianSlot:
         self.sweep_frames = sweep_frames
         self.cam_x = float(rig.camera_position()[0])
         self.motion = EgoMotionGate()
-        self.person_max_mps = tracking.person_max_mps
+        self.vehicle_min_mps = tracking.vehicle_min_mps
         self.asked: dict[int, PersonTrack] = {}  # the tracks asked for since the car last stood, as last seen
 
     def reset(self) -> None:
@@ -171,14 +171,14 @@ class PedestrianSlot:
     def _withdrawal(self, tracks: list[PersonTrack], speed: float) -> BrakingRequest | None:
         """With nothing to ask for: the request withdrawn when every track asked for since the car last stood moves
         like a vehicle: shown so (``too_fast``) or, lost from view before ``WALK_HITS`` detections, a standard
-        deviation faster than a person (a person asked for and since lost from view keeps the stop committed to for
+        deviation faster than ``TrackConfig.vehicle_min_mps`` (a person asked for and since lost from view keeps the stop committed to for
         them)."""
         now = {t.track_id for t in tracks}
 
         def vehicle(t: PersonTrack) -> bool:
             if t.track_id in now:
                 return t.too_fast
-            return t.hits < WALK_HITS and t.free_speed_mps - t.sigma_free_speed_mps > self.person_max_mps
+            return t.hits < WALK_HITS and t.free_speed_mps - t.sigma_free_speed_mps > self.vehicle_min_mps
 
         if not self.asked or not all(vehicle(t) for t in self.asked.values()):
             return None
