@@ -15,7 +15,7 @@ braking. A track too young for its motion to be known (fewer than ``WALK_HITS`` 
 car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2``. When a track the slot asked
 to stop for turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so
 that the stop committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with its
-free motion a standard deviation faster than ``TrackConfig.vehicle_min_mps``: a real person lost from view keeps the stop committed to
+free motion faster than ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's than a walk): a real person lost from view keeps the stop committed to
 for them. The conflict rule is the privileged slot's
 (``percept.sensors.conflict``).
 """
@@ -170,15 +170,15 @@ class PedestrianSlot:
 
     def _withdrawal(self, tracks: list[PersonTrack], speed: float) -> BrakingRequest | None:
         """With nothing to ask for: the request withdrawn when every track asked for since the car last stood moves
-        like a vehicle: shown so (``too_fast``) or, lost from view before ``WALK_HITS`` detections, a standard
-        deviation faster than ``TrackConfig.vehicle_min_mps`` (a person asked for and since lost from view keeps the stop committed to for
+        like a vehicle: shown so (``too_fast``) or, lost from view before ``WALK_HITS`` detections, faster than
+        ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's speed than a walk, if not shown so) (a person asked for and since lost from view keeps the stop committed to for
         them)."""
         now = {t.track_id for t in tracks}
 
         def vehicle(t: PersonTrack) -> bool:
             if t.track_id in now:
                 return t.too_fast
-            return t.hits < WALK_HITS and t.free_speed_mps - t.sigma_free_speed_mps > self.vehicle_min_mps
+            return t.hits < WALK_HITS and t.free_speed_mps > self.vehicle_min_mps
 
         if not self.asked or not all(vehicle(t) for t in self.asked.values()):
             return None
