@@ -39,9 +39,10 @@ class TrackConfig:
     degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s);
     free_sigma_v0_mps: the same for the track's free motion, which assumes no person (a vehicle's speed);
     vehicle_min_mps: a track whose free motion is faster than this by ``too_fast_sigmas`` of its standard deviation
-    moves like a vehicle and is no person on foot, for good (a vehicle's tail light and wheel can read as legs; people
-    walk at up to 2.5 m/s, and far away, where the feet's row is quantised, a person's free motion read 7.2 +- 1.1
-    m/s on `crossing` seed 15 when their range caught up by 8 m in 0.2 s);
+    moves like a vehicle and is no person on foot until its free motion is as clearly slower (a vehicle's tail light
+    and wheel can read as legs; people walk at up to 2.5 m/s, and far away, where the feet's row is quantised, a
+    person's free motion read 7.2 +- 1.1 m/s on `crossing` seed 15 when their range caught up by 8 m in 0.2 s, and
+    11 +- 2 m/s on `crossing` seed 2 in rain, before it settled at 1.4 +- 0.2);
     verify_chi2: a detection that must be verified (a lone window) is kept only when its stereo depth and its
     ground contact's agree within this squared number of standard deviations (one degree of freedom)."""
 
@@ -72,8 +73,9 @@ class PersonTrack:
     their ground contact's (``TrackConfig.verify_chi2``); free_speed_mps, sigma_free_speed_mps: the speed over the
     ground [m/s] and its standard deviation as the detections alone tell it, without the prior that a person barely
     moves (``velocity_mps`` lags a vehicle's corner taken for a person by seconds; this one does not); too_fast:
-    the free motion has once been a vehicle's (``TrackConfig.vehicle_min_mps``): whatever it is, no person on foot
-    (kept, since one detection on another part of the vehicle can pull the free motion back for a frame)."""
+    the free motion has been a vehicle's (``TrackConfig.vehicle_min_mps``) and has not since been clearly slower:
+    whatever it is, no person on foot (held, since one detection on another part of the vehicle can pull the free
+    motion back for a frame; released, since a far person's first ranges can run ahead of them)."""
 
     track_id: int
     position_m: tuple[float, float]
@@ -137,7 +139,9 @@ class _Track:
         self.hits += 1
         self.stereo_hits += int(stereo_ok)
         speed, sigma = self.free_speed()
-        self.too_fast |= speed - self.cfg.too_fast_sigmas * sigma > self.cfg.vehicle_min_mps
+        # hysteresis: too fast once clearly above the limit, a person again once clearly below it
+        k, limit = self.cfg.too_fast_sigmas, self.cfg.vehicle_min_mps
+        self.too_fast = speed + k * sigma >= limit if self.too_fast else speed - k * sigma > limit
         self.misses = 0
 
     def free_speed(self) -> tuple[float, float]:
