@@ -40,8 +40,8 @@ class EmergencyBraking(Controller):
     """standstill_m: margin kept to a vehicle [m]; ped_margin_m: margin kept to a pedestrian [m];
     trigger_mps2: required deceleration that triggers an emergency brake; gain: braking / required."""
 
-    def __init__(self, standstill_m: float = 4.0, ped_margin_m: float = PERSON_STOP_MARGIN_M, trigger_mps2: float = 2.0,
-                 gain: float = 1.3):
+    def __init__(self, standstill_m: float = 4.0, ped_margin_m: float = PERSON_STOP_MARGIN_M,
+                 trigger_mps2: float = 2.0, gain: float = 1.3):
         self.d0, self.ped_margin, self.trigger, self.gain = standstill_m, ped_margin_m, trigger_mps2, gain
         self.reset()
 

@@ -7,16 +7,16 @@ Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over t
 frame, the two levels around each tracked person's predicted window. A lone window (one that grouping would
 drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
 its feet touch the road. Only confirmed tracks act, and only once the stereo pair has seen them stand where their
-feet touch the road (``STEREO_HITS``), and never once their detections have shown them moving over the ground
-like a vehicle (``PersonTrack.too_fast``); a track walking sideways counts as walking only when it has ``WALK_HITS``
+feet touch the road (``STEREO_HITS``), and not while their detections show them moving over the ground like a
+vehicle (``PersonTrack.too_fast``); a track walking sideways counts as walking only when it has ``WALK_HITS``
 detections and its lateral speed is a person's and clear of its own uncertainty (``WALK_SIGMAS`` standard
 deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
 braking. A track too young for its motion to be known (fewer than ``WALK_HITS`` detections) asks only once the
 car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2``. When a track the slot asked
 to stop for turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so
-that the stop committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with its
-free motion faster than ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's than a walk): a real person lost from view keeps the stop committed to
-for them. The conflict rule is the privileged slot's
+that the stop committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with
+its free motion faster than ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's than a walk); a person lost
+from view otherwise keeps the stop committed to for them. The conflict rule is the privileged slot's
 (``percept.sensors.conflict``).
 """
 
@@ -170,9 +170,9 @@ class PedestrianSlot:
 
     def _withdrawal(self, tracks: list[PersonTrack], speed: float) -> BrakingRequest | None:
         """With nothing to ask for: the request withdrawn when every track asked for since the car last stood moves
-        like a vehicle: shown so (``too_fast``) or, lost from view before ``WALK_HITS`` detections, faster than
-        ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's speed than a walk, if not shown so) (a person asked for and since lost from view keeps the stop committed to for
-        them)."""
+        like a vehicle: shown so (``too_fast``), or lost from view before ``WALK_HITS`` detections with its free
+        speed above ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's than a walk). A person asked for and
+        lost from view otherwise keeps the stop committed to for them."""
         now = {t.track_id for t in tracks}
 
         def vehicle(t: PersonTrack) -> bool:
@@ -184,5 +184,5 @@ class PedestrianSlot:
             return None
         t = self.asked[max(self.asked)]
         self.asked = {}
-        return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed, "moves like a vehicle, not a person",
-                              ObjectKind.PEDESTRIAN, t.track_id, withdrawn=True)
+        return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed,
+                              "moves like a vehicle, not a person", ObjectKind.PEDESTRIAN, t.track_id, withdrawn=True)

@@ -139,7 +139,7 @@ class _Track:
         self.hits += 1
         self.stereo_hits += int(stereo_ok)
         speed, sigma = self.free_speed()
-        # hysteresis: too fast once clearly above the limit, a person again once clearly below it
+        # hysteresis: too fast once s - k sigma > limit, a person again once s + k sigma < limit
         k, limit = self.cfg.too_fast_sigmas, self.cfg.vehicle_min_mps
         self.too_fast = speed + k * sigma >= limit if self.too_fast else speed - k * sigma > limit
         self.misses = 0

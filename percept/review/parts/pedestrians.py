@@ -24,8 +24,9 @@ def draw_people(rec: rr.RecordingStream, ctx: PartContext, debug) -> None:
 
     tracks = debug.reported
     pts = [[t.position_m[0], t.position_m[1], 0.0] for t in tracks]
+    # a track whose detections move like a vehicle's is labelled with its free speed over the ground
     labels = [f"#{t.track_id} {t.position_m[0] - ctx.camera_x_m():.1f} m, {t.velocity_mps[1]:+.1f} m/s"
-              for t in tracks]
+              + (f", moves at {t.free_speed_mps:.0f} m/s: no person" if t.too_fast else "") for t in tracks]
     ctx.buffer.add(ctx.around_ego("people"), rr.Points3D, positions=pts, colors=[TRACK_RGB], radii=[0.3],
                    labels=labels)
     if not ctx.image:
