@@ -28,6 +28,6 @@ def nearest_target(lead: Lead | None, request: BrakingRequest | None) -> Target 
     cands = []
     if lead is not None:
         cands.append(Target(bumper_gap_m(lead.range_m), -lead.range_rate_mps, lead.kind, "lead"))
-    if request is not None and not request.withdrawn:
+    if BrakingRequest.asking(request) is not None:
         cands.append(Target(bumper_gap_m(request.stop_before_m), -request.range_rate_mps, request.kind, "request"))
     return min(cands, key=lambda t: t.gap_m) if cands else None

@@ -15,7 +15,7 @@ from percept.detection.constrained import SearchConfig
 from percept.detection.metrics import DetectionTally, eligible
 from percept.lanes.metrics import centering, rmse_columns
 from percept.longitudinal.metrics import range_abs_rel_err, range_abs_rel_err_by_bin, ttc_abs_err_s
-from percept.sensors import ObjectKind
+from percept.sensors import BrakingRequest, ObjectKind
 from percept.sensors.vehicle import EGO_WIDTH_M
 
 from .privileged import InPath, Obstacle, true_centre_y
@@ -204,7 +204,7 @@ class PedestrianScorer:
             self.false_stops += 1
         self._stopped = stopped
         braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
-        if braking and not self._braking and request is not None and not request.withdrawn:
+        if braking and not self._braking and BrakingRequest.asking(request) is not None:
             person = self._requested_person(request, debug, gt)
             self.verge_brakes += int(person is not None and not person.crossing)
             self.brakes_for_no_one += int(person is None)

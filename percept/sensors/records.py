@@ -128,6 +128,11 @@ class BrakingRequest:
     obj_id: int | None = None
     withdrawn: bool = False
 
+    @staticmethod
+    def asking(request: "BrakingRequest | None") -> "BrakingRequest | None":
+        """The request if it asks for braking; None when there is none or it is withdrawn."""
+        return None if request is None or request.withdrawn else request
+
 
 @dataclass(frozen=True)
 class PoseEstimate:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import rerun as rr
 
-from percept.sensors import ObjectKind
+from percept.sensors import BrakingRequest, ObjectKind
 
 from ..context import Part, PartContext, Plot, cross_line, log_on_change
 
@@ -47,7 +47,7 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, request, debug, truth) -> No
     obstacle = truth.in_path
     true_m = (ctx.range_from_gap_m(obstacle.gap_m)
               if obstacle is not None and obstacle.kind is ObjectKind.PEDESTRIAN else None)
-    asked = request is not None and not request.withdrawn
+    asked = BrakingRequest.asking(request) is not None
     ctx.scalars("stop_before_m", truth=true_m, estimate=request.stop_before_m if asked else None)
     if not asked:
         log_on_change(rec, ctx, LOG, None if request is None else "withdrawn",
