@@ -13,10 +13,11 @@ from percept.sensors.boxes import iou, iou_matrix
 from .metrics import DetectionScore, FrameMatch, eligible, match_detections, score_frames
 from .pyramid import Detection, detect_multiscale, group, pyramid_scales, windows_at_scale
 from .constrained import ConstrainedSearch, SearchConfig, SearchStats, person_box
+from .free_motion import FreeMotion
 from .tracking import PersonTrack, PersonTracker, TrackConfig
 from .slot import PedestrianDebug, PedestrianSlot, window_of
 
-__all__ = ["ConstrainedSearch", "PedestrianDebug", "PedestrianSlot", "PersonTrack", "PersonTracker", "SearchConfig",
+__all__ = ["ConstrainedSearch", "FreeMotion", "PedestrianDebug", "PedestrianSlot", "PersonTrack", "PersonTracker", "SearchConfig",
            "SearchStats", "TrackConfig", "person_box", "window_of",
            "DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",
            "detect_multiscale", "eligible", "group", "hog_blocks", "hog_descriptor", "iou", "iou_matrix",

@@ -160,6 +160,18 @@ def young(tid, x, free_mps, sigma_mps):
     return replace(track(tid, x, 0.2, hits=3), free_speed_mps=free_mps, sigma_free_speed_mps=sigma_mps)
 
 
+def test_a_young_track_whose_free_motion_reads_a_vehicles_speed_waits_longer():
+    # curves seed 17: a car's corner 32.5 m ahead in the path, confirmed after three detections with its free motion
+    # at 16.4 +- 5.0 m/s, asked for at 18.8 m/s (a stop at 6.5 m/s^2 and the 4 m margin took the room left); a frame
+    # later its free motion showed the vehicle (18.2 +- 3.5) and the request was withdrawn
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(18.8)
+    x = slot.cam_x + 32.5
+    assert slot._request([young(1, x, 16.4, 5.0)], path, 18.8) == (None, None)  # a stop at 7.5 m/s^2 still fits
+    assert slot._request([young(1, x, 3.0, 5.0)], path, 18.8)[1] == 1  # read as a walk: no longer
+    assert slot._request([young(1, x - 2.5, 16.4, 5.0)], path, 18.8)[1] == 1  # two frames on: no room left
+
+
 def test_a_young_track_asked_for_and_lost_is_withdrawn_only_if_it_moved_like_a_vehicle():
     # curves seed 8: a corner 36 m ahead asked for after four detections (free motion 16.3 +- 8.3 m/s), then lost
     # from view on the bend: the stop committed to for it brought the car from 19.5 m/s to a standstill
@@ -180,7 +192,7 @@ def test_a_young_track_once_asked_for_does_not_go_back_to_waiting():
     slot = PedestrianSlot(rig, 1 / 15)
     slot.tracker = _Tracks(rig, 1 / 15)
     black = np.zeros((rig.camera.height, rig.camera.width, 3), np.uint8)
-    slot.tracker.now = [young(7, slot.cam_x + 35.0, 16.0, 10.0)]
+    slot.tracker.now = [young(7, slot.cam_x + 31.0, 16.0, 10.0)]
     assert slot.step(frame(0, black, speed=19.5), {})[0].obj_id == 7  # no room left to wait at 19.5 m/s
     # braking, the car has room again at 17 m/s: the track stays asked for
     assert slot.step(frame(1, black, speed=17.0), {})[0].obj_id == 7
