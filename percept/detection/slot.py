@@ -12,11 +12,12 @@ vehicle (``PersonTrack.too_fast``); a track walking sideways counts as walking o
 detections and its lateral speed is a person's and clear of its own uncertainty (``WALK_SIGMAS`` standard
 deviations, and at least ``WALK_MIN_MPS``), so that people standing or walking along the verge do not cause
 braking. A track too young for its motion to be known (fewer than ``WALK_HITS`` detections) asks only once the
-car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2``. When a track the slot asked
-to stop for turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so
-that the stop committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with
-its free motion faster than ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's than a walk); a person lost
-from view otherwise keeps the stop committed to for them. The conflict rule is the privileged slot's
+car could no longer wait a frame and still stop short of it at ``YOUNG_STOP_MPS2`` (at ``YOUNG_FAST_STOP_MPS2``
+while its free motion reads faster than ``TrackConfig.vehicle_min_mps``). When a track the slot asked to stop for
+turns out to move like a vehicle, the slot withdraws the request (``BrakingRequest.withdrawn``), so that the stop
+committed to for it is dropped; so too when it is lost from view young (before ``WALK_HITS``) with its free motion
+faster than ``TrackConfig.vehicle_min_mps`` (more likely a vehicle's than a walk); a person lost from view
+otherwise keeps the stop committed to for them. The conflict rule is the privileged slot's
 (``percept.sensors.conflict``).
 """
 
