@@ -5,9 +5,12 @@ A vehicle's tail light and wheel can read as a person's legs; the person filter'
 its motion near a standstill for seconds, while its detections show a vehicle's speed over the ground. The free
 filter starts with a vehicle's speed uncertainty and follows the detections. One detection on another part of the
 same vehicle (a taller window that puts the feet 10-16 m nearer) would drag it back to a standstill in one frame, so
-its update is robust: an innovation beyond the gate counts as if it lay on the gate (its noise inflated by
-d^2 / gate), so one stray detection moves the free motion no more than a plausible one, and a lasting change is
-still followed, a gate's worth a frame.
+its update is robust: a detection whose innovation lies beyond the gate has its measurement noise inflated by
+d^2 / gate, so that (where the measurement noise dominates the innovation's) it lies on the gate, and the farther
+beyond it lies the less it moves the free motion. A lasting change is followed as the filter's own uncertainty
+grows. It does not help a young filter, whose uncertainty dominates: on `cut-in` seed 13 (clear) a window 12 m
+nearer than the seven before it still pulled a free motion of 12.3 +- 3.8 m/s to 2.3 +- 0.8 (shortening the
+innovation onto the gate instead gave 2.6 +- 1.2).
 
 References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Tracking and Navigation" (2001), the
 white-noise-acceleration model (ch. 6) and gating (ch. 7); Chang, "Robust Kalman filtering based on Mahalanobis
@@ -24,7 +27,7 @@ class FreeMotion:
     """The free motion of one track over the ground in the vehicle frame: state (x, y, vx, vy) [m, m/s].
 
     sigma_v0_mps: the first speed uncertainty (a vehicle's speed); gate_chi2: squared Mahalanobis distance beyond which
-    an innovation is scaled back onto the gate (2 degrees of freedom); vehicle_min_mps, too_fast_sigmas: the
+    a detection's noise is inflated by d^2 / gate (2 degrees of freedom); vehicle_min_mps, too_fast_sigmas: the
     hysteresis of ``too_fast`` (see ``update``)."""
 
     def __init__(self, xy: np.ndarray, r: np.ndarray, sigma_v0_mps: float, gate_chi2: float,
@@ -45,8 +48,8 @@ class FreeMotion:
         d = xy - kf.H @ kf.x
         # d^2 = (z - H x)^T S^-1 (z - H x), S = H P H^T + R
         d2 = float(d @ np.linalg.solve(kf.H @ kf.P @ kf.H.T + r, d))
-        # beyond the gate, R' = R d^2 / gate: the innovation then weighs as one on the gate would (Chang 2014; exact
-        # when R dominates S, and never more than the unscaled update)
+        # beyond the gate, R' = R d^2 / gate (Chang 2014): d'^2 = d^T (H P H^T + R')^-1 d is then the gate where R
+        # dominates S, and the update moves the state less than the unscaled one would
         kf.update(xy, R=r * (d2 / self.gate_chi2) if d2 > self.gate_chi2 else r)
         self.speed = speed, sigma = self._speed()
         # hysteresis: too fast once s - k sigma > limit, a person again once s + k sigma < limit

@@ -38,9 +38,9 @@ class TrackConfig:
     detection with a track's predicted box that pairs them; gate_chi2: squared Mahalanobis gate on the ground (2
     degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s);
     free_sigma_v0_mps: the same for the track's free motion, which assumes no person (a vehicle's speed);
-    free_gate_chi2: squared Mahalanobis distance beyond which a detection weighs in the free motion as one on this
-    gate would (2 degrees of freedom, 99.9 %: one window on another part of a vehicle, its feet 10 m nearer, pulled
-    the free motion from 14.8 +- 2.7 to 1.9 +- 1.0 m/s in one frame on `cut-in` seed 17 at night);
+    free_gate_chi2: squared Mahalanobis distance beyond which a detection's noise is inflated in the free motion
+    (``FreeMotion``; 2 degrees of freedom, 99.9 %: one window on another part of a vehicle, its feet 10 m nearer,
+    pulled the free motion from 14.8 +- 2.7 to 1.9 +- 1.0 m/s in one frame on `cut-in` seed 17 at night);
     vehicle_min_mps: a track whose free motion is faster than this by ``too_fast_sigmas`` of its standard deviation
     moves like a vehicle and is no person on foot until its free motion is as clearly slower (a vehicle's tail light
     and wheel can read as legs; people walk at up to 2.5 m/s, and far away, where the feet's row is quantised, a
