@@ -17,8 +17,8 @@ from .free_motion import FreeMotion
 from .tracking import PersonTrack, PersonTracker, TrackConfig
 from .slot import PedestrianDebug, PedestrianSlot, window_of
 
-__all__ = ["ConstrainedSearch", "FreeMotion", "PedestrianDebug", "PedestrianSlot", "PersonTrack", "PersonTracker", "SearchConfig",
-           "SearchStats", "TrackConfig", "person_box", "window_of",
+__all__ = ["ConstrainedSearch", "FreeMotion", "PedestrianDebug", "PedestrianSlot", "PersonTrack", "PersonTracker",
+           "SearchConfig", "SearchStats", "TrackConfig", "person_box", "window_of",
            "DESCRIPTOR_LEN", "Detection", "DetectionScore", "FrameMatch", "LinearModel", "WINDOW_PX", "block_grid",
            "detect_multiscale", "eligible", "group", "hog_blocks", "hog_descriptor", "iou", "iou_matrix",
            "match_detections", "pyramid_scales", "score_frames", "windows_at_scale"]
