@@ -22,38 +22,49 @@ def train_detector(
     condition: Annotated[list[str] | None, typer.Option(
         "--condition", help="Conditions rotated over the seeds, in order (repeat the option; a condition may "
         "repeat to weight it). Default: clear, night, rain.")] = None,
+    negatives_from: Annotated[list[str] | None, typer.Option(
+        "--negatives-from", help="Traffic scenarios whose frames give hard negatives too (repeat the option; "
+        "'none' for none). Default: highway, curves, cut-in, loop.")] = None,
+    negative_seeds: Annotated[str, typer.Option("--negative-seeds", help="Seeds of the traffic scenarios "
+                                                "(A-B, N or A,B,C); none may be an evaluation seed.")] = "1000-1004",
 ):
     """Render pedestrians and backgrounds, cut 64x128 windows (as the constrained search sees them, 4-pixel cells),
-    train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it and train again.
+    train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it (on the same frames and on the traffic
+    scenarios', where vehicles' corners are what it mistakes for people) and train again.
 
     The conditions rotate over the seeds (by default clear, night, rain). The model is selected with `--model FILE` in
     `percept detect`; the one shipped in the package (`--model sim`) was made by this command's defaults.
     """
     from percept.drive.batch import parse_seeds
-    from percept.drive.train_people import TrainPlan, frames_per_pass, train_people_model
+    from percept.drive.train_people import TrainPlan, frames_to_sample, train_people_model
 
     opt.check_number("--every", every, 1, 100)
     opt.check_number("--c", c, 1e-5, 10.0)
     try:
         conditions = {"conditions": tuple(condition)} if condition else {}
-        plan = TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c, **conditions)
+        if negatives_from:
+            conditions["negative_scenarios"] = () if negatives_from == ["none"] else tuple(negatives_from)
+        plan = TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c,
+                         negative_seeds=tuple(parse_seeds(negative_seeds, "--negative-seeds")), **conditions)
     except ValueError as e:
         fail(str(e))
     record_path = out.with_suffix(".json")
     check_outputs([out, record_path])
     on_interrupt("nothing: the model is written only when training ends")
     with progress_bar() as bar:
-        task = bar.add_task("rendering and training", total=2 * frames_per_pass(plan))
+        task = bar.add_task("rendering and training", total=frames_to_sample(plan))
         try:
             model, record = train_people_model(plan, tick=lambda: bar.advance(task))
         except ValueError as e:
             fail(str(e))
+    traffic = (f"; hard negatives also from {', '.join(plan.negative_scenarios)} seeds {negative_seeds}"
+               if plan.negative_scenarios else "")
     meta = {"trained_on": f"{plan.scenario} seeds {seeds}, conditions {', '.join(plan.conditions)}, every "
-                          f"{plan.every} frames"}
+                          f"{plan.every} frames{traffic}"}
     model.save(out, **meta)
     write_json(record_path, {**record, **meta, "model": str(out)})
     console.print(f"{record['positives']} positives, {record['random_negatives']} random and "
-                  f"{record['hard_negatives']} hard negatives; on its training windows: recall "
+                  f"{record['hard_negatives']} hard negatives ({record['hard_negatives_traffic']} from traffic); on its training windows: recall "
                   f"{record['train_recall']:.3f}, false positives {record['train_false_positive_rate']:.4f}")
     console.print(f"wrote {out} and {record_path}")
 

@@ -48,9 +48,9 @@ class Engine(str, Enum):
     RAY = "ray"
 
 
-def parse_seeds(text: str) -> list[int]:
+def parse_seeds(text: str, option: str = "--seeds") -> list[int]:
     """"A-B" (inclusive), "A,B,C" or "N" -> sorted unique seeds, each 0 to MAX_SEED and at most MAX_SEEDS of
-    them; ValueError with the expected forms otherwise."""
+    them; ValueError with the expected forms otherwise (naming ``option``)."""
     spans = []
     try:
         for part in text.split(","):
@@ -60,15 +60,15 @@ def parse_seeds(text: str) -> list[int]:
                 raise ValueError
             spans.append((lo, hi))
     except ValueError:
-        raise ValueError(f"--seeds must look like 0-9, 3 or 1,4,7 (non-negative, A <= B), got '{text}'") from None
+        raise ValueError(f"{option} must look like 0-9, 3 or 1,4,7 (non-negative, A <= B), got '{text}'") from None
     if (top := max(hi for _, hi in spans)) > MAX_SEED:
-        raise ValueError(f"--seeds go from 0 to {MAX_SEED}, got {top}")
+        raise ValueError(f"{option} go from 0 to {MAX_SEED}, got {top}")
     count, end = 0, -1  # seeds covered by the spans, overlaps counted once
     for lo, hi in sorted(spans):
         count += max(0, hi - max(lo, end + 1) + 1)
         end = max(end, hi)
     if count > MAX_SEEDS:
-        raise ValueError(f"--seeds '{text}' names {count} seeds; a batch takes at most {MAX_SEEDS} (split it)")
+        raise ValueError(f"{option} '{text}' names {count} seeds; a batch takes at most {MAX_SEEDS} (split it)")
     return sorted({s for lo, hi in spans for s in range(lo, hi + 1)})
 
 

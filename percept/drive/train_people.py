@@ -3,9 +3,11 @@
 Positives: pedestrians in the rendered ``crossing`` frames (at least ``min_person_px`` tall and 80 % visible),
 their window crops, a jittered copy (the search's stride and scale step) and the mirror images of both.
 Negatives: random windows where the constrained search looks (its levels and corridor) that touch no person,
-then hard negatives: the first model's false positives over the same frames, searched as the slot searches.
-Seeds are disjoint from every evaluation seed (0-19 closed loop, 100-119 detection); the conditions rotate over
-them so that the model sees day, night and rain.
+then hard negatives: the first model's false positives over the same frames, searched as the slot searches, and
+over frames of the traffic scenarios (``negative_scenarios``), whose vehicles' corners (a tail light over a wheel)
+the first model takes for people 30-45 m ahead (Dalal & Triggs 2005, sec. 4: hard negatives are mined from the
+images the detector will search, whatever they hold). Seeds are disjoint from every evaluation seed (0-19 closed
+loop, 100-119 detection); the conditions rotate over them so that the model sees day, night and rain.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 from percept.detection import ConstrainedSearch, LinearModel, SearchConfig, iou_matrix, window_of
 from percept.detection.training import features, hard_negatives, train_linear_svm, window_crop
 from percept.sensors import EgoPath, LaneEstimate, ObjectKind, StereoRig
-from percept.sims.world import check_condition
+from percept.sims.world import check_condition, check_scenario
 
 from .samples import for_each_frame
 
@@ -28,8 +30,11 @@ EVALUATION_SEEDS = frozenset(range(0, 20)) | frozenset(range(100, 120))
 @dataclass(frozen=True)
 class TrainPlan:
     """scenario; seeds: training seeds (none may be an evaluation seed); conditions: rotated over the seeds; every:
-    frame step; duration_s: of each run (None = the scenario's); min_person_px: smallest positive [px]; negatives_per_frame: random negatives; hard_per_frame: most
-    hard negatives kept per frame; c: the SVM's C; jitter_seed: the random generator's seed."""
+    frame step; duration_s: of each run (None = the scenario's); min_person_px: smallest positive [px];
+    negatives_per_frame: random negatives; hard_per_frame: most hard negatives kept per frame; c: the SVM's C;
+    jitter_seed: the random generator's seed; negative_scenarios: traffic scenarios whose frames give hard
+    negatives too, each driven with ``negative_seeds`` (conditions rotated the same way) and at most
+    ``traffic_hard_per_frame`` windows kept per frame."""
 
     scenario: str = "crossing"
     seeds: tuple[int, ...] = tuple(range(1000, 1010))
@@ -42,15 +47,22 @@ class TrainPlan:
     c: float = 0.01
     jitter_seed: int = 7
     search: SearchConfig = field(default_factory=SearchConfig)
+    negative_scenarios: tuple[str, ...] = ("highway", "curves", "cut-in", "loop")
+    negative_seeds: tuple[int, ...] = tuple(range(1000, 1005))
+    traffic_hard_per_frame: int = 3
 
     def __post_init__(self) -> None:
-        clash = sorted(set(self.seeds) & EVALUATION_SEEDS)
+        clash = sorted((set(self.seeds) | set(self.negative_seeds)) & EVALUATION_SEEDS)
         if clash:
             raise ValueError(f"training seeds {clash} are evaluation seeds (0-19, 100-119); choose others")
         if not self.seeds:
             raise ValueError("give at least one training seed")
+        if self.negative_scenarios and not self.negative_seeds:
+            raise ValueError("give at least one seed for the traffic scenarios' negatives")
         for name in self.conditions:
             check_condition(name)
+        for name in self.negative_scenarios:
+            check_scenario(name)
 
 
 def _truth_path(gt) -> EgoPath:
@@ -69,6 +81,7 @@ class _Collector:
         self.plan, self.rng, self.tick = plan, np.random.default_rng(plan.jitter_seed), tick
         self.search = ConstrainedSearch(rig, model or LinearModel.inria(), plan.search)
         self.mining = model is not None
+        self.keep_per_frame = plan.hard_per_frame
         self.pos: list[np.ndarray] = []
         self.neg: list[np.ndarray] = []
 
@@ -124,25 +137,42 @@ class _Collector:
             return
         corners = np.column_stack([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]])
         free = np.flatnonzero(self._free(corners, taboo))
-        for i in free[np.argsort(-scores[free])][:self.plan.hard_per_frame]:
+        for i in free[np.argsort(-scores[free])][:self.keep_per_frame]:
             if (crop := window_crop(image, tuple(corners[i]))) is not None:
                 self.neg.append(crop)
 
 
-def _drive(plan: TrainPlan, collector: _Collector) -> None:
-    for i, seed in enumerate(plan.seeds):
+def _drive(plan: TrainPlan, collector: _Collector, scenario: str | None = None,
+           seeds: tuple[int, ...] | None = None) -> None:
+    """Every sampled frame of ``scenario`` (default: the plan's) over ``seeds`` (default: the plan's) to the
+    collector, the plan's conditions rotated over the seeds."""
+    for i, seed in enumerate(plan.seeds if seeds is None else seeds):
         cond = plan.conditions[i % len(plan.conditions)]
-        for_each_frame(plan.scenario, [seed], collector, every=plan.every, condition=cond, duration_s=plan.duration_s)
+        for_each_frame(scenario or plan.scenario, [seed], collector, every=plan.every, condition=cond,
+                       duration_s=plan.duration_s)
 
 
-def frames_per_pass(plan: TrainPlan) -> int:
-    """How many frames each of the two passes samples (for a progress bar)."""
+def _mine_traffic(plan: TrainPlan, collector: _Collector) -> int:
+    """The traffic scenarios' hard negatives into the mining collector; how many windows they gave."""
+    before, collector.keep_per_frame = len(collector.neg), plan.traffic_hard_per_frame
+    for scenario in plan.negative_scenarios:
+        _drive(plan, collector, scenario, plan.negative_seeds)
+    collector.keep_per_frame = plan.hard_per_frame
+    return len(collector.neg) - before
+
+
+def frames_to_sample(plan: TrainPlan) -> int:
+    """How many frames the two passes sample in all (for a progress bar): the plan's scenario twice, then the
+    traffic scenarios once."""
     from percept.sims import SCENARIOS
     from percept.sims.env import SIMULATION_HZ
 
-    duration = plan.duration_s if plan.duration_s is not None else SCENARIOS[plan.scenario].duration_s
-    n = max(int(round(duration * SIMULATION_HZ)), 1)
-    return len(plan.seeds) * len(range(0, n, plan.every))
+    def frames(scenario: str) -> int:
+        duration = plan.duration_s if plan.duration_s is not None else SCENARIOS[scenario].duration_s
+        return len(range(0, max(int(round(duration * SIMULATION_HZ)), 1), plan.every))
+
+    return (2 * len(plan.seeds) * frames(plan.scenario)
+            + len(plan.negative_seeds) * sum(frames(s) for s in plan.negative_scenarios))
 
 
 def train_people_model(plan: TrainPlan = TrainPlan(),
@@ -161,10 +191,15 @@ def train_people_model(plan: TrainPlan = TrainPlan(),
     model0 = train_linear_svm(pos, neg, plan.c)
     mining = _Collector(plan, rig, model0, tick)
     _drive(plan, mining)
-    hard = hard_negatives(model0, features(mining.neg), limit=len(mining.neg)) if mining.neg else neg[:0]
+    traffic = _mine_traffic(plan, mining)
+    pool = features(mining.neg) if mining.neg else neg[:0]
+    hard = hard_negatives(model0, pool, limit=len(pool))
+    # of them, the traffic scenarios' (the last ``traffic`` windows of the pool)
+    hard_traffic = int(np.sum(pool[len(pool) - traffic:] @ model0.weights + model0.bias >= 0.0)) if traffic else 0
     model = train_linear_svm(pos, np.vstack([neg, hard]), plan.c)
     record = {"plan": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(plan).items()},
               "positives": int(len(pos)), "random_negatives": int(len(neg)), "hard_negatives": int(len(hard)),
+              "hard_negatives_traffic": hard_traffic,
               "train_recall": float(np.mean(pos @ model.weights + model.bias >= 0)),
               "train_false_positive_rate": float(np.mean(np.vstack([neg, hard]) @ model.weights + model.bias >= 0))}
     return model, record

@@ -41,11 +41,13 @@ def test_crops_are_the_search_window_and_mirroring_is_a_flip():
 def test_train_detector_writes_a_model_that_detect_loads(tmp_path):
     out = tmp_path / "m.npz"
     r = runner.invoke(app, ["train-detector", "--seeds", "1000", "--duration", "10", "--every", "5",
-                            "--out", str(out)])
+                            "--negatives-from", "highway", "--negative-seeds", "1001", "--out", str(out)])
     assert r.exit_code == 0, r.output
     rec = json.loads(out.with_suffix(".json").read_text())
     assert rec["positives"] > 20 and rec["random_negatives"] > 100 and rec["hard_negatives"] > 0
+    assert 0 <= rec["hard_negatives_traffic"] <= rec["hard_negatives"]
     assert rec["plan"]["seeds"] == [1000] and "crossing seeds 1000" in rec["trained_on"]
+    assert rec["plan"]["negative_scenarios"] == ["highway"] and "highway seeds 1001" in rec["trained_on"]
     model = LinearModel.load(out)
     assert model.weights.shape == (DESCRIPTOR_LEN,)
     img = np.full((240, 320, 3), 90, np.uint8)
@@ -62,6 +64,9 @@ def test_train_detector_writes_a_model_that_detect_loads(tmp_path):
     (["--c", "-1"], "--c"),
     (["--seeds", "x"], "--seeds must look like"),
     (["--condition", "fog"], "unknown condition 'fog'"),
+    (["--negative-seeds", "1000,7"], "are evaluation seeds"),
+    (["--negative-seeds", "a-b"], "--negative-seeds must look like"),
+    (["--negatives-from", "autobahn"], "unknown scenario 'autobahn'"),
 ])
 def test_train_detector_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
     r = runner.invoke(app, ["train-detector", *args, "--out", str(tmp_path / "m.npz")])
