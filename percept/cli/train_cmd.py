@@ -23,14 +23,14 @@ def train_detector(
         "--condition", help="Conditions rotated over the seeds, in order (repeat the option; a condition may "
         "repeat to weight it). Default: clear, night, rain.")] = None,
     negatives_from: Annotated[list[str] | None, typer.Option(
-        "--negatives-from", help="Traffic scenarios whose frames give hard negatives too (repeat the option; "
-        "'none' for none). Default: highway, curves, cut-in, loop.")] = None,
-    negative_seeds: Annotated[str, typer.Option("--negative-seeds", help="Seeds of the traffic scenarios "
+        "--negatives-from", help="Scenarios whose frames give hard negatives too, such as the traffic scenarios, "
+        "whose vehicles' corners the first model takes for people (repeat the option). Default: none.")] = None,
+    negative_seeds: Annotated[str, typer.Option("--negative-seeds", help="Seeds of the --negatives-from scenarios "
                                                 "(A-B, N or A,B,C); none may be an evaluation seed.")] = "1000-1004",
 ):
     """Render pedestrians and backgrounds, cut 64x128 windows (as the constrained search sees them, 4-pixel cells),
-    train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it (on the same frames and on the traffic
-    scenarios', where vehicles' corners are what it mistakes for people) and train again.
+    train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it (on the same frames, and on those of the
+    `--negatives-from` scenarios) and train again.
 
     The conditions rotate over the seeds (by default clear, night, rain). The model is selected with `--model FILE` in
     `percept detect`; the one shipped in the package (`--model sim`) was made by this command's defaults.
@@ -43,7 +43,7 @@ def train_detector(
     try:
         conditions = {"conditions": tuple(condition)} if condition else {}
         if negatives_from:
-            conditions["negative_scenarios"] = () if negatives_from == ["none"] else tuple(negatives_from)
+            conditions["negative_scenarios"] = tuple(negatives_from)
         plan = TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c,
                          negative_seeds=tuple(parse_seeds(negative_seeds, "--negative-seeds")), **conditions)
     except ValueError as e:
@@ -64,7 +64,8 @@ def train_detector(
     model.save(out, **meta)
     write_json(record_path, {**record, **meta, "model": str(out)})
     console.print(f"{record['positives']} positives, {record['random_negatives']} random and "
-                  f"{record['hard_negatives']} hard negatives ({record['hard_negatives_traffic']} from traffic); on its training windows: recall "
+                  f"{record['hard_negatives']} hard negatives ({record['hard_negatives_traffic']} from "
+                  f"{', '.join(plan.negative_scenarios) or 'no other scenario'}); on its training windows: recall "
                   f"{record['train_recall']:.3f}, false positives {record['train_false_positive_rate']:.4f}")
     console.print(f"wrote {out} and {record_path}")
 

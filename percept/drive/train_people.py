@@ -4,10 +4,12 @@ Positives: pedestrians in the rendered ``crossing`` frames (at least ``min_perso
 their window crops, a jittered copy (the search's stride and scale step) and the mirror images of both.
 Negatives: random windows where the constrained search looks (its levels and corridor) that touch no person,
 then hard negatives: the first model's false positives over the same frames, searched as the slot searches, and
-over frames of the traffic scenarios (``negative_scenarios``), whose vehicles' corners (a tail light over a wheel)
-the first model takes for people 30-45 m ahead (Dalal & Triggs 2005, sec. 4: hard negatives are mined from the
-images the detector will search, whatever they hold). Seeds are disjoint from every evaluation seed (0-19 closed
-loop, 100-119 detection); the conditions rotate over them so that the model sees day, night and rain.
+optionally over frames of traffic scenarios (``negative_scenarios``, none by default), whose vehicles' corners (a
+tail light over a wheel) the first model takes for people 30-45 m ahead (Dalal & Triggs 2005, sec. 4: hard
+negatives are mined from the images the detector will search). Measured with highway, curves, cut-in and loop: half
+the false positives on `crossing`, but in rain the far field's recall fell from 0.71 to 0.50 and a crossing person
+was hit (README, Pedestrians); so the shipped model has none. Seeds are disjoint from every evaluation seed (0-19
+closed loop, 100-119 detection); the conditions rotate over them so that the model sees day, night and rain.
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ class TrainPlan:
     c: float = 0.01
     jitter_seed: int = 7
     search: SearchConfig = field(default_factory=SearchConfig)
-    negative_scenarios: tuple[str, ...] = ("highway", "curves", "cut-in", "loop")
+    negative_scenarios: tuple[str, ...] = ()
     negative_seeds: tuple[int, ...] = tuple(range(1000, 1005))
     traffic_hard_per_frame: int = 3
 
@@ -65,7 +67,8 @@ class TrainPlan:
             check_scenario(name)
 
 
-def _truth_path(gt) -> EgoPath:
+def truth_path(gt) -> EgoPath:
+    """The ego path as the ground truth has it (the lane's true geometry, full confidence, the true speed)."""
     lane = gt.lane
     return EgoPath(LaneEstimate(lane.offset_m, lane.heading_rad, lane.curvature_1pm, lane.width_m, 1.0), gt.speed_mps)
 
@@ -118,7 +121,7 @@ class _Collector:
         return iou_matrix(boxes, taboo).max(axis=1) < 0.05
 
     def _negatives(self, image, gt, taboo) -> None:
-        path, s = _truth_path(gt), self.search
+        path, s = truth_path(gt), self.search
         for _ in range(self.plan.negatives_per_frame):
             k = int(self.rng.integers(len(s.scales)))
             r = s.region(k, path)
@@ -132,7 +135,7 @@ class _Collector:
                 self.neg.append(crop)
 
     def _mine(self, image, gt, taboo) -> None:
-        boxes, scores, _ = self.search.windows(image, _truth_path(gt))
+        boxes, scores, _ = self.search.windows(image, truth_path(gt))
         if not len(boxes):
             return
         corners = np.column_stack([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]])
