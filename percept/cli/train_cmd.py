@@ -63,9 +63,9 @@ def train_detector(
                           f"{plan.every} frames{traffic}"}
     model.save(out, **meta)
     write_json(record_path, {**record, **meta, "model": str(out)})
+    others = f" ({record['hard_negatives_traffic']} from {', '.join(plan.negative_scenarios)})" if traffic else ""
     console.print(f"{record['positives']} positives, {record['random_negatives']} random and "
-                  f"{record['hard_negatives']} hard negatives ({record['hard_negatives_traffic']} from "
-                  f"{', '.join(plan.negative_scenarios) or 'no other scenario'}); on its training windows: recall "
+                  f"{record['hard_negatives']} hard negatives{others}; on its training windows: recall "
                   f"{record['train_recall']:.3f}, false positives {record['train_false_positive_rate']:.4f}")
     console.print(f"wrote {out} and {record_path}")
 

@@ -9,8 +9,8 @@ tail light over a wheel) the first model takes for people 30-45 m ahead (Dalal &
 negatives are mined from the images the detector will search). Measured with highway, curves, cut-in and loop: no
 braking for no one left on the 27 runs that had 40, half the false positives on `crossing`, but in rain the far
 field's recall fell from 0.71 to 0.49 and a crossing person was hit (README, Pedestrians); so the shipped model has
-none. Seeds are disjoint from every evaluation seed (0-19
-closed loop, 100-119 detection); the conditions rotate over them so that the model sees day, night and rain.
+none. Seeds are disjoint from every evaluation seed (0-19 closed loop, 100-119 detection); the conditions rotate
+over them so that the model sees day, night and rain.
 """
 
 from __future__ import annotations
