@@ -81,11 +81,12 @@ def _people(gt) -> list:
 class _Collector:
     """Per frame: positive crops and random negative crops (pass 1), or hard negatives of a model (pass 2)."""
 
-    def __init__(self, plan: TrainPlan, rig: StereoRig, model: LinearModel | None, tick: Callable[[], None]):
+    def __init__(self, plan: TrainPlan, rig: StereoRig, model: LinearModel | None, tick: Callable[[], None],
+                 keep_per_frame: int | None = None):
         self.plan, self.rng, self.tick = plan, np.random.default_rng(plan.jitter_seed), tick
         self.search = ConstrainedSearch(rig, model or LinearModel.inria(), plan.search)
         self.mining = model is not None
-        self.keep_per_frame = plan.hard_per_frame
+        self.keep_per_frame = plan.hard_per_frame if keep_per_frame is None else keep_per_frame
         self.pos: list[np.ndarray] = []
         self.neg: list[np.ndarray] = []
 
@@ -156,13 +157,6 @@ def _drive(plan: TrainPlan, collector: _Collector, scenario: str | None = None,
                        duration_s=plan.duration_s)
 
 
-def _mine_traffic(plan: TrainPlan, collector: _Collector) -> int:
-    """The traffic scenarios' hard negatives into the mining collector; how many windows they gave."""
-    before, collector.keep_per_frame = len(collector.neg), plan.traffic_hard_per_frame
-    for scenario in plan.negative_scenarios:
-        _drive(plan, collector, scenario, plan.negative_seeds)
-    collector.keep_per_frame = plan.hard_per_frame
-    return len(collector.neg) - before
 
 
 def frames_to_sample(plan: TrainPlan) -> int:
@@ -195,15 +189,16 @@ def train_people_model(plan: TrainPlan = TrainPlan(),
     model0 = train_linear_svm(pos, neg, plan.c)
     mining = _Collector(plan, rig, model0, tick)
     _drive(plan, mining)
-    traffic = _mine_traffic(plan, mining)
-    pool = features(mining.neg) if mining.neg else neg[:0]
-    hard = hard_negatives(model0, pool, limit=len(pool))
-    # of them, the traffic scenarios' (the last ``traffic`` windows of the pool)
-    hard_traffic = int(np.sum(pool[len(pool) - traffic:] @ model0.weights + model0.bias >= 0.0)) if traffic else 0
+    traffic = _Collector(plan, rig, model0, tick, keep_per_frame=plan.traffic_hard_per_frame)
+    for scenario in plan.negative_scenarios:
+        _drive(plan, traffic, scenario, plan.negative_seeds)
+    own = hard_negatives(model0, features(mining.neg), limit=len(mining.neg)) if mining.neg else neg[:0]
+    others = hard_negatives(model0, features(traffic.neg), limit=len(traffic.neg)) if traffic.neg else neg[:0]
+    hard = np.vstack([own, others])
     model = train_linear_svm(pos, np.vstack([neg, hard]), plan.c)
     record = {"plan": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(plan).items()},
               "positives": int(len(pos)), "random_negatives": int(len(neg)), "hard_negatives": int(len(hard)),
-              "hard_negatives_traffic": hard_traffic,
+              "hard_negatives_traffic": int(len(others)),
               "train_recall": float(np.mean(pos @ model.weights + model.bias >= 0)),
               "train_false_positive_rate": float(np.mean(np.vstack([neg, hard]) @ model.weights + model.bias >= 0))}
     return model, record
