@@ -157,8 +157,6 @@ def _drive(plan: TrainPlan, collector: _Collector, scenario: str | None = None,
                        duration_s=plan.duration_s)
 
 
-
-
 def frames_to_sample(plan: TrainPlan) -> int:
     """How many frames the two passes sample in all (for a progress bar): the plan's scenario twice, then the
     traffic scenarios once."""
