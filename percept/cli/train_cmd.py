@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -27,20 +28,31 @@ def train_detector(
         "whose vehicles' corners the first model takes for people (repeat the option). Default: none.")] = None,
     negative_seeds: Annotated[str, typer.Option("--negative-seeds", help="Seeds of the --negatives-from scenarios "
                                                 "(A-B, N or A,B,C); none may be an evaluation seed.")] = "1000-1004",
+    first_stage: Annotated[str | None, typer.Option(
+        "--first-stage", help="Write a two-stage cascade: this model (sim, inria or a .npz file; of a cascade, its "
+        "first stage) finds the people and the model trained here confirms them. Default: none (one model).")] = None,
+    second_threshold: Annotated[float, typer.Option(
+        "--second-threshold", help="With --first-stage: the second stage's score a detection needs on one of its "
+        "windows, -5 to 5.")] = -0.5,
 ):
     """Render pedestrians and backgrounds, cut 64x128 windows (as the constrained search sees them, 4-pixel cells),
     train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it (on the same frames, and on those of the
     `--negatives-from` scenarios) and train again.
 
     The conditions rotate over the seeds (by default clear, night, rain). The model is selected with `--model FILE` in
-    `percept detect`; the one shipped in the package (`--model sim`) was made by this command's defaults.
+    `percept detect` and `--detector FILE` in `percept drive` and `percept eval`. The one shipped in the package
+    (`sim`) is a cascade: this command's defaults made its first stage, and `--negatives-from highway
+    --negatives-from curves --negatives-from cut-in --negatives-from loop --first-stage sim` its second.
     """
     from percept.drive.batch import parse_seeds
+    from percept.detection import LinearModel
     from percept.drive.train_people import TrainPlan, frames_to_sample, train_people_model
 
     opt.check_number("--every", every, 1, 100)
     opt.check_number("--c", c, 1e-5, 10.0)
+    opt.check_number("--second-threshold", second_threshold, -5.0, 5.0)
     try:
+        first = None if first_stage is None else replace(LinearModel.named(first_stage), second=None)
         conditions = {"conditions": tuple(condition)} if condition else {}
         if negatives_from:
             conditions["negative_scenarios"] = tuple(negatives_from)
@@ -49,7 +61,7 @@ def train_detector(
     except ValueError as e:
         fail(str(e))
     record_path = out.with_suffix(".json")
-    check_outputs([out, record_path])
+    check_outputs([out, record_path], [None if first_stage in (None, "sim", "inria") else Path(first_stage)])
     on_interrupt("nothing: the model is written only when training ends")
     with progress_bar() as bar:
         task = bar.add_task("rendering and training", total=frames_to_sample(plan))
@@ -61,6 +73,10 @@ def train_detector(
                if plan.negative_scenarios else "")
     meta = {"trained_on": f"{plan.scenario} seeds {seeds}, conditions {', '.join(plan.conditions)}, every "
                           f"{plan.every} frames{traffic}"}
+    if first is not None:
+        meta["cascade"] = f"second stage of {first_stage} (its first stage), at a score of {second_threshold:g}"
+        model = replace(first, second=model, second_threshold=second_threshold)
+        record["first_stage_record"] = _first_stage_record(first_stage)
     model.save(out, **meta)
     write_json(record_path, {**record, **meta, "model": str(out)})
     others = f" ({record['hard_negatives_traffic']} from {', '.join(plan.negative_scenarios)})" if traffic else ""
@@ -69,3 +85,18 @@ def train_detector(
                   f"{record['train_recall']:.3f}, false positives {record['train_false_positive_rate']:.4f}")
     console.print(f"wrote {out} and {record_path}")
 
+
+
+def _first_stage_record(name: str) -> dict | None:
+    """The training record of a cascade's first stage: the record beside its model file (of a cascade, that
+    record's own first stage's); None for OpenCV's model or a file without one."""
+    import json
+
+    from percept.detection.hog import SIM_MODEL_PATH
+
+    path = None if name == "inria" else (SIM_MODEL_PATH if name == "sim" else Path(name)).with_suffix(".json")
+    try:
+        record = json.loads(path.read_text()) if path is not None else None
+    except (OSError, ValueError):
+        return None
+    return record.get("first_stage_record", record) if isinstance(record, dict) else None

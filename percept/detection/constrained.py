@@ -15,7 +15,8 @@ neighbouring scales" idea of Dollar et al., "Fast Feature Pyramids for Object De
 
 ``search`` takes the levels (scale indices) to search and regions of interest (windows predicted by a tracker,
 searched at their neighbouring scales only): the vision slot spreads the levels over frames and searches around
-its tracks every frame. ``SearchStats`` counts the windows scored against those of the full pyramid.
+its tracks every frame. A model with a second stage (``LinearModel.second``) keeps only the detections it
+confirms. ``SearchStats`` counts the windows scored against those of the full pyramid.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ import numpy as np
 from percept.sensors import EgoPath, StereoRig
 
 from .hog import CELL_PX, WINDOW_PX, LinearModel, block_grid
-from .pyramid import Detection, group, lone_windows
+from .pyramid import Detection, group, lone_windows, second_stage_kept
 
 PERSON_PX = 96
 """Height of the person inside a 64x128 window [px]."""
@@ -169,35 +170,43 @@ class ConstrainedSearch:
         f = c / CELL_PX / s
         size = (max(int(round((u1 - u0) * f)), 8 * c), max(int(round((v1 - v0) * f)), 16 * c))
         crop = cv2.resize(image[v0:v1, u0:u1], size, interpolation=cv2.INTER_LINEAR)
-        scores = self.model.score_map(block_grid(crop, c))
+        blocks = block_grid(crop, c)
+        scores = self.model.score_map(blocks)
         x, y = np.nonzero(scores >= cfg.threshold)
         sx, sy = (u1 - u0) / size[0], (v1 - v0) / size[1]
         boxes = np.column_stack([u0 + x * c * sx, v0 + y * c * sy, np.full(len(x), 8 * c * sx),
                                  np.full(len(x), 16 * c * sy)])
-        return boxes, scores[x, y], scores.size
+        return boxes, scores[x, y], self.model.second_scores(blocks, x, y), scores.size
 
     def windows(self, image: np.ndarray, path: EgoPath, levels: Iterable[int] | None = None,
                 rois: Sequence[Box] = ()) -> tuple[np.ndarray, np.ndarray, SearchStats]:
         """Every window scoring at least the threshold, before grouping: boxes (N, 4) as (x, y, w, h) [px], scores
         (N,), and the counts."""
+        boxes, scores, _, stats = self._windows(image, path, levels, rois)
+        return boxes, scores, stats
+
+    def _windows(self, image, path, levels, rois) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, SearchStats]:
+        """``windows`` and the windows' second-stage scores (N,) (None when the model has no second stage)."""
         todo = [(k, self.region(k, path)) for k in (range(len(self.scales)) if levels is None else levels)]
         todo = [t for t in todo if t[1] is not None] + self._roi_regions(rois)
-        boxes, scores, windows = [np.zeros((0, 4))], [np.zeros(0, np.float32)], 0
+        boxes, scores, second, windows = [np.zeros((0, 4))], [np.zeros(0, np.float32)], [np.zeros(0, np.float32)], 0
         for k, region in todo:
-            b, sc, n = self._scan(image, k, region)
+            b, sc, s2, n = self._scan(image, k, region)
             boxes.append(b)
             scores.append(sc)
+            second.append(s2)
             windows += n
         stats = SearchStats(windows, self.full_windows, len({k for k, _ in todo}))
-        return np.concatenate(boxes), np.concatenate(scores), stats
+        return (np.concatenate(boxes), np.concatenate(scores),
+                None if self.model.second is None else np.concatenate(second), stats)
 
     def search(self, image: np.ndarray, path: EgoPath, levels: Iterable[int] | None = None,
                rois: Sequence[Box] = ()) -> tuple[list[Detection], SearchStats]:
         """Detections (windows, best first) at ``levels`` (default: every scale) over the corridor, and at the
         neighbouring scales of each region of interest; then the lone windows scoring ``lone_threshold``."""
-        boxes, scores, stats = self.windows(image, path, levels, rois)
+        boxes, scores, second, stats = self._windows(image, path, levels, rois)
         boxes = np.round(boxes).astype(np.int32)
         dets = group(boxes, scores, self.cfg.group_threshold)
         if self.cfg.lone_threshold is not None and self.cfg.group_threshold >= 1:
             dets += [d for d in lone_windows(boxes, scores) if d.score >= self.cfg.lone_threshold]
-        return dets, stats
+        return second_stage_kept(dets, boxes, second, self.model.second_threshold), stats

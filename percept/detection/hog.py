@@ -68,16 +68,25 @@ def block_grid(image: np.ndarray, cell_px: int = CELL_PX) -> np.ndarray:
 @dataclass(frozen=True)
 class LinearModel:
     """A linear window classifier on HOG: weights (3780,) float32 in OpenCV's descriptor order, bias; name: where
-    it came from. ``score_map`` scores every window of a block grid."""
+    it came from. ``score_map`` scores every window of a block grid.
+
+    second: an optional second stage (a two-stage cascade, Viola & Jones, CVPR 2001): a detection made of the first
+    model's windows is kept only if the second model scores one of its windows at least ``second_threshold``
+    (``second_scores``; ``pyramid.second_stage_kept``). Its score stays the first model's."""
 
     weights: np.ndarray
     bias: float
     name: str
+    second: "LinearModel | None" = None
+    second_threshold: float = 0.0
 
     def __post_init__(self) -> None:
         if self.weights.shape != (DESCRIPTOR_LEN,) or not np.all(np.isfinite(self.weights)):
             raise ValueError(f"model {self.name}: expected {DESCRIPTOR_LEN} finite weights, got shape "
                              f"{self.weights.shape}")
+        if self.second is not None and (self.second.second is not None or not np.isfinite(self.second_threshold)):
+            raise ValueError(f"model {self.name}: a second stage must be a single linear model with a finite "
+                             f"threshold")
 
     @classmethod
     def inria(cls) -> "LinearModel":
@@ -103,7 +112,10 @@ class LinearModel:
         try:
             with np.load(path, allow_pickle=False) as z:
                 name = "sim" if path == SIM_MODEL_PATH else str(path)
-                return cls(np.asarray(z["weights"], np.float32), float(z["bias"]), name)
+                second = (cls(np.asarray(z["second_weights"], np.float32), float(z["second_bias"]), f"{name} (second)")
+                          if "second_weights" in z else None)
+                return cls(np.asarray(z["weights"], np.float32), float(z["bias"]), name, second,
+                           float(z["second_threshold"]) if second is not None else 0.0)
         except FileNotFoundError:
             raise ValueError(f"model file {path} does not exist") from None
         except (OSError, KeyError, ValueError, EOFError) as e:
@@ -116,12 +128,18 @@ class LinearModel:
         from percept.outputs import write_bytes_atomic
 
         buf = io.BytesIO()
-        np.savez(buf, weights=self.weights.astype(np.float32), bias=np.float32(self.bias),
+        stages = {} if self.second is None else dict(second_weights=self.second.weights.astype(np.float32),
+                                                     second_bias=np.float32(self.second.bias),
+                                                     second_threshold=np.float32(self.second_threshold))
+        np.savez(buf, weights=self.weights.astype(np.float32), bias=np.float32(self.bias), **stages,
                  **{k: np.asarray(v) for k, v in meta.items()})
         write_bytes_atomic(path, buf.getvalue())
 
     def opencv_detector(self) -> np.ndarray:
-        """The model as OpenCV's ``setSVMDetector`` takes it: weights then bias, (3781,) float32."""
+        """The model as OpenCV's ``setSVMDetector`` takes it: weights then bias, (3781,) float32. ValueError for a
+        cascade (OpenCV's detector is one linear model)."""
+        if self.second is not None:
+            raise ValueError(f"model {self.name} is a cascade; OpenCV's HOG detector takes a single linear model")
         return np.append(self.weights, np.float32(self.bias)).astype(np.float32)
 
     def score_map(self, blocks: np.ndarray) -> np.ndarray:
@@ -134,6 +152,18 @@ class LinearModel:
         sx, sy, sk = blocks.strides
         column_blocks = np.ndarray((ny, nbx, BLOCKS[1] * BLOCK_LEN), np.float32, blocks, 0, (sy, sx, sk))
         return _window_sums(np.matmul(column_blocks, self._weights_by_column), np.float32(self.bias))
+
+    def second_scores(self, blocks: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray | None:
+        """The second stage's scores (N,) float32 of the windows at block positions (``x``, ``y``) (N,) of ``blocks``
+        (nbx, nby, 36); None without a second stage."""
+        if self.second is None:
+            return None
+        # a window's descriptor is its blocks (x + i, y + j), i < 7, j < 15, in OpenCV's order: (N, 7, 15, 36)
+        i, j = np.arange(BLOCKS[0]), np.arange(BLOCKS[1])
+        d = blocks[np.asarray(x)[:, None, None] + i[None, :, None], np.asarray(y)[:, None, None] + j[None, None, :]]
+        # s2 = b2 + w2 . descriptor
+        return (d.reshape(len(x), DESCRIPTOR_LEN) @ self.second.weights + np.float32(self.second.bias)).astype(
+            np.float32)
 
     @cached_property
     def _weights_by_column(self) -> np.ndarray:

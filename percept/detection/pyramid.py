@@ -5,7 +5,8 @@ builds them); at each scale the image's HOG blocks are computed once (``hog.bloc
 8-pixel stride is scored from them (``LinearModel.score_map``). Windows scoring at least the threshold are
 grouped as ``detectMultiScale`` groups them (``cv2.groupRectangles``: rectangles within 20 % of each other's size
 and position form a cluster, clusters of fewer than ``group_threshold + 1`` are dropped, the cluster's mean is
-the detection); a detection's score is the best of the windows it was made from.
+the detection); a detection's score is the best of the windows it was made from. A model with a second stage
+(a cascade) keeps a detection only if the second stage takes one of its windows for a person.
 """
 
 from __future__ import annotations
@@ -49,11 +50,22 @@ def windows_at_scale(image: np.ndarray, model: LinearModel, scale: float,
     h, w = image.shape[:2]
     size = (round(w / scale), round(h / scale))
     small = image if size == (w, h) else cv2.resize(image, size, interpolation=cv2.INTER_LINEAR_EXACT)
-    s = model.score_map(block_grid(small))
+    boxes, scores, _ = _windows_at_scale(image, model, scale, threshold)
+    return boxes, scores
+
+
+def _windows_at_scale(image: np.ndarray, model: LinearModel, scale: float,
+                      threshold: float) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``windows_at_scale`` and the windows' second-stage scores (N,) (None without a second stage)."""
+    h, w = image.shape[:2]
+    size = (round(w / scale), round(h / scale))
+    small = image if size == (w, h) else cv2.resize(image, size, interpolation=cv2.INTER_LINEAR_EXACT)
+    blocks = block_grid(small)
+    s = model.score_map(blocks)
     x, y = np.nonzero(s >= threshold)
     boxes = np.column_stack([np.round(x * CELL_PX * scale), np.round(y * CELL_PX * scale),
                              np.full(len(x), round(WINDOW_PX[0] * scale)), np.full(len(x), round(WINDOW_PX[1] * scale))])
-    return boxes.astype(np.int32), s[x, y]
+    return boxes.astype(np.int32), s[x, y], model.second_scores(blocks, x, y)
 
 
 def group(boxes: np.ndarray, scores: np.ndarray, group_threshold: int = 2, eps: float = 0.2) -> list[Detection]:
@@ -64,14 +76,33 @@ def group(boxes: np.ndarray, scores: np.ndarray, group_threshold: int = 2, eps: 
     grouped, weights = cv2.groupRectangles(boxes.tolist(), group_threshold, eps)
     out = []
     for (gx, gy, gw, gh), n in zip(np.asarray(grouped).reshape(-1, 4), np.asarray(weights).ravel()):
-        # IoU of the group's box with each window
-        ix = np.clip(np.minimum(gx + gw, boxes[:, 0] + boxes[:, 2]) - np.maximum(gx, boxes[:, 0]), 0, None)
-        iy = np.clip(np.minimum(gy + gh, boxes[:, 1] + boxes[:, 3]) - np.maximum(gy, boxes[:, 1]), 0, None)
-        inter = ix * iy
-        iou = inter / (gw * gh + boxes[:, 2] * boxes[:, 3] - inter)
-        best = float(scores[iou >= 0.5].max()) if (iou >= 0.5).any() else float(scores.max())
+        best = _best_of_overlapping((gx, gy, gw, gh), boxes, scores)
         out.append(Detection((float(gx), float(gy), float(gx + gw), float(gy + gh)), best, int(n)))
     return sorted(out, key=lambda d: -d.score)
+
+
+def _best_of_overlapping(box, boxes: np.ndarray, values: np.ndarray) -> float:
+    """The best of ``values`` (N,) over the windows ``boxes`` (N, 4) as (x, y, w, h) that overlap ``box`` (x, y, w, h)
+    by IoU >= 0.5 (over every window when none does)."""
+    gx, gy, gw, gh = box
+    ix = np.clip(np.minimum(gx + gw, boxes[:, 0] + boxes[:, 2]) - np.maximum(gx, boxes[:, 0]), 0, None)
+    iy = np.clip(np.minimum(gy + gh, boxes[:, 1] + boxes[:, 3]) - np.maximum(gy, boxes[:, 1]), 0, None)
+    inter = ix * iy
+    # IoU = |A n B| / (|A| + |B| - |A n B|)
+    iou = inter / (gw * gh + boxes[:, 2] * boxes[:, 3] - inter)
+    return float(values[iou >= 0.5].max()) if (iou >= 0.5).any() else float(values.max())
+
+
+def second_stage_kept(dets: list[Detection], boxes: np.ndarray, second: np.ndarray | None,
+                      threshold: float) -> list[Detection]:
+    """The detections that a cascade's second stage keeps: those with a window (of ``boxes`` (N, 4) as (x, y, w, h),
+    IoU >= 0.5 with the detection, as its score is found) whose second-stage score ``second`` (N,) is at least
+    ``threshold``. A vehicle's corner makes a cluster of windows that all look alike to the second stage; a person
+    needs one window that it takes for a person (a per-window veto thins the person's cluster and loses it)."""
+    if second is None:
+        return dets
+    return [d for d in dets if _best_of_overlapping((d.box_px[0], d.box_px[1], d.box_px[2] - d.box_px[0],
+                                                     d.box_px[3] - d.box_px[1]), boxes, second) >= threshold]
 
 
 def lone_windows(boxes: np.ndarray, scores: np.ndarray, eps: float = 0.2) -> list[Detection]:
@@ -95,7 +126,8 @@ def detect_multiscale(image: np.ndarray, model: LinearModel, step: float = 1.05,
     h, w = image.shape[:2]
     if w < WINDOW_PX[0] or h < WINDOW_PX[1]:
         raise ValueError(f"image of {w}x{h} px is smaller than the {WINDOW_PX[0]}x{WINDOW_PX[1]} detection window")
-    found = [windows_at_scale(image, model, s, threshold) for s in pyramid_scales(w, h, step)]
+    found = [_windows_at_scale(image, model, s, threshold) for s in pyramid_scales(w, h, step)]
     boxes = np.concatenate([f[0] for f in found])
     scores = np.concatenate([f[1] for f in found])
-    return group(boxes, scores, group_threshold)
+    second = None if model.second is None else np.concatenate([f[2] for f in found])
+    return second_stage_kept(group(boxes, scores, group_threshold), boxes, second, model.second_threshold)

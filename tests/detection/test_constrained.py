@@ -2,6 +2,8 @@
 can be, finds a person 30 m ahead (33 px tall, below what a full pyramid from scale 1 can see) and skips most of the
 full pyramid's windows over the same scales."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -40,3 +42,17 @@ def test_no_scale_admits_a_person_outside_the_searched_depths():
     # a 2.1 m person at 5 m would be 233 px tall: no window that large is ever scored
     big = [s for k, s in enumerate(search.scales) if search.region(k, path) is not None and s * PERSON_PX > 150]
     assert not big and np.all(np.diff(search.scales) > 0)
+
+
+def test_a_cascade_keeps_what_its_second_stage_confirms(crossing_frame):
+    """The search with a second stage that confirms every window finds what the first model alone finds; one that
+    confirms none finds nothing (the second stage is applied to the search's detections, windows and lone ones)."""
+    rig, frame, _ = crossing_frame
+    path = EgoPath.straight(frame.wheel_speed_mps)
+    first = LinearModel.inria()
+    alone, _ = ConstrainedSearch(rig, first).search(frame.left, path)
+    assert alone
+    for threshold, expected in ((-1e6, alone), (1e6, [])):
+        cascade = replace(first, second=first, second_threshold=threshold)
+        dets, _ = ConstrainedSearch(rig, cascade).search(frame.left, path)
+        assert dets == expected

@@ -1,6 +1,9 @@
 """HOG blocks computed once per image and scored for every window equal OpenCV's per-window descriptors; the
-pyramid search finds what OpenCV's detectMultiScale finds (real video); models load, save and fail clearly."""
+pyramid search finds what OpenCV's detectMultiScale finds (real video); models load, save and fail clearly; a
+cascade's second stage scores windows as its own model does and keeps the detections one of whose windows it
+passes."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -8,7 +11,7 @@ import numpy as np
 import pytest
 
 from percept.detection import DESCRIPTOR_LEN, LinearModel, block_grid, detect_multiscale, hog_descriptor
-from percept.detection.pyramid import group, lone_windows, pyramid_scales
+from percept.detection.pyramid import group, lone_windows, pyramid_scales, second_stage_kept
 from percept.sensors import iou
 
 VTEST = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "opencv-samples" / "pedestrians" / "vtest.avi"
@@ -112,3 +115,42 @@ def test_lone_windows_are_those_opencv_never_groups_with_another():
     assert 0 < len(lone) < 40
     grouped = group(boxes, np.ones(40, np.float32), 1)
     assert all(d.windows >= 2 for d in grouped)
+
+
+def test_the_second_stage_scores_each_window_as_its_own_model_would():
+    """A cascade's second-stage score of a window equals the second model's ``score_map`` there."""
+    blocks = block_grid(textured(seed=5), 4)
+    first, second = LinearModel.inria(), LinearModel(np.linspace(-1, 1, DESCRIPTOR_LEN).astype(np.float32), 0.3, "b")
+    cascade = replace(first, second=second, second_threshold=-0.5)
+    assert first.second_scores(blocks, np.array([0]), np.array([0])) is None
+    full = second.score_map(blocks)
+    x, y = np.nonzero(np.ones_like(full, bool))
+    got = cascade.second_scores(blocks, x, y)
+    assert got.dtype == np.float32 and np.abs(got - full[x, y]).max() <= 1e-5 * max(1.0, np.abs(full).max())
+
+
+def test_a_cascade_saves_and_loads_and_a_bad_second_stage_is_refused(tmp_path):
+    a = LinearModel(np.linspace(-1, 1, DESCRIPTOR_LEN).astype(np.float32), -0.5, "a")
+    b = LinearModel(np.linspace(1, -1, DESCRIPTOR_LEN).astype(np.float32), 0.25, "b")
+    replace(a, second=b, second_threshold=-0.75).save(tmp_path / "c.npz")
+    back = LinearModel.load(tmp_path / "c.npz")
+    assert np.array_equal(back.weights, a.weights) and back.bias == -0.5
+    assert np.array_equal(back.second.weights, b.weights) and back.second.bias == 0.25
+    assert back.second_threshold == -0.75 and back.second.second is None
+    assert LinearModel.load(tmp_path / "c.npz").second is not None and LinearModel.inria().second is None
+    with pytest.raises(ValueError, match="a second stage must be a single linear model"):
+        replace(a, second=replace(a, second=b))
+    with pytest.raises(ValueError, match="with a finite threshold"):
+        replace(a, second=b, second_threshold=float("nan"))
+
+
+def test_the_second_stage_keeps_a_detection_when_one_of_its_windows_passes():
+    """A detection is kept when a window overlapping it (IoU >= 0.5) passes the second stage, whichever; a cluster
+    whose windows all fail it is dropped; without a second stage every detection stays."""
+    boxes = np.array([[10, 10, 64, 128], [14, 12, 64, 128], [200, 10, 64, 128], [204, 14, 64, 128]], np.int32)
+    dets = group(boxes, np.array([1.0, 0.5, 0.8, 0.9], np.float32), 1)
+    assert len(dets) == 2
+    kept = second_stage_kept(dets, boxes, np.array([-2.0, -0.1, -0.9, -0.6], np.float32), -0.5)
+    assert [d.box_px[0] < 100 for d in kept] == [True]
+    assert second_stage_kept(dets, boxes, None, -0.5) == dets
+    assert second_stage_kept(dets, boxes, np.full(4, -0.5, np.float32), -0.5) == dets

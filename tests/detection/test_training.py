@@ -41,15 +41,20 @@ def test_crops_are_the_search_window_and_mirroring_is_a_flip():
 def test_train_detector_writes_a_model_that_detect_loads(tmp_path):
     out = tmp_path / "m.npz"
     r = runner.invoke(app, ["train-detector", "--seeds", "1000", "--duration", "10", "--every", "5",
-                            "--negatives-from", "highway", "--negative-seeds", "1001", "--out", str(out)])
+                            "--negatives-from", "highway", "--negative-seeds", "1001", "--first-stage", "inria",
+                            "--second-threshold", "-0.25", "--out", str(out)])
     assert r.exit_code == 0, r.output
     rec = json.loads(out.with_suffix(".json").read_text())
     assert rec["positives"] > 20 and rec["random_negatives"] > 100 and rec["hard_negatives"] > 0
     assert 0 <= rec["hard_negatives_traffic"] <= rec["hard_negatives"]
     assert rec["plan"]["seeds"] == [1000] and "crossing seeds 1000" in rec["trained_on"]
     assert rec["plan"]["negative_scenarios"] == ["highway"] and "highway seeds 1001" in rec["trained_on"]
+    assert rec["cascade"] == "second stage of inria (its first stage), at a score of -0.25"
+    assert rec["first_stage_record"] is None  # OpenCV's model has no training record here
     model = LinearModel.load(out)
-    assert model.weights.shape == (DESCRIPTOR_LEN,)
+    # a cascade: OpenCV's INRIA model finds, the model trained here confirms
+    assert np.array_equal(model.weights, LinearModel.inria().weights) and model.second_threshold == -0.25
+    assert model.second.weights.shape == (DESCRIPTOR_LEN,) and model.second.second is None
     img = np.full((240, 320, 3), 90, np.uint8)
     cv2.imwrite(str(tmp_path / "grey.png"), img)
     r = runner.invoke(app, ["detect", str(tmp_path / "grey.png"), "--model", str(out), "--json",
@@ -67,6 +72,8 @@ def test_train_detector_writes_a_model_that_detect_loads(tmp_path):
     (["--negative-seeds", "1000,7"], "are evaluation seeds"),
     (["--negative-seeds", "a-b"], "--negative-seeds must look like"),
     (["--negatives-from", "autobahn"], "unknown scenario 'autobahn'"),
+    (["--first-stage", "missing.npz"], "model file missing.npz does not exist"),
+    (["--second-threshold", "9"], "--second-threshold"),
 ])
 def test_train_detector_bad_input_is_one_line_and_exit_2(args, message, tmp_path):
     r = runner.invoke(app, ["train-detector", *args, "--out", str(tmp_path / "m.npz")])
@@ -80,3 +87,15 @@ def test_the_shipped_sim_model_loads_with_its_training_record():
     assert m.name == "sim" and m.weights.shape == (DESCRIPTOR_LEN,)
     rec = json.loads(SIM_MODEL_PATH.with_suffix(".json").read_text())
     assert rec["positives"] > 1000 and not set(rec["plan"]["seeds"]) & (set(range(20)) | set(range(100, 120)))
+
+
+def test_a_cascades_record_keeps_its_first_stages_record(tmp_path):
+    """A cascade's first stage is its own first stage's record (of a cascade, that record's first stage)."""
+    from percept.cli.train_cmd import _first_stage_record
+
+    (tmp_path / "one.json").write_text(json.dumps({"positives": 5}))
+    (tmp_path / "two.json").write_text(json.dumps({"positives": 7, "first_stage_record": {"positives": 5}}))
+    assert _first_stage_record(str(tmp_path / "one.npz")) == {"positives": 5}
+    assert _first_stage_record(str(tmp_path / "two.npz")) == {"positives": 5}
+    assert _first_stage_record(str(tmp_path / "none.npz")) is None and _first_stage_record("inria") is None
+    assert _first_stage_record("sim")["positives"] > 1000
