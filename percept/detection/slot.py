@@ -2,9 +2,10 @@
 stereo pair, tracking on the ground plane, and a braking request for the nearest person in the ego path or
 walking into it.
 
-Each frame the search covers 1 / ``sweep_frames`` of the pyramid's levels over the corridor (every level once in
-``sweep_frames`` frames: a person appears first in the far field, where people change scale slowly) and, every
-frame, the two levels around each tracked person's predicted window. A lone window (one that grouping would
+Each frame the search covers a share of the pyramid's levels over the corridor (every level once in ``sweep_frames``
+frames, those of the far field, people up to ``far_person_px`` tall, once in ``far_sweep_frames``: a person appears
+first in the far field, where people change scale slowly) and, every frame, the two levels around each tracked
+person's predicted window. A lone window (one that grouping would
 drop: often all the far field gives in rain) counts only where the stereo pair agrees that something stands where
 its feet touch the road. Only confirmed tracks act, and only once the stereo pair has seen them stand where their
 feet touch the road (``STEREO_HITS``), and not while their detections show them moving over the ground like a
@@ -29,7 +30,7 @@ from percept.sensors import BrakingRequest, EgoMotionGate, EgoPath, Frame, Objec
 from percept.sensors.conflict import PERSON_STOP_MARGIN_M, person_conflict
 from percept.sensors.vehicle import bumper_gap_m
 
-from .constrained import FEET_MARGIN_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
+from .constrained import FEET_MARGIN_PX, PERSON_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
 from .hog import WINDOW_PX, LinearModel
 from .pyramid import Detection
 from .stereo_range import box_depth
@@ -95,12 +96,17 @@ class PedestrianSlot:
     """``step(frame, upstream)`` -> (BrakingRequest or None, PedestrianDebug); upstream["lateral"]: the ego path."""
 
     def __init__(self, rig: StereoRig, dt_s: float, model: LinearModel | None = None,
-                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 6):
-        if sweep_frames < 1:
-            raise ValueError(f"sweep_frames must be at least 1, got {sweep_frames}")
+                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 6,
+                 far_sweep_frames: int = 6, far_person_px: float = 50.0):
+        if sweep_frames < 1 or far_sweep_frames < 1:
+            raise ValueError(f"sweep_frames and far_sweep_frames must be at least 1, got {sweep_frames} and "
+                             f"{far_sweep_frames}")
         self.search = ConstrainedSearch(rig, model if model is not None else LinearModel.inria(), search)
         self.tracker = PersonTracker(rig, dt_s, tracking)
-        self.sweep_frames = sweep_frames
+        # frames between two searches of each level: the far field's levels (people up to far_person_px tall)
+        # every far_sweep_frames, the others every sweep_frames
+        self.periods = tuple(far_sweep_frames if PERSON_PX * s <= far_person_px else sweep_frames
+                             for s in self.search.scales)
         self.cam_x = float(rig.camera_position()[0])
         self.motion = EgoMotionGate()
         self.vehicle_min_mps = tracking.vehicle_min_mps
@@ -120,8 +126,7 @@ class PedestrianSlot:
             tracks = self.tracker.update([], [], seen=False)
             dets, levels, stats = [], (), None
         else:
-            n = len(self.search.scales)
-            levels = tuple(k for k in range(n) if k % self.sweep_frames == frame.index % self.sweep_frames)
+            levels = tuple(k for k, p in enumerate(self.periods) if k % p == frame.index % p)
             dets, stats = self.search.search(frame.left, path, levels, rois=[window_of(b) for b in predicted])
             boxes = [person_box(d.box_px) for d in dets]
             # a lone window is a person only where the stereo pair agrees with its ground contact

@@ -57,6 +57,21 @@ def test_dropped_and_black_frames_and_nan_wheel_speed_or_yaw_rate_degrade_gracef
     assert request is None and slot.motion.last.yaw_rate_rps == 0.1  # and the last good yaw rate
     with pytest.raises(ValueError, match="sweep_frames"):
         PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=0)
+    with pytest.raises(ValueError, match="far_sweep_frames must be at least 1"):
+        PedestrianSlot(StereoRig(), 1 / 15, far_sweep_frames=0)
+
+
+def test_the_far_fields_levels_are_searched_more_often_than_the_near_ones():
+    """Every level once in its period: the far field's (people up to far_person_px tall) in far_sweep_frames frames,
+    the others in sweep_frames."""
+    slot = PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=6, far_sweep_frames=3, far_person_px=50.0)
+    black = np.zeros((480, 640, 3), np.uint8)
+    seen = [slot.step(frame(i, black), {"lateral": EgoPath.straight(10.0)})[1].levels for i in range(12)]
+    heights = 96 * slot.search.scales
+    for k, h in enumerate(heights):
+        frames = [i for i, levels in enumerate(seen) if k in levels]
+        assert frames == list(range(k % (3 if h <= 50 else 6), 12, 3 if h <= 50 else 6))
+    assert 0 < sum(heights <= 50) < len(heights)
 
 
 def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
