@@ -137,8 +137,31 @@ class _HelpWithoutType:
         return option
 
 
+def reflow(text: str | None) -> str | None:
+    """A docstring as help text: the line breaks inside each paragraph joined (typer's rich help keeps them, so a
+    paragraph wrapped at 120 columns in the source printed with ragged lines); paragraphs and lines that begin a list
+    item ("- ", "* ", "1. ") stay."""
+    if not text:
+        return text
+    out = []
+    for para in text.split("\n\n"):
+        lines = [line.strip() for line in para.strip().splitlines()]
+        joined = []
+        for line in lines:
+            if joined and not re.match(r"([-*]|\d+\.) ", line):
+                joined[-1] += " " + line
+            else:
+                joined.append(line)
+        out.append("\n".join(joined))
+    return "\n\n".join(out)
+
+
 class Command(_HelpWithoutType, TyperCommand):
-    """The class of every percept command (``app.command(NAME, cls=Command)``)."""
+    """The class of every percept command (``app.command(NAME, cls=Command)``); its help reflowed (``reflow``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.help = reflow(self.help)
 
 
 class Group(_HelpWithoutType, TyperGroup):

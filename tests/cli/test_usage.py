@@ -54,3 +54,17 @@ def test_flags_show_no_value_type_in_help(command, flags):
         assert "<bool>" not in lines[flag], lines[flag]
     if command in ("calibrate", "view", "lanes", "detect"):  # registered with percept's Command class
         assert "<bool>" not in lines["--help"], lines["--help"]
+
+
+def test_help_paragraphs_are_reflowed_and_lists_kept():
+    """A docstring's line breaks inside a paragraph are joined (typer's rich help kept them as ragged lines);
+    paragraphs and list items stay."""
+    from percept.cli.common import reflow
+
+    assert reflow("One line\n    wrapped here.\n\n    Next\n    para:\n    - item one\n      goes on\n    - two") == (
+        "One line wrapped here.\n\nNext para:\n- item one goes on\n- two")
+    assert reflow(None) is None and reflow("") == ""
+    r = runner.invoke(app, ["eval", "--help"], env={"COLUMNS": "240"})
+    assert r.exit_code == 0
+    assert ("summary.csv (every metric per scenario and condition: runs, mean, p95, worst), summary.md (safety "
+            "counts, headline metrics, runs to look at with the command that reproduces each)") in r.output
