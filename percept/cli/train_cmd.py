@@ -44,8 +44,8 @@ def train_detector(
     (`sim`) was made by this command's defaults. With `--first-stage MODEL` the model trained here becomes the second
     stage of a cascade: MODEL finds the people, this one confirms them.
     """
-    from percept.drive.batch import parse_seeds
     from percept.detection import LinearModel
+    from percept.drive.batch import parse_seeds
     from percept.drive.train_people import TrainPlan, frames_to_sample, train_people_model
 
     opt.check_number("--every", every, 1, 100)
@@ -84,7 +84,6 @@ def train_detector(
                   f"{record['hard_negatives']} hard negatives{others}; on its training windows: recall "
                   f"{record['train_recall']:.3f}, false positives {record['train_false_positive_rate']:.4f}")
     console.print(f"wrote {out} and {record_path}")
-
 
 
 def _first_stage_record(name: str) -> dict | None:

@@ -47,9 +47,6 @@ def windows_at_scale(image: np.ndarray, model: LinearModel, scale: float,
                      threshold: float) -> tuple[np.ndarray, np.ndarray]:
     """Windows of ``image`` shrunk by ``scale`` that score >= ``threshold``: boxes (N, 4) as (x, y, w, h) in the
     original image [px] and their scores (N,)."""
-    h, w = image.shape[:2]
-    size = (round(w / scale), round(h / scale))
-    small = image if size == (w, h) else cv2.resize(image, size, interpolation=cv2.INTER_LINEAR_EXACT)
     boxes, scores, _ = _windows_at_scale(image, model, scale, threshold)
     return boxes, scores
 
