@@ -40,9 +40,11 @@ def train_detector(
     `--negatives-from` scenarios) and train again.
 
     The conditions rotate over the seeds (by default clear, night, rain). The model is selected with `--model FILE` in
-    `percept detect` and `--detector FILE` in `percept drive` and `percept eval`; the one shipped in the package
-    (`sim`) was made by this command's defaults. With `--first-stage MODEL` the model trained here becomes the second
-    stage of a cascade: MODEL finds the people, this one confirms them.
+    `percept detect` and `--detector FILE` in `percept drive` and `percept eval`. With `--first-stage MODEL` the model
+    trained here becomes the second stage of a cascade: MODEL finds the people, this one confirms them. The one
+    shipped in the package (`sim`) is such a cascade: this command's defaults made its first stage, and
+    `--negatives-from highway --negatives-from curves --negatives-from cut-in --negatives-from loop --first-stage sim`
+    its second (at the default --second-threshold).
     """
     from percept.detection import LinearModel
     from percept.drive.batch import parse_seeds

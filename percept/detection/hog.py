@@ -97,7 +97,9 @@ class LinearModel:
     @classmethod
     def sim(cls) -> "LinearModel":
         """percept's own model, trained on rendered people by ``percept train-detector`` (shipped in the package,
-        its training record beside it in ``people_sim.json``)."""
+        its training record beside it in ``people_sim.json``): a cascade whose first stage was made by the command's
+        defaults and whose second stage, trained with hard negatives from the traffic scenarios too, confirms a
+        detection when it scores one of its windows at least -0.5."""
         return cls.load(SIM_MODEL_PATH)
 
     @classmethod

@@ -97,7 +97,7 @@ class PedestrianSlot:
 
     def __init__(self, rig: StereoRig, dt_s: float, model: LinearModel | None = None,
                  search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 6,
-                 far_sweep_frames: int = 6, far_person_px: float = 50.0):
+                 far_sweep_frames: int = 3, far_person_px: float = 50.0):
         if sweep_frames < 1 or far_sweep_frames < 1:
             raise ValueError(f"sweep_frames and far_sweep_frames must be at least 1, got {sweep_frames} and "
                              f"{far_sweep_frames}")

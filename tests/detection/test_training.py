@@ -87,6 +87,9 @@ def test_the_shipped_sim_model_loads_with_its_training_record():
     assert m.name == "sim" and m.weights.shape == (DESCRIPTOR_LEN,)
     rec = json.loads(SIM_MODEL_PATH.with_suffix(".json").read_text())
     assert rec["positives"] > 1000 and not set(rec["plan"]["seeds"]) & (set(range(20)) | set(range(100, 120)))
+    # a cascade: its second stage trained with the traffic scenarios' negatives, its first stage's record kept
+    assert m.second is not None and m.second_threshold == -0.5 and rec["hard_negatives_traffic"] > 0
+    assert rec["first_stage_record"]["positives"] > 1000 and not rec["first_stage_record"]["plan"].get("negative_scenarios")
 
 
 def test_a_cascades_record_keeps_its_first_stages_record(tmp_path):
