@@ -58,7 +58,7 @@ def register(app: typer.Typer) -> None:
         if out is not None and out.exists() and not out.is_dir():
             fail(f"--out {out} is a file; give a folder for the overlays")
         check_outputs([json_path, *([] if out is None else [overlay_path(out, p, "detect", video) for p in files])],
-                      [*files, None if model in ("inria", "sim") else Path(model)])
+                      [*files, LinearModel.file_of(model)])
         header = {"source": str(source), "kind": kind.value, "model": linear.name, "scale_step": scale_step,
                   "threshold": threshold}
         params = dict(model=linear, step=scale_step, threshold=threshold)

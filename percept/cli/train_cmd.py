@@ -63,7 +63,7 @@ def train_detector(
     except ValueError as e:
         fail(str(e))
     record_path = out.with_suffix(".json")
-    check_outputs([out, record_path], [None if first_stage in (None, "sim", "inria") else Path(first_stage)])
+    check_outputs([out, record_path], [None if first_stage is None else LinearModel.file_of(first_stage)])
     on_interrupt("nothing: the model is written only when training ends")
     with progress_bar() as bar:
         task = bar.add_task("rendering and training", total=frames_to_sample(plan))
@@ -93,9 +93,10 @@ def _first_stage_record(name: str) -> dict | None:
     record's own first stage's); None for OpenCV's model or a file without one."""
     import json
 
-    from percept.detection.hog import SIM_MODEL_PATH
+    from percept.detection import LinearModel
 
-    path = None if name == "inria" else (SIM_MODEL_PATH if name == "sim" else Path(name)).with_suffix(".json")
+    model = LinearModel.file_of(name)
+    path = None if model is None else model.with_suffix(".json")
     try:
         record = json.loads(path.read_text()) if path is not None else None
     except (OSError, ValueError):

@@ -189,16 +189,17 @@ class ConstrainedSearch:
         """``windows`` and the windows' second-stage scores (N,) (None when the model has no second stage)."""
         todo = [(k, self.region(k, path)) for k in (range(len(self.scales)) if levels is None else levels)]
         todo = [t for t in todo if t[1] is not None] + self._roi_regions(rois)
-        boxes, scores, second, windows = [np.zeros((0, 4))], [np.zeros(0, np.float32)], [np.zeros(0, np.float32)], 0
+        boxes, scores, windows = [np.zeros((0, 4))], [np.zeros(0, np.float32)], 0
+        second = None if self.model.second is None else [np.zeros(0, np.float32)]
         for k, region in todo:
             b, sc, s2, n = self._scan(image, k, region)
             boxes.append(b)
             scores.append(sc)
-            second.append(s2)
+            if second is not None:
+                second.append(s2)
             windows += n
         stats = SearchStats(windows, self.full_windows, len({k for k, _ in todo}))
-        return (np.concatenate(boxes), np.concatenate(scores),
-                None if self.model.second is None else np.concatenate(second), stats)
+        return np.concatenate(boxes), np.concatenate(scores), None if second is None else np.concatenate(second), stats
 
     def search(self, image: np.ndarray, path: EgoPath, levels: Iterable[int] | None = None,
                rois: Sequence[Box] = ()) -> tuple[list[Detection], SearchStats]:

@@ -102,10 +102,17 @@ class LinearModel:
         detection when it scores one of its windows at least -0.5."""
         return cls.load(SIM_MODEL_PATH)
 
+    @staticmethod
+    def file_of(name: str) -> Path | None:
+        """The file a model name stands for: None for 'inria' (built into OpenCV), the packaged file for 'sim', else
+        the path ``name``."""
+        return None if name == "inria" else SIM_MODEL_PATH if name == "sim" else Path(name)
+
     @classmethod
     def named(cls, name: str) -> "LinearModel":
         """'inria', 'sim' or the path of a model file; ValueError when the file is missing or corrupt."""
-        return cls.inria() if name == "inria" else cls.sim() if name == "sim" else cls.load(Path(name))
+        path = cls.file_of(name)
+        return cls.inria() if path is None else cls.load(path)
 
     @classmethod
     def load(cls, path: Path) -> "LinearModel":

@@ -102,3 +102,14 @@ def test_a_cascades_record_keeps_its_first_stages_record(tmp_path):
     assert _first_stage_record(str(tmp_path / "two.npz")) == {"positives": 5}
     assert _first_stage_record(str(tmp_path / "none.npz")) is None and _first_stage_record("inria") is None
     assert _first_stage_record("sim")["positives"] > 1000
+
+
+def test_train_detector_will_not_overwrite_its_first_stage(tmp_path):
+    """`--out` on the first stage's own file (the packaged one for `sim`) is refused before any work."""
+    from percept.detection.hog import SIM_MODEL_PATH
+
+    assert LinearModel.file_of("sim") == SIM_MODEL_PATH and LinearModel.file_of("inria") is None
+    before = SIM_MODEL_PATH.read_bytes()
+    r = runner.invoke(app, ["train-detector", "--first-stage", "sim", "--out", str(SIM_MODEL_PATH)])
+    assert r.exit_code != 0 and "also an input" in r.output, r.output
+    assert SIM_MODEL_PATH.read_bytes() == before
