@@ -4,8 +4,9 @@ alternated on every frame).
 
     python tools/detect_vs_opencv.py VIDEO [--every 5] [--model inria]
 
-Both use the same people detector (the INRIA one unless ``--model`` names another) and scale step (1.05);
-``detectMultiScale`` runs with its defaults, as ``tests/detection/test_hog.py`` calls it.
+Both use the same people detector (the INRIA one unless ``--model`` names another; of a cascade such as ``sim``,
+its first stage, since ``detectMultiScale`` takes one linear model) and scale step (1.05); ``detectMultiScale``
+runs with its defaults, as ``tests/detection/test_hog.py`` calls it.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -43,7 +45,11 @@ def main() -> None:
     ap.add_argument("--model", default="inria", help="inria, sim or a model file (default inria)")
     args = ap.parse_args()
     cv2.setNumThreads(1)
-    model = LinearModel.named(args.model)
+    try:
+        # detectMultiScale takes one linear model: a cascade's first stage on both sides
+        model = replace(LinearModel.named(args.model), second=None)
+    except ValueError as e:
+        sys.exit(str(e))
     hog = cv2.HOGDescriptor()
     hog.setSVMDetector(model.opencv_detector())
     ours_ms, theirs_ms = [], []

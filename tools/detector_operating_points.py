@@ -2,7 +2,8 @@
 constrained search's scales, the truth's ego path), the best window score on each true person 24-40 px tall and at
 least half visible (a window at IoU >= 0.5 with the person's window), and the scores of the windows touching no
 person. Printed per model and threshold: the share of far people found and the windows kept off people, so that two
-models are compared at the same false positives, not only at the threshold each was trained for.
+models are compared at the same false positives, not only at the threshold each was trained for. A cascade (such as
+``sim``) is scored by its first stage's windows.
 usage: detector_operating_points.py CONDITION SEEDS(a,b,c) MODEL [MODEL ...]   (MODEL: sim, inria or a .npz file)
 """
 import sys
@@ -19,8 +20,8 @@ cv2.setNumThreads(1)
 THRESHOLDS = (-0.4, -0.2, 0.0, 0.25)
 
 cond, seeds, models = sys.argv[1], [int(s) for s in sys.argv[2].split(",")], sys.argv[3:]
-searches = {m: ConstrainedSearch(StereoRig(), LinearModel.named(m) if m in ("sim", "inria") else LinearModel.load(m),
-                                 SearchConfig(threshold=min(THRESHOLDS))) for m in models}
+searches = {m: ConstrainedSearch(StereoRig(), LinearModel.named(m), SearchConfig(threshold=min(THRESHOLDS)))
+            for m in models}
 best = {m: [] for m in models}
 off = {m: [] for m in models}
 
