@@ -63,12 +63,19 @@ def bench(
 def _stage_table(results) -> Table:
     t = Table(title="percept bench (one thread, ms per call: slots the median of 3 passes' means over consecutive "
                     "frames, the rest the median)")
-    for col in ("stage", "what", "ms", "target ms", "peer", "peer ms", "ratio (ours / peer)"):
-        t.add_column(col, justify="left" if col in ("stage", "what", "peer") else "right")
+    for col in ("stage", "what", "ms", "peer", "peer ms", "ratio (ours / peer)", "target", "met"):
+        t.add_column(col, justify="left" if col in ("stage", "what", "peer", "target") else "right")
     for r in results:
-        t.add_row(r.stage, r.what, f"{r.ms:.2f}", fmt(r.target_ms), r.peer or "-", fmt(r.peer_ms),
-                  ratio_text(r.ratio))
+        t.add_row(r.stage, r.what, f"{r.ms:.2f}", r.peer or "-", fmt(r.peer_ms), ratio_text(r.ratio),
+                  target_text(r), "-" if r.met is None else ("yes" if r.met else "NO"))
     return t
+
+
+def target_text(r) -> str:
+    """A stage's targets as a person reads them: '<= 3.00 ms, >= 15x faster', or '-'."""
+    parts = ([] if r.target_ms is None else [f"<= {r.target_ms:.2f} ms"]) + (
+        [] if r.target_speedup is None else [f">= {r.target_speedup:g}x faster"])
+    return ", ".join(parts) or "-"
 
 
 def ratio_text(ratio: float | None) -> str:

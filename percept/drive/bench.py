@@ -22,7 +22,9 @@ from .tasks import SlotContext, Task
 class StageCost:
     """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (a slot's mean per frame,
     else the median; see ``bench_task``); peer: the peer's name and peer_ms its cost in the same run (None where
-    no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any."""
+    no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any; target_speedup: how many
+    times faster than its peer the stage must be (peer_ms / ms), if any; met: whether it keeps both (None without a
+    target)."""
 
     stage: str
     what: str
@@ -30,16 +32,28 @@ class StageCost:
     peer: str | None = None
     peer_ms: float | None = None
     target_ms: float | None = None
+    target_speedup: float | None = None
 
     @property
     def ratio(self) -> float | None:
         return self.ms / self.peer_ms if self.peer_ms else None
 
+    @property
+    def met(self) -> bool | None:
+        checks = []
+        if self.target_ms is not None:
+            checks.append(self.ms <= self.target_ms)
+        if self.target_speedup is not None and self.peer_ms:
+            # speed-up = peer_ms / ms
+            checks.append(self.peer_ms >= self.target_speedup * self.ms)
+        return all(checks) if checks else None
+
     def to_dict(self) -> dict:
         r = self.ratio
         return {"stage": self.stage, "what": self.what, "ms": round(self.ms, 3), "peer": self.peer,
                 "peer_ms": None if self.peer_ms is None else round(self.peer_ms, 3),
-                "ratio": None if r is None else round(r, 3), "target_ms": self.target_ms}
+                "ratio": None if r is None else round(r, 3), "target_ms": self.target_ms,
+                "target_speedup": self.target_speedup, "met": self.met}
 
 
 def median_ms(fn: Callable[[], object], repeats: int, warmup: int = 2) -> float:
@@ -160,7 +174,7 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
         peer, run = task.bench_peer([f for f, _ in shots])
         peer_ms = median_ms(lambda: run(shot()[0]), frames)
     return StageCost(task.timing_key, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms, peer,
-                     peer_ms, task.budget_ms)
+                     peer_ms, task.budget_ms, task.bench_speedup if peer is not None else None)
 
 
 def sgbm_full_frame(frames: list) -> tuple[str, Callable]:

@@ -55,7 +55,8 @@ class Task:
     scorer: ScoreContext -> scorer; recorder: "module:function" of its part in ``percept.review`` (None = none);
     upstream: tasks whose estimates it reads; headline: metrics the tables show; help: one line for --help;
     bench_scenario: where ``percept bench`` times its vision slot; budget_ms: its per-frame budget [ms];
-    bench_peer: frames -> (name, run(frame)), the stock way to do the same job, timed in the same run."""
+    bench_peer: frames -> (name, run(frame)), the stock way to do the same job, timed in the same run;
+    bench_speedup: how many times faster than that peer the slot must be."""
 
     name: str
     group: str
@@ -70,6 +71,7 @@ class Task:
     bench_scenario: str = "highway"
     budget_ms: float | None = None
     bench_peer: Callable | None = None
+    bench_speedup: float | None = None
 
 
 def _longitudinal_slot(ctx: SlotContext) -> Slot:
@@ -123,14 +125,15 @@ TASKS: tuple[Task, ...] = (
                    Headline("time gap mean [s]", "time_gap_mean_s", "{:.2f}"),
                    Headline("time gap min [s]", "time_gap_min_s", "{:.2f}"),
                    Headline("phantom brakes", "phantom_brakes", "{}")),
-         help="the lead ahead (following, emergency braking)", budget_ms=3.0, bench_peer=_sgbm_peer),
+         help="the lead ahead (following, emergency braking)", budget_ms=3.0, bench_peer=_sgbm_peer,
+         bench_speedup=15.0),
     Task("pedestrians", "pedestrians", "pedestrians", priv.PrivilegedPedestrians,
          PedestrianScorer, vision=_pedestrian_slot, recorder="percept.review.parts:pedestrians", upstream=("lateral",),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}"),
                    Headline("verge brakes", "verge_brakes", "{}"),
                    Headline("brakes for no one", "brakes_for_no_one", "{}")),
          help="people in or stepping into the path (braking requests)", bench_scenario="crossing",
-         bench_peer=_people_peer),
+         bench_peer=_people_peer, bench_speedup=40.0),
     Task("odometry", "odometry", "odometry", priv.PrivilegedOdometry, OdometryScorer, vision=_odometry_slot,
          recorder="percept.review.parts:odometry", upstream=("longitudinal",),
          headline=(Headline("drift VO [%]", "drift_pct_vo", "{:.2f}"),
