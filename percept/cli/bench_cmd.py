@@ -132,6 +132,7 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
                                                                      for c in stacks))
         console.print("stereo pair with each condition (highway, ms): " + ", ".join(
             f"{k} {fmt(conditions[k])}" for k in CONDITIONS))
+        console.print(_stack_targets(stacks))
         out.update({"stack": [c.to_dict() for c in stacks],
                     "render_conditions_ms": {k: round(v, 3) for k, v in conditions.items()}})
     if soaked:
@@ -141,6 +142,22 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
                       f"{soaked['realtime_factor']}")
         out["soak"] = soaked
     return out
+
+
+def _stack_targets(stacks) -> str:
+    """On how many scenarios each of the stack's targets was kept in this run, as one line."""
+    from percept.drive.bench_stack import (PERCEPTION_BUDGET_MS, REALTIME_RECORDED, STACK_SPEEDUP,
+                                           STEREO_PAIR_BUDGET_MS)
+
+    names = {"perception_total": f"perception total <= {PERCEPTION_BUDGET_MS:g} ms",
+             "speedup": f">= {STACK_SPEEDUP:g}x the stock composition",
+             "stereo_pair": f"stereo pair <= {STEREO_PAIR_BUDGET_MS:g} ms",
+             "realtime_recorded": f"every recorded drive >= {REALTIME_RECORDED:g}x real time"}
+    parts = []
+    for key, name in names.items():
+        kept = [c.met[key] for c in stacks if c.met[key] is not None]
+        parts.append(f"{name}: {sum(kept)} of {len(kept)} scenarios")
+    return "targets kept: " + "; ".join(parts)
 
 
 def _spread(median: float, values: tuple[float, ...]) -> str:
