@@ -60,8 +60,9 @@ def _windows_at_scale(image: np.ndarray, model: LinearModel, scale: float,
     blocks = block_grid(small)
     s = model.score_map(blocks)
     x, y = np.nonzero(s >= threshold)
-    boxes = np.column_stack([np.round(x * CELL_PX * scale), np.round(y * CELL_PX * scale),
-                             np.full(len(x), round(WINDOW_PX[0] * scale)), np.full(len(x), round(WINDOW_PX[1] * scale))])
+    win_w, win_h = round(WINDOW_PX[0] * scale), round(WINDOW_PX[1] * scale)
+    boxes = np.column_stack([np.round(x * CELL_PX * scale), np.round(y * CELL_PX * scale), np.full(len(x), win_w),
+                             np.full(len(x), win_h)])
     return boxes.astype(np.int32), s[x, y], model.second_scores(blocks, x, y)
 
 

@@ -36,6 +36,11 @@ STEREO_PAIR_BUDGET_MS = 8.0
 """The stereo pair's budget on every scenario [ms]."""
 REALTIME_RECORDED = 2.0
 """The closed loop with every vision slot and recording must run at least this many times real time, every drive."""
+TARGETS = {"perception_total": f"perception total <= {PERCEPTION_BUDGET_MS:g} ms",
+           "speedup": f">= {STACK_SPEEDUP:g}x the stock composition",
+           "stereo_pair": f"stereo pair <= {STEREO_PAIR_BUDGET_MS:g} ms",
+           "realtime_recorded": f"every recorded drive >= {REALTIME_RECORDED:g}x real time"}
+"""The stack's targets, as ``StackCost.met`` names them, as a person reads them."""
 
 
 def lane_fit_full_frame(frames: list) -> tuple[str, Callable]:

@@ -10,8 +10,8 @@ negatives are mined from the images the detector will search). Measured with hig
 braking for no one left on the 27 runs that had 40, half the false positives on `crossing`, but in rain the far
 field's recall fell from 0.71 to 0.49 and a crossing person was hit (README, Pedestrians); so in the shipped model
 such a model is only the second stage of a cascade (``LinearModel.second``: it confirms what a model trained
-without them finds). Seeds are disjoint from every evaluation seed (0-19 closed loop, 100-119 detection); the conditions rotate
-over them so that the model sees day, night and rain.
+without them finds). Seeds are disjoint from every evaluation seed (0-19 closed loop, 100-119 detection); the
+conditions rotate over them so that the model sees day, night and rain.
 """
 
 from __future__ import annotations
