@@ -31,8 +31,10 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed,
                                                        cfg.detector, hw_pose(world.ego)),
                   world.cruise_speed_mps)
+    rig = world.cfg.rig
     scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
-                                             world.crossing_pedestrians, agent.following.time_gap))
+                                             world.crossing_pedestrians, agent.following.time_gap,
+                                             rig.camera.fx * rig.baseline_m))
                for t in cfg.tasks}
     safety = SafetyScorer()
     recorder = recorder_factory(world) if recorder_factory else None

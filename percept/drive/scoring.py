@@ -38,12 +38,15 @@ for STEADY_S [s]; ``time_gap_steady_s`` averages the time gap over those frames.
 @dataclass(frozen=True)
 class ScoreContext:
     """vision: the task's slot is a vision one (its estimates are scored); pedestrians, crossing_pedestrians: how
-    many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting."""
+    many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting;
+    stereo_fb_px_m: the rig's focal length times its baseline [px m] (one disparity pixel is Z^2 / (f b) of range
+    at range Z), or None without a stereo rig."""
 
     vision: bool
     pedestrians: int
     crossing_pedestrians: int
     time_gap_setting_s: float
+    stereo_fb_px_m: float | None = None
 
 
 @dataclass(frozen=True)
@@ -162,13 +165,36 @@ class LongitudinalScorer:
         }
 
 
+MATCH_M = 3.0
+"""How far a vision track may lie from the true person it stands for [m], across; along the range, this plus one
+disparity pixel of the rig's range resolution (``person_matches``)."""
+
+
+def person_matches(track_xy, person_xy, stereo_fb_px_m: float | None) -> bool:
+    """Whether a vision track at ``track_xy`` (vehicle frame, x ahead [m]) stands for the true person at
+    ``person_xy``: within MATCH_M across and, along x, within MATCH_M plus the range one disparity pixel spans at the
+    track's range, dZ = Z^2 / (f b) (5.9 m at 42 m on the default rig): a person stereo read a pixel short is still
+    that person, not "no one". Within MATCH_M of each other on the ground always matches (without a rig, only that)."""
+    dx, dy = abs(person_xy[0] - track_xy[0]), abs(person_xy[1] - track_xy[1])
+    if np.hypot(dx, dy) < MATCH_M:
+        return True
+    if stereo_fb_px_m is None or not stereo_fb_px_m > 0:
+        return False
+    # Z: the track's x, from the vehicle's centre (the cameras sit 0.8 m ahead of it on the default rig: a little more
+    # room than the range itself gives)
+    z = max(float(track_xy[0]), 0.0)
+    # one disparity pixel of range at Z: Z^2 / (f b)
+    return dy < MATCH_M and dx < MATCH_M + z * z / stereo_fb_px_m
+
+
 class PedestrianScorer:
     """Stops for crossing pedestrians and false stops; with the vision slot, its reported people (confirmed tracks'
     boxes) against the true boxes of every frame. A true pedestrian counts (``eligible``: at least 24 px tall and
     half visible) inside the searched domain (the search's depths and corridor about the true lane centre); the
     others are ignore regions. ``verge_brakes``: hard brakings (below -3 m/s², above a walking pace) that begin on a
     braking request for a person who is not crossing (the request's person: the truth's id for the privileged slot,
-    the true pedestrian nearest the requesting track for the vision slot, within 3 m); ``brakes_for_no_one``: those
+    the true pedestrian nearest the requesting track for the vision slot, if it lies within ``MATCH_M`` across and within
+    ``MATCH_M`` plus one disparity pixel of range along, ``person_matches``); ``brakes_for_no_one``: those
     that begin on a request for no true person at all. ``false_stops``: stops that nothing in the path calls for (no
     crossing person within 40 m ahead, no vehicle in the path slower than HALTING_VEHICLE_MPS). The last two are
     scored in every scenario: the pedestrian slot can stop the car for a person who is not there, on any road."""
@@ -212,15 +238,14 @@ class PedestrianScorer:
         if self.tally is not None and debug is not None:
             self._score_detections(debug, gt)
 
-    @staticmethod
-    def _requested_person(request, debug, gt):
+    def _requested_person(self, request, debug, gt):
         """The true pedestrian a braking request is for, or None."""
         people = [o for o in gt.objects if o.kind is ObjectKind.PEDESTRIAN]
         tracks = {t.track_id: t for t in getattr(debug, "tracks", ())}
-        if request.obj_id in tracks:  # a vision track: the true person nearest it on the ground, within 3 m
+        if request.obj_id in tracks:  # a vision track: the true person nearest it on the ground, if close enough
             x, y = tracks[request.obj_id].position_m
             near = min(people, key=lambda o: np.hypot(o.position_m[0] - x, o.position_m[1] - y), default=None)
-            ok = near is not None and np.hypot(near.position_m[0] - x, near.position_m[1] - y) < 3.0
+            ok = near is not None and person_matches((x, y), near.position_m[:2], self.ctx.stereo_fb_px_m)
             return near if ok else None
         return next((o for o in people if o.obj_id == request.obj_id), None)
 
