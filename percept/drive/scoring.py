@@ -193,8 +193,8 @@ class PedestrianScorer:
     half visible) inside the searched domain (the search's depths and corridor about the true lane centre); the
     others are ignore regions. ``verge_brakes``: hard brakings (below -3 m/s², above a walking pace) that begin on a
     braking request for a person who is not crossing (the request's person: the truth's id for the privileged slot,
-    the true pedestrian nearest the requesting track for the vision slot, if it lies within ``MATCH_M`` across and within
-    ``MATCH_M`` plus one disparity pixel of range along, ``person_matches``); ``brakes_for_no_one``: those
+    the true pedestrian nearest the requesting track for the vision slot, if it lies within ``MATCH_M`` across and
+    within ``MATCH_M`` plus one disparity pixel of range along, ``person_matches``); ``brakes_for_no_one``: those
     that begin on a request for no true person at all. ``false_stops``: stops that nothing in the path calls for (no
     crossing person within 40 m ahead, no vehicle in the path slower than HALTING_VEHICLE_MPS). The last two are
     scored in every scenario: the pedestrian slot can stop the car for a person who is not there, on any road."""

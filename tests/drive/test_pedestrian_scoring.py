@@ -6,7 +6,7 @@ import numpy as np
 
 from percept.drive.privileged import Obstacle
 from percept.drive.scoring import PedestrianScorer, ScoreContext, StepTruth, person_matches
-from percept.sensors import BrakingRequest, ObjectKind
+from percept.sensors import BrakingRequest, ObjectKind, StereoRig
 
 
 def drive(scorer, speeds, accels, obstacle=None, request=None, objects=()):
@@ -24,8 +24,9 @@ def scorer(pedestrians: int = 0, fb: float | None = None) -> PedestrianScorer:
     return PedestrianScorer(ScoreContext(False, pedestrians, 0, 1.8, fb))
 
 
-FB = 554.26 * 0.54
-"""The default rig's focal length times baseline [px m]: one disparity pixel is 5.9 m of range at 42 m."""
+RIG = StereoRig()
+FB = RIG.camera.fx * RIG.baseline_m
+"""The default rig's focal length times baseline [px m] (299.3): one disparity pixel is 5.9 m of range at 42 m."""
 
 
 def test_a_stop_behind_a_lead_that_drives_on_is_false_even_without_pedestrians():
@@ -79,7 +80,7 @@ def test_a_person_stereo_read_a_pixel_short_is_still_the_person_braked_for():
 def test_a_track_beside_a_person_or_far_short_of_a_near_one_is_for_no_one():
     # 4 m to the side at 42 m: range resolution does not widen the lateral match
     assert drive_track(scorer(1, FB), (42.0, 4.0), crossing_person(42.0, 0.0))["brakes_for_no_one"] == 1
-    # 5 m short at 15 m, where a disparity pixel is 0.75 m of range
+    # 5 m short of a person at 15 m: a disparity pixel is 0.33 m of range at the track's 10 m
     assert drive_track(scorer(1, FB), (10.0, 0.0), crossing_person(15.0, 0.0))["brakes_for_no_one"] == 1
 
 
