@@ -10,6 +10,7 @@ from enum import Enum
 import cv2
 import numpy as np
 
+from percept.compiled import kernel
 from percept.sensors import StereoRig
 
 
@@ -41,6 +42,68 @@ def frame_rng(seed: int, frame: int, camera: int) -> np.random.Generator:
 def is_dropped(condition: Condition, seed: int, frame: int) -> bool:
     """Whether the camera delivers no frame at this step (dropout condition only)."""
     return condition is Condition.DROPOUT and frame_rng(seed, frame, 9).random() < DROPOUT_RATE
+
+
+@kernel()
+def _lit(img, gain, out):  # pragma: no cover - compiled
+    """out (H, W, 3) float32 = img (H, W, 3) as float32 times gain (H, W) float32, channel by channel: the float32
+    product numpy's broadcast (and OpenCV's ``multiply``) gives, without the float copy and the three-channel gain."""
+    for y in range(img.shape[0]):
+        for x in range(img.shape[1]):
+            g = gain[y, x]
+            for ch in range(3):
+                out[y, x, ch] = np.float32(img[y, x, ch]) * g
+
+
+@kernel()
+def _with_noise_uint8(out, noise, scale):  # pragma: no cover - compiled
+    """uint8 (H, W, 3) of out (H, W, 3) float32 plus ``scale`` times the per-pixel ``noise`` (H, W) float32 on every
+    channel, clipped to 0..255 and truncated: numpy's ``noise *= scale``, ``out += noise[..., None]``,
+    ``np.clip(out, 0, 255)`` and ``astype(np.uint8)`` in one pass, each step in float32 as there."""
+    res = np.empty(out.shape, np.uint8)
+    for y in range(out.shape[0]):
+        for x in range(out.shape[1]):
+            a = noise[y, x] * scale
+            for ch in range(3):
+                v = min(max(out[y, x, ch] + a, np.float32(0)), np.float32(255))
+                res[y, x, ch] = np.uint8(v)
+    return res
+
+
+@kernel()
+def _beam_spread(inv, slope, cam_y, z, t):  # pragma: no cover - compiled
+    """The night's beam before its exponential, per pixel in float32 as numpy's whole-array steps did: z = depth
+    from 1/Z (``inv`` (H, W); inf for sky, capped at 1e4 m) and t = -spread^2, spread the lateral distance beyond
+    1.5 m from the centreline over 0.3 Z + 1 (``slope`` (1, W): (u - cx) / fx; ``cam_y``: the camera's lateral
+    offset [m])."""
+    for y in range(inv.shape[0]):
+        for x in range(inv.shape[1]):
+            v = inv[y, x]
+            # z = 1 / max(1/Z, 1e-6), inf for sky, capped at 1e4 m
+            zv = np.float32(1.0) / max(v, np.float32(1e-6))
+            if v <= 0:
+                zv = np.float32(np.inf)
+            zv = min(zv, np.float32(1e4))
+            z[y, x] = zv
+            # lateral distance from the centreline: y = y_cam - (u - cx) Z / fx
+            d = abs(cam_y - slope[0, x] * zv)
+            # spread = max(|y| - 1.5, 0) / (0.3 Z + 1)
+            sp = max(d - np.float32(1.5), np.float32(0)) / (np.float32(0.3) * zv + np.float32(1.0))
+            t[y, x] = -sp * sp
+
+
+@kernel()
+def _beam_gain(z, t):  # pragma: no cover - compiled
+    """The night's gain from t = exp(-spread^2) (in place): 0.08 + 1.1 beam, beam = t / (1 + (Z / 35)^2), none on
+    the sky (Z at its 1e4 m cap), in float32 as numpy's whole-array steps did."""
+    for y in range(z.shape[0]):
+        for x in range(z.shape[1]):
+            zv = z[y, x]
+            q = zv / np.float32(35.0)
+            b = t[y, x] / (q * q + np.float32(1.0))
+            if zv >= np.float32(1e4):
+                b = np.float32(0.0)
+            t[y, x] = b * np.float32(1.1) + np.float32(0.08)
 
 
 def _three(a: np.ndarray, dst: np.ndarray | None = None) -> np.ndarray:
@@ -85,6 +148,14 @@ class ConditionEffects:
         # 0.38 haze, per channel, as OpenCV's scalar
         self._haze_lit = tuple(float(c) for c in np.float32(0.38) * np.array([150, 150, 145], np.float32)) + (0.0,)
         self.H, self.W = H, W
+        if self.condition is Condition.NIGHT:
+            # the night's compiled kernels loaded (or compiled, once after an install) now, not in a timed frame
+            one = np.zeros((1, 1, 3), np.float32)
+            _lit(np.zeros((1, 1, 3), np.uint8), np.ones((1, 1), np.float32), one)
+            scratch = np.zeros((1, 1), np.float32)
+            _beam_spread(scratch, self.slope[:, :1].copy(), np.float32(0.0), scratch.copy(), scratch.copy())
+            _beam_gain(scratch + 1, scratch.copy())
+            _with_noise_uint8(one, np.zeros((1, 1), np.float32), np.float32(3.0))
 
     @property
     def reads_emission(self) -> bool:
@@ -103,47 +174,27 @@ class ConditionEffects:
         """``night_gain`` written in place on scratch buffers (the result is one of them, valid until the next
         call)."""
         inv = self.ground_inv if inv_depth is None else inv_depth
-        # z = 1 / max(1/Z, 1e-6), inf for sky, capped at 1e4 m
-        z = np.maximum(inv, np.float32(1e-6), out=self._scratch("noise"))
-        np.divide(np.float32(1.0), z, out=z)
-        z[inv <= 0] = np.inf
-        np.minimum(z, np.float32(1e4), out=z)
-        # lateral distance from the centreline: y = y_cam - (u - cx) Z / fx
-        t = np.multiply(self.slope, z, out=self._scratch("t"))
-        np.subtract(np.float32(self.cam_y[camera]), t, out=t)
-        np.abs(t, out=t)
-        # spread = max(|y| - 1.5, 0) / (0.3 Z + 1)
-        t -= np.float32(1.5)
-        np.maximum(t, np.float32(0), out=t)
-        sky = z >= 1e4
-        q = np.multiply(np.float32(0.3), z, out=self._scratch("q"))
-        q += np.float32(1.0)
-        t /= q
-        # beam = exp(-spread^2) / (1 + (Z / 35)^2)
-        np.multiply(np.negative(t, out=q), t, out=t)
+        z, t = self._scratch("noise"), self._scratch("t")
+        _beam_spread(inv, self.slope, np.float32(self.cam_y[camera]), z, t)
+        # beam = exp(-spread^2) / (1 + (Z / 35)^2): numpy's exp, between the two compiled passes
         np.exp(t, out=t)
-        np.divide(z, np.float32(35.0), out=q)
-        np.square(q, out=q)
-        q += np.float32(1.0)
-        t /= q
-        t[sky] = 0.0
-        # gain = 0.08 + 1.1 beam
-        t *= np.float32(1.1)
-        t += np.float32(0.08)
+        _beam_gain(z, t)
         return t
 
-    def _night(self, f: np.ndarray, gain: np.ndarray, emission: np.ndarray) -> np.ndarray:
+    def _night(self, img: np.ndarray, gain: np.ndarray, emission: np.ndarray) -> np.ndarray:
         """Lamps keep their light and glow; everything else is lit by ``gain``. Linear in each pixel's lamp
         fraction, so that a lamp's anti-aliased edge moves smoothly (a threshold would snap it to whole pixels).
-        Where no lamp is (e = 0) the mix is f gain exactly, so it is computed in full only in the lamps' box."""
-        out = cv2.multiply(f, _three(gain, self._scratch("three", 3)), dst=self._scratch("out", 3))
+        Where no lamp is (e = 0) the mix is f gain exactly (f: ``img`` in float32), so it is computed in full only
+        in the lamps' box."""
+        out = self._scratch("out", 3)
+        _lit(img, gain, out)
         rows, cols = np.flatnonzero(emission.any(axis=1)), np.flatnonzero(emission.any(axis=0))
         if len(rows):
             # the glow is local: blur only the lamps' bounding box, padded by the kernel radius (4 sigma)
             y0, y1 = max(rows[0] - 13, 0), min(rows[-1] + 14, self.H)
             x0, x1 = max(cols[0] - 13, 0), min(cols[-1] + 14, self.W)
             box = np.s_[y0:y1, x0:x1]
-            fb, e = f[box], emission[box][..., None]
+            fb, e = img[box].astype(np.float32), emission[box][..., None]
             lamps = fb * e
             # out = f gain (1 - e) + f e
             out[box] = fb * gain[box][..., None] * (1.0 - e) + lamps
@@ -209,12 +260,10 @@ class ConditionEffects:
         if c is Condition.NIGHT:
             if emission is None:
                 emission = ((img[..., 2] > 180) & (img[..., 1] < 90)).astype(np.float32)
-            f = self._scratch("f", 3)
-            f[...] = img
-            out = self._night(f, self._night_gain(inv_depth, camera), emission)
+            out = self._night(img, self._night_gain(inv_depth, camera), emission)
             n = rng.standard_normal(out.shape[:2], dtype=np.float32, out=self._scratch("noise"))
-            n *= np.float32(3.0)
-            cv2.add(out, _three(n, self._scratch("three", 3)), dst=out)
+            # out + 3 n on every channel, clipped and truncated to uint8
+            return _with_noise_uint8(out, n, np.float32(3.0))
         elif c is Condition.RAIN:
             out = self._rain(img, rng)
         elif c is Condition.GLARE:
