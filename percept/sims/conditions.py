@@ -106,6 +106,30 @@ def _beam_gain(z, t):  # pragma: no cover - compiled
             t[y, x] = b * np.float32(1.1) + np.float32(0.08)
 
 
+@kernel()
+def _hazy(blurred, scale, haze, streaks, out):  # pragma: no cover - compiled
+    """The rain's veil in one pass: out (H, W, 3) float32 = blurred (H, W, 3) uint8 as float32 times ``scale``, plus
+    ``haze`` (3,) per channel, plus ``streaks`` (H, W) on every channel, each step in float32 as numpy's and
+    OpenCV's whole-image steps did."""
+    for y in range(out.shape[0]):
+        for x in range(out.shape[1]):
+            s = streaks[y, x]
+            for ch in range(3):
+                out[y, x, ch] = (np.float32(blurred[y, x, ch]) * scale + haze[ch]) + s
+
+
+@kernel()
+def _through_drops(out, d, blurred):  # pragma: no cover - compiled
+    """Drops on the windscreen, in place: out = out (1 - 0.6 d) + 0.6 d ``blurred`` (out, blurred (H, W, 3), d (H, W),
+    float32), each product and sum in float32 as OpenCV's whole-image steps did."""
+    for y in range(out.shape[0]):
+        for x in range(out.shape[1]):
+            a = d[y, x] * np.float32(0.6)
+            keep = np.float32(1) - a
+            for ch in range(3):
+                out[y, x, ch] = out[y, x, ch] * keep + a * blurred[y, x, ch]
+
+
 def _three(a: np.ndarray, dst: np.ndarray | None = None) -> np.ndarray:
     """(H, W) -> (H, W, 3) (into ``dst`` if given), for OpenCV's per-channel arithmetic, which is the same float32
     operation as numpy's broadcast of (H, W, 1) and several times faster."""
@@ -145,9 +169,14 @@ class ConditionEffects:
                 box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
                 self._ghosts.append((box, ghost[box]))
         self._buffers: dict[str, np.ndarray] = {}
-        # 0.38 haze, per channel, as OpenCV's scalar
-        self._haze_lit = tuple(float(c) for c in np.float32(0.38) * np.array([150, 150, 145], np.float32)) + (0.0,)
+        # 0.38 haze, per channel (float32)
+        self._haze_f32 = np.float32(0.38) * np.array([150, 150, 145], np.float32)
         self.H, self.W = H, W
+        if self.condition is Condition.RAIN:
+            # the rain's compiled kernels loaded (or compiled, once after an install) now, not in a timed frame
+            one, plane = np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.float32)
+            _hazy(np.zeros((1, 1, 3), np.uint8), np.float32(0.62), self._haze_f32, plane, one)
+            _through_drops(one, plane, one.copy())
         if self.condition is Condition.NIGHT:
             # the night's compiled kernels loaded (or compiled, once after an install) now, not in a timed frame
             one = np.zeros((1, 1, 3), np.float32)
@@ -211,10 +240,6 @@ class ConditionEffects:
         return b
 
     def _rain(self, img: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        three = self._scratch("three", 3)
-        # out = 0.62 blur(img) + 0.38 haze
-        out = np.multiply(cv2.GaussianBlur(img, (0, 0), 1.1), np.float32(0.62), out=self._scratch("out", 3))
-        cv2.add(out, self._haze_lit, dst=out)
         streaks = self._scratch("streaks")
         streaks.fill(0)
         x, y = rng.uniform(0, self.W, 260), rng.uniform(0, self.H, 260)
@@ -222,7 +247,9 @@ class ConditionEffects:
         for k in range(260):
             cv2.line(streaks, (int(x[k]), int(y[k])), (int(x[k] + 0.15 * ln[k]), int(y[k] + ln[k])),
                      float(val[k]), 1, cv2.LINE_AA)
-        cv2.add(out, _three(streaks, three), dst=out)
+        # out = 0.62 blur(img) + 0.38 haze + the streaks
+        out = self._scratch("out", 3)
+        _hazy(cv2.GaussianBlur(img, (0, 0), 1.1), np.float32(0.62), self._haze_f32, streaks, out)
         drops = self._scratch("drops")
         drops.fill(0)
         du, dv, dr = rng.uniform(0, self.W, 18), rng.uniform(0, self.H, 18), rng.uniform(4, 12, 18)
@@ -233,10 +260,8 @@ class ConditionEffects:
         small = cv2.GaussianBlur(cv2.pyrDown(cv2.pyrDown(out)), (0, 0), 1.5)
         blurred = cv2.resize(small, (self.W, self.H), dst=self._scratch("blurred", 3), interpolation=cv2.INTER_LINEAR)
         # out = out (1 - 0.6 d) + 0.6 d blurred
-        d *= np.float32(0.6)
-        # (1 - 0.6 d) goes into the drops' buffer, no longer needed once blurred
-        cv2.multiply(out, _three(np.subtract(np.float32(1), d, out=drops), three), dst=out)
-        return cv2.add(out, cv2.multiply(_three(d, three), blurred, dst=blurred), dst=out)
+        _through_drops(out, d, blurred)
+        return out
 
     def _glare(self, img: np.ndarray) -> np.ndarray:
         # out = 0.8 f + 0.2 * 235 + 1.2 glare, then the lens flare's ghosts

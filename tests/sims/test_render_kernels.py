@@ -111,12 +111,14 @@ from percept.sims import SimWorld, WorldConfig, conditions
 from percept.sims.render import cull, ground, paint, pedestrian, pixels, spans
 modules = (pixels, cull, spans, pedestrian, ground, paint, conditions)
 kernels = [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
-# the world's renderer and its night effects warm their kernels up when they are built
+# the world's renderer and its night effects warm their kernels up when they are built, and so do the rain's
 world = SimWorld(WorldConfig("crossing", seed=1, condition="night", autopilot=True))
+rain = conditions.ConditionEffects(world.cfg.rig, "rain")
 before = [len(k.signatures) for k in kernels]
 for _ in range(6):
     world.step()
-    world.observe()
+    frame, _ = world.observe()
+    rain.apply(frame.left, 1, world.frame_index, 0)
 print(len(kernels), min(before), [len(k.signatures) for k in kernels] == before)
 """
 
