@@ -130,6 +130,31 @@ def _through_drops(out, d, blurred):  # pragma: no cover - compiled
                 out[y, x, ch] = out[y, x, ch] * keep + a * blurred[y, x, ch]
 
 
+@kernel()
+def _glared(img, scale, lift, lit, out):  # pragma: no cover - compiled
+    """The glare's wash in one pass: out (H, W, 3) float32 = (img (H, W, 3) uint8 as float32 times ``scale`` plus
+    ``lift``) plus ``lit`` (H, W, 3) float32, each step in float32 as numpy's and OpenCV's whole-image steps did."""
+    for y in range(out.shape[0]):
+        for x in range(out.shape[1]):
+            for ch in range(3):
+                out[y, x, ch] = (scale * np.float32(img[y, x, ch]) + lift) + lit[y, x, ch]
+
+
+@kernel()
+def _noisy_uint8(img, n, band):  # pragma: no cover - compiled
+    """uint8 (H, W, 3) of img (H, W, 3) uint8 plus 10 ``n`` (H, W, 3) float32 plus the row's ``band`` (H, 1)
+    float32, clipped to 0..255 and truncated: numpy's ``n *= 10``, ``n += img``, ``n += band`` by row, ``np.clip``
+    and ``astype(np.uint8)`` in one pass, each step in float32 as there."""
+    res = np.empty(img.shape, np.uint8)
+    for y in range(img.shape[0]):
+        b = band[y, 0]
+        for x in range(img.shape[1]):
+            for ch in range(3):
+                v = (n[y, x, ch] * np.float32(10.0) + np.float32(img[y, x, ch])) + b
+                res[y, x, ch] = np.uint8(min(max(v, np.float32(0)), np.float32(255)))
+    return res
+
+
 def _three(a: np.ndarray, dst: np.ndarray | None = None) -> np.ndarray:
     """(H, W) -> (H, W, 3) (into ``dst`` if given), for OpenCV's per-channel arithmetic, which is the same float32
     operation as numpy's broadcast of (H, W, 1) and several times faster."""
@@ -172,6 +197,12 @@ class ConditionEffects:
         # 0.38 haze, per channel (float32)
         self._haze_f32 = np.float32(0.38) * np.array([150, 150, 145], np.float32)
         self.H, self.W = H, W
+        if self.condition is Condition.GLARE:
+            # the glare's and the noise's compiled kernels loaded (or compiled, once after an install) now
+            _glared(np.zeros((1, 1, 3), np.uint8), np.float32(0.8), np.float32(47.0), self._glare_lit[:1, :1].copy(),
+                    np.zeros((1, 1, 3), np.float32))
+        if self.condition is Condition.NOISE:
+            _noisy_uint8(np.zeros((1, 1, 3), np.uint8), np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.float32))
         if self.condition is Condition.RAIN:
             # the rain's compiled kernels loaded (or compiled, once after an install) now, not in a timed frame
             one, plane = np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.float32)
@@ -265,9 +296,8 @@ class ConditionEffects:
 
     def _glare(self, img: np.ndarray) -> np.ndarray:
         # out = 0.8 f + 0.2 * 235 + 1.2 glare, then the lens flare's ghosts
-        out = np.multiply(np.float32(0.8), img, out=self._scratch("out", 3))
-        out += np.float32(0.2 * 235)
-        cv2.add(out, self._glare_lit, dst=out)
+        out = self._scratch("out", 3)
+        _glared(img, np.float32(0.8), np.float32(0.2 * 235), self._glare_lit, out)
         for box, ghost in self._ghosts:
             out[box] += ghost
         return out
@@ -294,11 +324,8 @@ class ConditionEffects:
         elif c is Condition.GLARE:
             out = self._glare(img)
         else:  # NOISE
-            out = rng.standard_normal(img.shape, dtype=np.float32, out=self._scratch("out", 3))
-            # out = f + 10 n, then a row banding of 3 n_row
-            out *= np.float32(10.0)
-            out += img
-            rows = out.reshape(self.H, -1)
-            rows += np.float32(3.0) * rng.standard_normal((self.H, 1), dtype=np.float32)
+            n = rng.standard_normal(img.shape, dtype=np.float32, out=self._scratch("out", 3))
+            # out = f + 10 n, then a row banding of 3 n_row, clipped and truncated to uint8
+            return _noisy_uint8(img, n, np.float32(3.0) * rng.standard_normal((self.H, 1), dtype=np.float32))
         np.clip(out, 0, 255, out=out)
         return out.astype(np.uint8)
