@@ -155,12 +155,6 @@ def _noisy_uint8(img, n, band):  # pragma: no cover - compiled
     return res
 
 
-def _three(a: np.ndarray, dst: np.ndarray | None = None) -> np.ndarray:
-    """(H, W) -> (H, W, 3) (into ``dst`` if given), for OpenCV's per-channel arithmetic, which is the same float32
-    operation as numpy's broadcast of (H, W, 1) and several times faster."""
-    return cv2.merge((a, a, a), dst)
-
-
 class ConditionEffects:
     """Precomputed masks of one rig for applying a condition to each camera's image."""
 
@@ -179,7 +173,7 @@ class ConditionEffects:
         self.sun_uv = (cam.cx - 0.25 * cam.cx, max(hz - 0.18 * H, 10))
         r = np.hypot(u - self.sun_uv[0], v - self.sun_uv[1])
         glare = (255 * (np.exp(-r / 40.0) + 0.35 * np.exp(-r / 220.0))).astype(np.float32)
-        self._glare_lit = _three(glare * 1.2)
+        self._glare_lit = np.repeat((glare * 1.2)[..., None], 3, axis=2)
         # lens flare: ghosts on the line through the sun and the image centre, each kept with the box where its
         # blur is not zero (the blur's kernel reaches 4 sigma + 1 px beyond the disc)
         self._ghosts = []
