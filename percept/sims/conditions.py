@@ -10,8 +10,9 @@ from enum import Enum
 import cv2
 import numpy as np
 
-from percept.compiled import kernel
 from percept.sensors import StereoRig
+
+from . import condition_passes as passes
 
 
 class Condition(str, Enum):
@@ -42,117 +43,6 @@ def frame_rng(seed: int, frame: int, camera: int) -> np.random.Generator:
 def is_dropped(condition: Condition, seed: int, frame: int) -> bool:
     """Whether the camera delivers no frame at this step (dropout condition only)."""
     return condition is Condition.DROPOUT and frame_rng(seed, frame, 9).random() < DROPOUT_RATE
-
-
-@kernel()
-def _lit(img, gain, out):  # pragma: no cover - compiled
-    """out (H, W, 3) float32 = img (H, W, 3) as float32 times gain (H, W) float32, channel by channel: the float32
-    product numpy's broadcast (and OpenCV's ``multiply``) gives, without the float copy and the three-channel gain."""
-    for y in range(img.shape[0]):
-        for x in range(img.shape[1]):
-            g = gain[y, x]
-            for ch in range(3):
-                out[y, x, ch] = np.float32(img[y, x, ch]) * g
-
-
-@kernel()
-def _with_noise_uint8(out, noise, scale):  # pragma: no cover - compiled
-    """uint8 (H, W, 3) of out (H, W, 3) float32 plus ``scale`` times the per-pixel ``noise`` (H, W) float32 on every
-    channel, clipped to 0..255 and truncated: numpy's ``noise *= scale``, ``out += noise[..., None]``,
-    ``np.clip(out, 0, 255)`` and ``astype(np.uint8)`` in one pass, each step in float32 as there."""
-    res = np.empty(out.shape, np.uint8)
-    for y in range(out.shape[0]):
-        for x in range(out.shape[1]):
-            a = noise[y, x] * scale
-            for ch in range(3):
-                v = min(max(out[y, x, ch] + a, np.float32(0)), np.float32(255))
-                res[y, x, ch] = np.uint8(v)
-    return res
-
-
-@kernel()
-def _beam_spread(inv, slope, cam_y, z, t):  # pragma: no cover - compiled
-    """The night's beam before its exponential, per pixel in float32 as numpy's whole-array steps did: z = depth
-    from 1/Z (``inv`` (H, W); inf for sky, capped at 1e4 m) and t = -spread^2, spread the lateral distance beyond
-    1.5 m from the centreline over 0.3 Z + 1 (``slope`` (1, W): (u - cx) / fx; ``cam_y``: the camera's lateral
-    offset [m])."""
-    for y in range(inv.shape[0]):
-        for x in range(inv.shape[1]):
-            v = inv[y, x]
-            # z = 1 / max(1/Z, 1e-6), inf for sky, capped at 1e4 m
-            zv = np.float32(1.0) / max(v, np.float32(1e-6))
-            if v <= 0:
-                zv = np.float32(np.inf)
-            zv = min(zv, np.float32(1e4))
-            z[y, x] = zv
-            # lateral distance from the centreline: y = y_cam - (u - cx) Z / fx
-            d = abs(cam_y - slope[0, x] * zv)
-            # spread = max(|y| - 1.5, 0) / (0.3 Z + 1)
-            sp = max(d - np.float32(1.5), np.float32(0)) / (np.float32(0.3) * zv + np.float32(1.0))
-            t[y, x] = -sp * sp
-
-
-@kernel()
-def _beam_gain(z, t):  # pragma: no cover - compiled
-    """The night's gain from t = exp(-spread^2) (in place): 0.08 + 1.1 beam, beam = t / (1 + (Z / 35)^2), none on
-    the sky (Z at its 1e4 m cap), in float32 as numpy's whole-array steps did."""
-    for y in range(z.shape[0]):
-        for x in range(z.shape[1]):
-            zv = z[y, x]
-            q = zv / np.float32(35.0)
-            b = t[y, x] / (q * q + np.float32(1.0))
-            if zv >= np.float32(1e4):
-                b = np.float32(0.0)
-            t[y, x] = b * np.float32(1.1) + np.float32(0.08)
-
-
-@kernel()
-def _hazy(blurred, scale, haze, streaks, out):  # pragma: no cover - compiled
-    """The rain's veil in one pass: out (H, W, 3) float32 = blurred (H, W, 3) uint8 as float32 times ``scale``, plus
-    ``haze`` (3,) per channel, plus ``streaks`` (H, W) on every channel, each step in float32 as numpy's and
-    OpenCV's whole-image steps did."""
-    for y in range(out.shape[0]):
-        for x in range(out.shape[1]):
-            s = streaks[y, x]
-            for ch in range(3):
-                out[y, x, ch] = (np.float32(blurred[y, x, ch]) * scale + haze[ch]) + s
-
-
-@kernel()
-def _through_drops(out, d, blurred):  # pragma: no cover - compiled
-    """Drops on the windscreen, in place: out = out (1 - 0.6 d) + 0.6 d ``blurred`` (out, blurred (H, W, 3), d (H, W),
-    float32), each product and sum in float32 as OpenCV's whole-image steps did."""
-    for y in range(out.shape[0]):
-        for x in range(out.shape[1]):
-            a = d[y, x] * np.float32(0.6)
-            keep = np.float32(1) - a
-            for ch in range(3):
-                out[y, x, ch] = out[y, x, ch] * keep + a * blurred[y, x, ch]
-
-
-@kernel()
-def _glared(img, scale, lift, lit, out):  # pragma: no cover - compiled
-    """The glare's wash in one pass: out (H, W, 3) float32 = (img (H, W, 3) uint8 as float32 times ``scale`` plus
-    ``lift``) plus ``lit`` (H, W, 3) float32, each step in float32 as numpy's and OpenCV's whole-image steps did."""
-    for y in range(out.shape[0]):
-        for x in range(out.shape[1]):
-            for ch in range(3):
-                out[y, x, ch] = (scale * np.float32(img[y, x, ch]) + lift) + lit[y, x, ch]
-
-
-@kernel()
-def _noisy_uint8(img, n, band):  # pragma: no cover - compiled
-    """uint8 (H, W, 3) of img (H, W, 3) uint8 plus 10 ``n`` (H, W, 3) float32 plus the row's ``band`` (H, 1)
-    float32, clipped to 0..255 and truncated: numpy's ``n *= 10``, ``n += img``, ``n += band`` by row, ``np.clip``
-    and ``astype(np.uint8)`` in one pass, each step in float32 as there."""
-    res = np.empty(img.shape, np.uint8)
-    for y in range(img.shape[0]):
-        b = band[y, 0]
-        for x in range(img.shape[1]):
-            for ch in range(3):
-                v = (n[y, x, ch] * np.float32(10.0) + np.float32(img[y, x, ch])) + b
-                res[y, x, ch] = np.uint8(min(max(v, np.float32(0)), np.float32(255)))
-    return res
 
 
 class ConditionEffects:
@@ -193,23 +83,24 @@ class ConditionEffects:
         self.H, self.W = H, W
         if self.condition is Condition.GLARE:
             # the glare's and the noise's compiled kernels loaded (or compiled, once after an install) now
-            _glared(np.zeros((1, 1, 3), np.uint8), np.float32(0.8), np.float32(47.0), self._glare_lit[:1, :1].copy(),
-                    np.zeros((1, 1, 3), np.float32))
+            passes.glared(np.zeros((1, 1, 3), np.uint8), np.float32(0.8), np.float32(47.0),
+                          self._glare_lit[:1, :1].copy(), np.zeros((1, 1, 3), np.float32))
         if self.condition is Condition.NOISE:
-            _noisy_uint8(np.zeros((1, 1, 3), np.uint8), np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.float32))
+            passes.noisy_uint8(np.zeros((1, 1, 3), np.uint8), np.zeros((1, 1, 3), np.float32),
+                               np.zeros((1, 1), np.float32))
         if self.condition is Condition.RAIN:
             # the rain's compiled kernels loaded (or compiled, once after an install) now, not in a timed frame
             one, plane = np.zeros((1, 1, 3), np.float32), np.zeros((1, 1), np.float32)
-            _hazy(np.zeros((1, 1, 3), np.uint8), np.float32(0.62), self._haze_f32, plane, one)
-            _through_drops(one, plane, one.copy())
+            passes.hazy(np.zeros((1, 1, 3), np.uint8), np.float32(0.62), self._haze_f32, plane, one)
+            passes.through_drops(one, plane, one.copy())
         if self.condition is Condition.NIGHT:
             # the night's compiled kernels loaded (or compiled, once after an install) now, not in a timed frame
             one = np.zeros((1, 1, 3), np.float32)
-            _lit(np.zeros((1, 1, 3), np.uint8), np.ones((1, 1), np.float32), one)
+            passes.lit(np.zeros((1, 1, 3), np.uint8), np.ones((1, 1), np.float32), one)
             scratch = np.zeros((1, 1), np.float32)
-            _beam_spread(scratch, self.slope[:, :1].copy(), np.float32(0.0), scratch.copy(), scratch.copy())
-            _beam_gain(scratch + 1, scratch.copy())
-            _with_noise_uint8(one, np.zeros((1, 1), np.float32), np.float32(3.0))
+            passes.beam_spread(scratch, self.slope[:, :1].copy(), np.float32(0.0), scratch.copy(), scratch.copy())
+            passes.beam_gain(scratch + 1, scratch.copy())
+            passes.with_noise_uint8(one, np.zeros((1, 1), np.float32), np.float32(3.0))
 
     @property
     def reads_emission(self) -> bool:
@@ -229,10 +120,10 @@ class ConditionEffects:
         call)."""
         inv = self.ground_inv if inv_depth is None else inv_depth
         z, t = self._scratch("noise"), self._scratch("t")
-        _beam_spread(inv, self.slope, np.float32(self.cam_y[camera]), z, t)
+        passes.beam_spread(inv, self.slope, np.float32(self.cam_y[camera]), z, t)
         # beam = exp(-spread^2) / (1 + (Z / 35)^2): numpy's exp, between the two compiled passes
         np.exp(t, out=t)
-        _beam_gain(z, t)
+        passes.beam_gain(z, t)
         return t
 
     def _night(self, img: np.ndarray, gain: np.ndarray, emission: np.ndarray) -> np.ndarray:
@@ -241,7 +132,7 @@ class ConditionEffects:
         Where no lamp is (e = 0) the mix is f gain exactly (f: ``img`` in float32), so it is computed in full only
         in the lamps' box."""
         out = self._scratch("out", 3)
-        _lit(img, gain, out)
+        passes.lit(img, gain, out)
         rows, cols = np.flatnonzero(emission.any(axis=1)), np.flatnonzero(emission.any(axis=0))
         if len(rows):
             # the glow is local: blur only the lamps' bounding box, padded by the kernel radius (4 sigma)
@@ -274,7 +165,7 @@ class ConditionEffects:
                      float(val[k]), 1, cv2.LINE_AA)
         # out = 0.62 blur(img) + 0.38 haze + the streaks
         out = self._scratch("out", 3)
-        _hazy(cv2.GaussianBlur(img, (0, 0), 1.1), np.float32(0.62), self._haze_f32, streaks, out)
+        passes.hazy(cv2.GaussianBlur(img, (0, 0), 1.1), np.float32(0.62), self._haze_f32, streaks, out)
         drops = self._scratch("drops")
         drops.fill(0)
         du, dv, dr = rng.uniform(0, self.W, 18), rng.uniform(0, self.H, 18), rng.uniform(4, 12, 18)
@@ -285,13 +176,13 @@ class ConditionEffects:
         small = cv2.GaussianBlur(cv2.pyrDown(cv2.pyrDown(out)), (0, 0), 1.5)
         blurred = cv2.resize(small, (self.W, self.H), dst=self._scratch("blurred", 3), interpolation=cv2.INTER_LINEAR)
         # out = out (1 - 0.6 d) + 0.6 d blurred
-        _through_drops(out, d, blurred)
+        passes.through_drops(out, d, blurred)
         return out
 
     def _glare(self, img: np.ndarray) -> np.ndarray:
         # out = 0.8 f + 0.2 * 235 + 1.2 glare, then the lens flare's ghosts
         out = self._scratch("out", 3)
-        _glared(img, np.float32(0.8), np.float32(0.2 * 235), self._glare_lit, out)
+        passes.glared(img, np.float32(0.8), np.float32(0.2 * 235), self._glare_lit, out)
         for box, ghost in self._ghosts:
             out[box] += ghost
         return out
@@ -312,7 +203,7 @@ class ConditionEffects:
             out = self._night(img, self._night_gain(inv_depth, camera), emission)
             n = rng.standard_normal(out.shape[:2], dtype=np.float32, out=self._scratch("noise"))
             # out + 3 n on every channel, clipped and truncated to uint8
-            return _with_noise_uint8(out, n, np.float32(3.0))
+            return passes.with_noise_uint8(out, n, np.float32(3.0))
         elif c is Condition.RAIN:
             out = self._rain(img, rng)
         elif c is Condition.GLARE:
@@ -320,6 +211,6 @@ class ConditionEffects:
         else:  # NOISE
             n = rng.standard_normal(img.shape, dtype=np.float32, out=self._scratch("out", 3))
             # out = f + 10 n, then a row banding of 3 n_row, clipped and truncated to uint8
-            return _noisy_uint8(img, n, np.float32(3.0) * rng.standard_normal((self.H, 1), dtype=np.float32))
+            return passes.noisy_uint8(img, n, np.float32(3.0) * rng.standard_normal((self.H, 1), dtype=np.float32))
         np.clip(out, 0, 255, out=out)
         return out.astype(np.uint8)
