@@ -8,9 +8,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from numba import njit
+
 from percept.compiled import kernel
 
 __all__ = ["beam_gain", "beam_spread", "glared", "hazy", "lit", "noisy_uint8", "through_drops", "with_noise_uint8"]
+
+
+@njit(cache=True, inline="always")
+def _byte(v):  # pragma: no cover - compiled
+    """A float32 value clipped to 0..255 and truncated to uint8, as ``np.clip`` then ``astype(np.uint8)``."""
+    return np.uint8(min(max(v, np.float32(0)), np.float32(255)))
 
 
 @kernel()
@@ -34,8 +42,7 @@ def with_noise_uint8(out, noise, scale):  # pragma: no cover - compiled
         for x in range(out.shape[1]):
             a = noise[y, x] * scale
             for ch in range(3):
-                v = min(max(out[y, x, ch] + a, np.float32(0)), np.float32(255))
-                res[y, x, ch] = np.uint8(v)
+                res[y, x, ch] = _byte(out[y, x, ch] + a)
     return res
 
 
@@ -119,6 +126,5 @@ def noisy_uint8(img, n, band):  # pragma: no cover - compiled
         b = band[y, 0]
         for x in range(img.shape[1]):
             for ch in range(3):
-                v = (n[y, x, ch] * np.float32(10.0) + np.float32(img[y, x, ch])) + b
-                res[y, x, ch] = np.uint8(min(max(v, np.float32(0)), np.float32(255)))
+                res[y, x, ch] = _byte((n[y, x, ch] * np.float32(10.0) + np.float32(img[y, x, ch])) + b)
     return res
