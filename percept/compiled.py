@@ -52,3 +52,61 @@ def kernel(**options) -> Callable[[Callable], Callable]:
         call.dispatcher = dispatcher
         return call
     return wrap
+
+
+@njit(cache=True)
+def _pairwise_leaf(a, lo, n):  # pragma: no cover - compiled
+    """numpy's sum of a run of at most 128: up to 8 sequentially, more in eight interleaved partial sums."""
+    if n < 8:
+        res = a.dtype.type(0)
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - n % 8:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True)
+def pairwise_sum(a, lo, n):  # pragma: no cover - compiled
+    """``np.sum`` of ``a[lo:lo + n]`` (1-D, contiguous) bit for bit: numpy's pairwise summation in the array's own
+    type (numpy/_core/src/umath/loops_utils.h.src, ``pairwise_sum``): a run longer than 128 is the sum of its two
+    halves, split at a multiple of 8. numpy recurses; this walks the same tree with a stack (numba does not cache
+    recursive functions safely: loaded from its cache, one crashed)."""
+    # tasks (start, length, halves done?) and the partial sums, post-order: left half, right half, then their sum
+    starts, lengths, combine = np.empty(128, np.int64), np.empty(128, np.int64), np.empty(128, np.bool_)
+    sums = np.empty(64, a.dtype)
+    top, filled = 0, 0
+    starts[0], lengths[0], combine[0] = lo, n, False
+    while top >= 0:
+        s, m, c = starts[top], lengths[top], combine[top]
+        top -= 1
+        if c:
+            filled -= 1
+            sums[filled - 1] = sums[filled - 1] + sums[filled]
+        elif m <= 128:
+            sums[filled] = _pairwise_leaf(a, s, m)
+            filled += 1
+        else:
+            half = m // 2
+            half -= half % 8
+            starts[top + 1], lengths[top + 1], combine[top + 1] = s, m, True
+            starts[top + 2], lengths[top + 2], combine[top + 2] = s + half, m - half, False
+            starts[top + 3], lengths[top + 3], combine[top + 3] = s, half, False
+            top += 3
+    return sums[0]

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from percept.compiled import kernel
+
 from .quantiles import median
 
 
@@ -66,27 +68,14 @@ class GroundPlane:
         self.frames += 1
         if (self.frames - 1) % cfg.every_frames:
             return
-        # only the range cells the fit can use (the cells of the cell test below)
-        lo = np.floor(cfg.min_range_m / cfg.cell_m) * cfg.cell_m
-        hi = (np.floor(cfg.max_range_m / cfg.cell_m) + 1) * cfg.cell_m
-        sel = (points[:, 0] >= lo) & (points[:, 0] < hi)
-        points, u_px = points[sel], u_px[sel]
-        x, y, z = points[:, 0], points[:, 1], points[:, 2]
-        h = z - self._plane(x)
-        near = ((x > cfg.min_range_m) & (x < cfg.max_range_m) & (np.abs(y) < cfg.half_width_m)
-                & (np.abs(h) < cfg.band_m))
-        # not the low parts of what stands on the road (bumpers, tyres): no point in a cell (image columns x range)
-        # that also holds a point standing above the band
-        cell_u, cell_x = (u_px // cfg.cell_px).astype(int), np.floor(x / cfg.cell_m).astype(int)
-        up = (h > cfg.band_m) & (h < cfg.max_standing_m) & (x > 0)
-        key = cell_u * 100003 + cell_x
-        near &= ~np.isin(key, key[up])
-        k = np.floor((x[near] - cfg.min_range_m) / cfg.bin_m).astype(int)
+        x, zs = _road_points(points, np.asarray(u_px, np.float32), self.offset_m, self.slope, cfg.band_m,
+                             cfg.min_range_m, cfg.max_range_m, cfg.half_width_m, np.float32(cfg.cell_px), cfg.cell_m,
+                             cfg.max_standing_m)
+        k = np.floor((x - cfg.min_range_m) / cfg.bin_m).astype(int)
         counts = np.bincount(k)
         bins = np.flatnonzero(counts >= cfg.min_points)
         if len(bins) < 4:
             return
-        zs = z[near]
         med = np.array([median(zs[k == b]) for b in bins])
         xc = cfg.min_range_m + (bins + 0.5) * cfg.bin_m
         # least squares z = a + b x through the bins' medians
@@ -99,3 +88,54 @@ class GroundPlane:
     def height(self, points: np.ndarray) -> np.ndarray:
         """Height above the road of vehicle-frame points (N, 3) [m]: above the fitted plane once it is applied."""
         return points[:, 2] - self._plane(points[:, 0]) if self.active else points[:, 2]
+
+
+@kernel()
+def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, cell_px, cell_m,
+                 max_standing):  # pragma: no cover - compiled
+    """The ranges x and heights z (N,) float64 of the points (N, 3) [m] that lie on the road plane z = offset +
+    slope x: within ``band`` of it, x in (x_min, x_max), |y| < half_width, and in no cell (image column // cell_px
+    x range // cell_m) that also holds a point standing band..max_standing above it at x > 0, among the points
+    of the range cells the fit uses. In numpy's arithmetic (column // cell_px is float32 floor division)."""
+    lo = np.floor(x_min / cell_m) * cell_m
+    hi = (np.floor(x_max / cell_m) + 1) * cell_m
+    n = points.shape[0]
+    h, cu, cx = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
+    inside = np.zeros(n, np.bool_)
+    u_lo, u_hi, x_lo, x_hi = 1 << 40, -(1 << 40), 1 << 40, -(1 << 40)
+    for i in range(n):
+        x = points[i, 0]
+        if not (x >= lo and x < hi):
+            continue
+        inside[i] = True
+        h[i] = points[i, 2] - (offset + slope * x)
+        # numpy's float32 floor division: (u - fmod(u, c)) / c, floored, one down if fmod's sign differs from c's
+        u = u_px[i]
+        mod = np.fmod(u, cell_px)
+        div = (u - mod) / cell_px
+        if mod != 0 and (cell_px < 0) != (mod < 0):
+            div -= np.float32(1.0)
+        fl = np.floor(div)
+        if div - fl > np.float32(0.5):
+            fl += np.float32(1.0)
+        cu[i], cx[i] = np.int64(fl), np.int64(np.floor(x / cell_m))
+        if h[i] > band and h[i] < max_standing and x > 0:
+            u_lo, u_hi, x_lo, x_hi = min(u_lo, cu[i]), max(u_hi, cu[i]), min(x_lo, cx[i]), max(x_hi, cx[i])
+    standing = np.zeros((max(u_hi - u_lo + 1, 0), max(x_hi - x_lo + 1, 0)), np.bool_)
+    for i in range(n):
+        if inside[i] and h[i] > band and h[i] < max_standing and points[i, 0] > 0:
+            standing[cu[i] - u_lo, cx[i] - x_lo] = True
+    xs, zs = np.empty(n), np.empty(n)
+    m = 0
+    for i in range(n):
+        if not inside[i]:
+            continue
+        x = points[i, 0]
+        if not (x > x_min and x < x_max and abs(points[i, 1]) < half_width and abs(h[i]) < band):
+            continue
+        a, b = cu[i] - u_lo, cx[i] - x_lo
+        if 0 <= a < standing.shape[0] and 0 <= b < standing.shape[1] and standing[a, b]:
+            continue
+        xs[m], zs[m] = x, points[i, 2]
+        m += 1
+    return xs[:m], zs[:m]

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from percept.compiled import kernel, pairwise_sum
+
 
 @dataclass(frozen=True)
 class Refined:
@@ -88,24 +90,40 @@ class PatchAligner:
             if float(np.float32(u0) - np.float32(d)) < 1 or float(np.float32(u1 - 1) - np.float32(d)) > w - 2:
                 return None
             both = cv2.remap(self.right_gx, self.uu - d, self.vv, cv2.INTER_CUBIC)
-            Rw, g = both[..., 0], both[..., 1]
-            r = L - Rw
-            # Huber weights: w = 1 inside the threshold, k / |r| outside
-            a = np.abs(r)
-            wts = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-6)) * keep
-            H = float(np.sum(wts * g * g))
+            H, wgr, wrr = (float(s) for s in _weighted_sums(L, both, keep, np.float32(huber)))
             if H < 1e-3:
                 return None
             # Gauss-Newton: delta = -sum(w g r) / sum(w g^2)
-            step = -float(np.sum(wts * g * r)) / H
+            step = -wgr / H
             d += min(max(step, -1.0), 1.0)
             if abs(step) < tol:
                 converged = True
                 break
         n = int(keep.sum())
         # standard error of the estimate: sigma^2 = sum(w r^2) / (n - 1) / sum(w g^2)
-        s2 = float(np.sum(wts * r * r)) / max(n - 1, 1) / H
+        s2 = wrr / max(n - 1, 1) / H
         return Refined(d, float(np.sqrt(s2)), n, converged)
+
+
+@kernel()
+def _weighted_sums(L, both, keep, huber):  # pragma: no cover - compiled
+    """sum(w g^2), sum(w g r), sum(w r^2) over the patch, float32, for the residual r = L - R and Huber weights
+    w = (1 if |r| <= huber else huber / max(|r|, 1e-6)) x keep, with R, g the two channels of ``both`` (h, w, 2): the
+    float32 arrays numpy made of those products, summed as numpy sums them (``pairwise_sum``), so equal bit for bit."""
+    h, w = L.shape
+    n = h * w
+    wgg, wgr, wrr = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
+    eps = np.float32(1e-6)
+    for y in range(h):
+        for x in range(w):
+            g = both[y, x, 1]
+            r = L[y, x] - both[y, x, 0]
+            a = abs(r)
+            wt = np.float32(1.0) if a <= huber else huber / max(a, eps)
+            wt = wt * np.float32(keep[y, x])
+            k = y * w + x
+            wgg[k], wgr[k], wrr[k] = wt * g * g, wt * g * r, wt * r * r
+    return pairwise_sum(wgg, 0, n), pairwise_sum(wgr, 0, n), pairwise_sum(wrr, 0, n)
 
 
 def refine_disparity(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int], mask: np.ndarray | None,

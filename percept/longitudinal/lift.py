@@ -1,0 +1,59 @@
+"""Matched stereo pixels lifted to the vehicle frame in one compiled pass over a band's disparity map.
+
+The numpy it replaces (kept as the reference in tests/longitudinal/test_lift.py) took five passes and as many
+temporaries over the ~7 000 matches of a frame: the mask of matched pixels, the gathers of their columns, rows and
+rays, the depth, the range cut and the lift. The arithmetic is numpy's, operation for operation and type for type,
+so the points are the same bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from percept.compiled import kernel
+
+
+def lift_band(d16: np.ndarray, c0: int, skip: int, u: np.ndarray, v: np.ndarray, rays: np.ndarray, fb_scaled: float,
+              z_min_m: float, z_max_m: float, origin: np.ndarray):
+    """The matches of one band within the range (z_min_m, z_max_m), in row-major order.
+
+    d16: (rows, c1 - c0) int16 StereoBM disparities (16 x pixels at the band's scale) of the band's columns c0..c1;
+    skip: its first columns that had no room to search (left out); u, v: (rows, w) float32 full-resolution pixel
+    centres of the band's pixels; rays: (rows, w, 3) float32 their rays in the vehicle frame; fb_scaled: f b x 16 x
+    the band's scale, so that Z = fb_scaled / d16 [m]; origin: (3,) float64 the left camera in the vehicle frame [m].
+
+    Returns u, v (N,) float32 [px], Z (N,) float32 [m] and the points (N, 3) float64 [m]: p = ray Z + origin.
+    Comparisons and the depth are in float32 (numpy's rule for a Python float against a float32 array), the ray
+    times the depth in float32 and the sum with the float64 origin in float64.
+    """
+    return _lift(d16, int(c0), int(skip), u, v, rays, np.float32(fb_scaled), np.float32(z_min_m), np.float32(z_max_m),
+                 np.asarray(origin, np.float64))
+
+
+@kernel()
+def _lift(d16, c0, skip, u, v, rays, k, z_min, z_max, origin):  # pragma: no cover - compiled
+    rows, cols = d16.shape
+    n = 0
+    for r in range(rows):
+        for j in range(skip, cols):
+            if d16[r, j] > 0:
+                n += 1
+    uo, vo, zo = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
+    po = np.empty((n, 3), np.float64)
+    m = 0
+    for r in range(rows):
+        for j in range(skip, cols):
+            d = d16[r, j]
+            if d <= 0:
+                continue
+            # Z = f b 16 s / d16
+            z = k / np.float32(d)
+            if not (z > z_min and z < z_max):
+                continue
+            x = c0 + j
+            uo[m], vo[m], zo[m] = u[r, x], v[r, x], z
+            for a in range(3):
+                # p = ray Z + origin: the product in float32, the sum in float64
+                po[m, a] = np.float64(rays[r, x, a] * z) + origin[a]
+            m += 1
+    return uo[:m], vo[:m], zo[:m], po[:m]

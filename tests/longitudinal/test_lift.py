@@ -1,0 +1,112 @@
+"""The compiled passes of the obstacle finder and the disparity refinement against the numpy they replaced: the same
+results, bit for bit."""
+
+import numpy as np
+import pytest
+
+from percept.compiled import pairwise_sum
+from percept.longitudinal.ground import GroundConfig, _road_points
+from percept.longitudinal.lift import lift_band
+from percept.longitudinal.refine import _weighted_sums
+
+
+def _numpy_lift(d16, c0, skip, u, v, rays, fb_scaled, z_min, z_max, origin):
+    """The finder's numpy before the kernel: mask, gathers, depth, range cut, lift."""
+    c1 = c0 + d16.shape[1]
+    ok = d16 > 0
+    ok[:, :skip] = False
+    z = fb_scaled / d16[ok].astype(np.float32)
+    sl = (slice(None), slice(c0, c1))
+    uu, vv, rr = u[sl][ok], v[sl][ok], rays[sl][ok]
+    keep = (z > z_min) & (z < z_max)
+    return uu[keep], vv[keep], z[keep], rr[keep] * z[keep][:, None] + origin
+
+
+@pytest.mark.parametrize("c0, skip", [(0, 0), (37, 48), (90, 5)])
+def test_lifted_matches_equal_numpys_bit_for_bit(c0, skip):
+    rng = np.random.default_rng(c0)
+    rows, w, cols = 23, 200, 101
+    # disparities of every sign, many unmatched (<= 0), some so small or large that the range cut drops them
+    d16 = rng.integers(-20, 800, size=(rows, cols)).astype(np.int16)
+    u = rng.uniform(0, 640, (rows, w)).astype(np.float32)
+    v = rng.uniform(0, 480, (rows, w)).astype(np.float32)
+    rays = rng.normal(size=(rows, w, 3)).astype(np.float32)
+    origin = np.array([0.8, 0.27, 1.4])
+    fb_scaled = 480.0 * 0.3 * 16.0 * 0.37  # not a float32: rounded once, as numpy rounds a Python float
+    ref = _numpy_lift(d16, c0, skip, u, v, rays, fb_scaled, 3.3, 100.0, origin)
+    got = lift_band(d16, c0, skip, u, v, rays, fb_scaled, 3.3, 100.0, origin)
+    assert 0 < len(got[0]) < int((d16 > 0).sum())  # the cut dropped some matches and kept others
+    for a, b in zip(ref, got):
+        assert a.dtype == b.dtype and a.shape == b.shape
+        assert a.tobytes() == b.tobytes()
+
+
+def _numpy_road_points(points, u_px, offset, slope, cfg):
+    lo = np.floor(cfg.min_range_m / cfg.cell_m) * cfg.cell_m
+    hi = (np.floor(cfg.max_range_m / cfg.cell_m) + 1) * cfg.cell_m
+    sel = (points[:, 0] >= lo) & (points[:, 0] < hi)
+    points, u_px = points[sel], u_px[sel]
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    h = z - (offset + slope * x)
+    near = (x > cfg.min_range_m) & (x < cfg.max_range_m) & (np.abs(y) < cfg.half_width_m) & (np.abs(h) < cfg.band_m)
+    cell_u, cell_x = (u_px // cfg.cell_px).astype(int), np.floor(x / cfg.cell_m).astype(int)
+    up = (h > cfg.band_m) & (h < cfg.max_standing_m) & (x > 0)
+    key = cell_u * 100003 + cell_x
+    near &= ~np.isin(key, key[up])
+    return x[near], z[near]
+
+
+@pytest.mark.parametrize("cell_px", [16, 12])
+def test_road_points_equal_numpys(cell_px):
+    cfg = GroundConfig(cell_px=cell_px)
+    rng = np.random.default_rng(cell_px)
+    n = 5000
+    # points 0-25 m ahead, mostly on a slightly tilted road, some standing (an obstacle's low parts share cells)
+    x = rng.uniform(0, 25, n)
+    z = 0.05 + 0.01 * x + rng.normal(0, 0.2, n)
+    standing = rng.random(n) < 0.05
+    z[standing] += rng.uniform(0.5, 4.0, int(standing.sum()))
+    points = np.column_stack([x, rng.uniform(-8, 8, n), z])
+    u_px = rng.uniform(0, 639.5, n).astype(np.float32)
+    u_px[:50] = np.float32(cell_px) * rng.integers(0, 40, 50)  # on cell boundaries
+    offset, slope = 0.03, 0.012
+    ref = _numpy_road_points(points, u_px, offset, slope, cfg)
+    got = _road_points(points, u_px, offset, slope, cfg.band_m, cfg.min_range_m, cfg.max_range_m, cfg.half_width_m,
+                       np.float32(cfg.cell_px), cfg.cell_m, cfg.max_standing_m)
+    assert 100 < len(ref[0]) < n
+    for a, b in zip(ref, got):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def test_no_points_give_no_road_points():
+    got = _road_points(np.zeros((0, 3)), np.zeros(0, np.float32), 0.0, 0.0, 0.5, 4.0, 16.0, 6.0, np.float32(16), 3.0,
+                       3.5)
+    assert got[0].shape == (0,) and got[1].shape == (0,)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_pairwise_sum_equals_numpys_sum_at_every_length(dtype):
+    """numpy sums a contiguous array pairwise; a sequential sum of the same float32 values differs in the last bits
+    at a few hundred elements already, so this tells the two apart."""
+    rng = np.random.default_rng(7)
+    sequential_differs = 0
+    for n in [*range(0, 300), 1000, 1031, 4096, 8191, 8192, 8193, 20011]:
+        a = (rng.normal(size=n) * 37.0).astype(dtype)
+        assert pairwise_sum(a, 0, n) == np.sum(a), n
+        sequential_differs += dtype == np.float32 and n > 200 and float(np.cumsum(a)[-1]) != float(np.sum(a))
+    assert dtype == np.float64 or sequential_differs > 0
+
+
+def test_gauss_newton_sums_equal_numpys():
+    rng = np.random.default_rng(3)
+    L = rng.uniform(0, 255, (17, 45)).astype(np.float32)
+    both = np.stack([L + rng.normal(0, 9, L.shape), rng.normal(0, 20, L.shape)], axis=-1).astype(np.float32)
+    keep = rng.random(L.shape) < 0.8
+    r = L - both[..., 0]
+    a = np.abs(r)
+    wts = np.where(a <= 6.0, 1.0, 6.0 / np.maximum(a, 1e-6)) * keep
+    g = both[..., 1]
+    got = _weighted_sums(L[:, 2:40], both[:, 2:40], keep[:, 2:40], np.float32(6.0))
+    ref = tuple(np.sum(x[:, 2:40]) for x in (wts * g * g, wts * g * r, wts * r * r))
+    assert all(x.dtype == np.float32 for x in ref)
+    assert got == ref
