@@ -16,6 +16,7 @@ from enum import Enum
 import cv2
 import numpy as np
 
+from percept.compiled import kernel
 from percept.sensors import Side, StereoRig
 
 from .types import MarkingEvidence
@@ -134,29 +135,55 @@ class MarkingExtractor:
         # top-hat: centre mean minus the brighter of the two flank means at 1.5 widths (the flank means are the
         # same box means shifted by s columns; the s columns at each side get no response)
         centre = cv2.blur(b, (w, 1))
-        s = int(round(1.5 * w)) + 1
-        resp = np.zeros_like(centre)
-        inner = resp[:, s:-s]
-        np.maximum(centre[:, :-2 * s], centre[:, 2 * s:], out=inner)
-        np.subtract(centre[:, s:-s], inner, out=inner)
-        resp *= self.valid_f
-        strong = resp[resp > self.cfg.min_contrast]
+        resp, strong = _top_hat(centre, int(round(1.5 * w)) + 1, self.valid_f, np.float32(self.cfg.min_contrast))
         if strong.size:
             # 90th percentile of the strong responses
             k = int(0.9 * (strong.size - 1))
             thr = max(self.cfg.min_contrast, self.cfg.rel_contrast * float(np.partition(strong, k)[k]))
         else:
             thr = np.inf
-        # one point per stripe per row: local maxima along the row above the threshold (tested at the few
-        # pixels above it)
-        r, c = np.nonzero(resp[:, 1:-1] > thr)
-        c += 1
+        # one point per stripe per row: local maxima along the row above the threshold
+        r, c = _row_peaks(resp, np.float32(thr))
         v = resp[r, c]
-        keep = (v >= resp[r, c - 1]) & (v > resp[r, c + 1])
-        r, c = r[keep], c[keep]
         pts = np.column_stack([self.x[r], self.y[c]])
-        ev = MarkingEvidence(pts, v[keep], self.uv[r, c], self.row_weight[r])
+        ev = MarkingEvidence(pts, v, self.uv[r, c], self.row_weight[r])
         if self.cfg.vehicles is None:
             return ev
         boxes = find_vehicles(image, self.rig, self.cfg.max_row_px, self.cfg.vehicles)
         return replace(mask_evidence(ev, boxes, self.rig.horizon_row, self.cfg.vehicles.pad), vehicles=tuple(boxes))
+
+
+@kernel()
+def _top_hat(centre, s, valid, min_contrast):  # pragma: no cover - compiled
+    """The top-hat response (rows, cols) float32 of the box means ``centre``: centre - max(centre s columns left,
+    centre s columns right), times ``valid`` (0 in the s columns at each side), and the responses above
+    ``min_contrast`` in row-major order (numpy's ``resp[resp > min_contrast]``). float32 throughout, as numpy."""
+    rows, cols = centre.shape
+    resp = np.zeros((rows, cols), np.float32)
+    strong = np.empty(rows * cols, np.float32)
+    n = 0
+    for y in range(rows):
+        for x in range(cols):
+            if s <= x < cols - s:
+                resp[y, x] = centre[y, x] - max(centre[y, x - s], centre[y, x + s])
+            resp[y, x] *= valid[y, x]
+            if resp[y, x] > min_contrast:
+                strong[n] = resp[y, x]
+                n += 1
+    return resp, strong[:n]
+
+
+@kernel()
+def _row_peaks(resp, thr):  # pragma: no cover - compiled
+    """Rows and columns (N,) of the pixels above ``thr`` that are a maximum along their row (>= the left neighbour,
+    > the right one), columns 1..cols - 2, in row-major order."""
+    rows, cols = resp.shape
+    r, c = np.empty(rows * cols, np.int64), np.empty(rows * cols, np.int64)
+    n = 0
+    for y in range(rows):
+        for x in range(1, cols - 1):
+            v = resp[y, x]
+            if v > thr and v >= resp[y, x - 1] and v > resp[y, x + 1]:
+                r[n], c[n] = y, x
+                n += 1
+    return r[:n], c[:n]
