@@ -13,6 +13,7 @@ import numpy as np
 from percept.sensors import StereoRig
 
 from . import condition_passes as passes
+from .normals import standard_normal_f32
 
 
 class Condition(str, Enum):
@@ -185,7 +186,7 @@ class ConditionEffects:
             if emission is None:
                 emission = ((img[..., 2] > 180) & (img[..., 1] < 90)).astype(np.float32)
             out = self._night(img, self._night_gain(inv_depth, camera), emission)
-            n = rng.standard_normal(out.shape[:2], dtype=np.float32, out=self._scratch("noise"))
+            n = standard_normal_f32(rng, self._scratch("noise"))
             # out + 3 n on every channel, clipped and truncated to uint8
             return passes.with_noise_uint8(out, n, np.float32(3.0))
         elif c is Condition.RAIN:
@@ -193,7 +194,7 @@ class ConditionEffects:
         elif c is Condition.GLARE:
             out = self._glare(img)
         else:  # NOISE
-            n = rng.standard_normal(img.shape, dtype=np.float32, out=self._scratch("out", 3))
+            n = standard_normal_f32(rng, self._scratch("out", 3))
             # out = f + 10 n, then a row banding of 3 n_row, clipped and truncated to uint8
             return passes.noisy_uint8(img, n, np.float32(3.0) * rng.standard_normal((self.H, 1), dtype=np.float32))
         # rain and glare: numpy's clip and cast (a compiled pass for them alone measured no faster; the night's and the
