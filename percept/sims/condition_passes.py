@@ -97,9 +97,12 @@ def hazy(blurred, scale, haze, streaks, out):  # pragma: no cover - compiled
 @kernel()
 def through_drops(out, d, blurred):  # pragma: no cover - compiled
     """Drops on the windscreen, in place: out = out (1 - 0.6 d) + 0.6 d ``blurred`` (out, blurred (H, W, 3), d (H, W),
-    float32), each product and sum in float32 as OpenCV's whole-image steps did."""
+    float32), each product and sum in float32 as OpenCV's whole-image steps did. Where d is 0 (most of the image)
+    that is out x 1 + 0 x blurred = out (out >= 0, blurred finite), so those pixels are left as they are."""
     for y in range(out.shape[0]):
         for x in range(out.shape[1]):
+            if d[y, x] == 0:
+                continue
             a = d[y, x] * np.float32(0.6)
             keep = np.float32(1) - a
             for ch in range(3):
