@@ -63,7 +63,10 @@ class GroundPlane:
         return self.offset_m + self.slope * x
 
     def update(self, points: np.ndarray, u_px: np.ndarray) -> None:
-        """Refine from vehicle-frame points (N, 3) and their image columns (N,) [px] (every ``every_frames``)."""
+        """Refine from vehicle-frame points (N, 3) and their image columns (N,) [px] (every ``every_frames``; the
+        columns are taken as float32, the finder's pixel centres)."""
+        if np.shape(points)[1:] != (3,) or len(points) != len(u_px):
+            raise ValueError(f"need points (N, 3) and columns (N,), got {np.shape(points)} and {np.shape(u_px)}")
         cfg = self.cfg
         self.frames += 1
         if (self.frames - 1) % cfg.every_frames:

@@ -26,6 +26,10 @@ def lift_band(d16: np.ndarray, c0: int, skip: int, u: np.ndarray, v: np.ndarray,
     Comparisons and the depth are in float32 (numpy's rule for a Python float against a float32 array), the ray
     times the depth in float32 and the sum with the float64 origin in float64.
     """
+    fits = d16.shape[0] == u.shape[0] and c0 + d16.shape[1] <= u.shape[1]
+    if u.shape != v.shape or rays.shape != (*u.shape, 3) or not fits:
+        raise ValueError(f"disparities {d16.shape} at column {c0} do not fit the band's pixels {u.shape} and rays "
+                         f"{rays.shape}")
     return _lift(d16, int(c0), int(skip), u, v, rays, np.float32(fb_scaled), np.float32(z_min_m), np.float32(z_max_m),
                  np.asarray(origin, np.float64))
 

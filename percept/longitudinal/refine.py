@@ -90,6 +90,8 @@ class PatchAligner:
             if float(np.float32(u0) - np.float32(d)) < 1 or float(np.float32(u1 - 1) - np.float32(d)) > w - 2:
                 return None
             both = cv2.remap(self.right_gx, self.uu - d, self.vv, cv2.INTER_CUBIC)
+            if both.shape[:2] != L.shape or keep.shape != L.shape:
+                raise ValueError(f"mask {keep.shape} and box {both.shape[:2]} must match the patch {L.shape}")
             H, wgr, wrr = (float(s) for s in _weighted_sums(L, both, keep, np.float32(huber)))
             if H < 1e-3:
                 return None

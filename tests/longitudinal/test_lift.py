@@ -110,3 +110,15 @@ def test_gauss_newton_sums_equal_numpys():
     ref = tuple(np.sum(x[:, 2:40]) for x in (wts * g * g, wts * g * r, wts * r * r))
     assert all(x.dtype == np.float32 for x in ref)
     assert got == ref
+
+
+def test_mismatched_inputs_raise_instead_of_reading_past_the_arrays():
+    u = np.zeros((4, 10), np.float32)
+    with pytest.raises(ValueError, match="do not fit the band"):
+        lift_band(np.ones((4, 8), np.int16), 5, 0, u, u, np.zeros((4, 10, 3), np.float32), 1.0, 0.0, 10.0, np.zeros(3))
+    from percept.longitudinal import GroundPlane, PatchAligner
+    with pytest.raises(ValueError, match=r"points \(N, 3\) and columns \(N,\)"):
+        GroundPlane().update(np.zeros((5, 3)), np.zeros(4, np.float32))
+    img = np.random.default_rng(0).uniform(0, 255, (20, 60)).astype(np.float32)
+    with pytest.raises(ValueError, match="must match the patch"):
+        PatchAligner(img, img, (20, 2, 40, 12)).refine(np.ones((5, 5), bool), 4.0)
