@@ -116,6 +116,10 @@ class MarkingExtractor:
         # grid -> image lookup for cv2.remap, in OpenCV's fast fixed-point form; rows below max_row_px read black
         uv = np.where(self.valid[..., None], self.uv, -10.0).astype(np.float32)
         self.map1, self.map2 = cv2.convertMaps(uv[..., 0], uv[..., 1], cv2.CV_16SC2)
+        # the compiled passes (compiled once after an install) loaded now, on a grid's argument types, not in a timed
+        # frame
+        resp, _ = _top_hat(np.zeros(self.valid_f.shape, np.float32), 2, self.valid_f, np.float32(cfg.min_contrast))
+        _row_peaks(resp, np.float32(np.inf))
 
     def birdseye(self, image: np.ndarray) -> np.ndarray:
         """Top-down marking brightness (rows, cols) float32; rows go from near to far."""

@@ -136,6 +136,11 @@ class ObstacleFinder:
         self.c = rig.camera_position(Side.LEFT)
         self.x_far = np.linspace(cfg.near_m, cfg.max_range_m, 24) + rig.mount_x_m
         self.ground = GroundPlane(cfg.ground)
+        # the compiled passes (compiled once after an install) loaded now, on a frame's argument types, not in a timed
+        # frame: a black frame matches nothing, and the plane fit it starts is forgotten
+        black = np.zeros((cam.height, cam.width), np.uint8)
+        self.find(black, black, EgoPath.straight(0.0))
+        self.reset()
 
     def reset(self) -> None:
         self.ground.reset()

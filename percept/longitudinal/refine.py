@@ -128,6 +128,13 @@ def _weighted_sums(L, both, keep, huber):  # pragma: no cover - compiled
     return pairwise_sum(wgg, 0, n), pairwise_sum(wgr, 0, n), pairwise_sum(wrr, 0, n)
 
 
+def warm_up_refinement() -> None:
+    """The refinement's compiled sums loaded now (compiled once after an install), on a frame's argument types: the
+    patch a view of a wider crop, its mask an array of its own."""
+    ramp = np.tile(np.arange(24, dtype=np.float32) * 9, (6, 1))
+    PatchAligner(ramp, ramp, (4, 0, 20, 6)).refine(np.ones((6, 16), bool), 2.0, iterations=1)
+
+
 def refine_disparity(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int], mask: np.ndarray | None,
                      d0: float, iterations: int = 10, huber: float = 6.0, tol: float = 1e-3) -> Refined | None:
     """Disparity [px] of the pixels of ``box`` (u0, v0, u1, v1) in ``mask`` ((v1-v0, u1-u0) bool, None = all),

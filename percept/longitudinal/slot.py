@@ -25,7 +25,7 @@ from percept.sensors import EgoMotionGate, EgoPath, Frame, Lead, ObjectKind, Ste
 from .contact import Contact, ContactConfig, ContactRange
 from .flow import Expansion, ExpansionTracker, FlowConfig
 from .obstacles import Obstacle, ObstacleConfig, ObstacleFinder
-from .refine import PatchAligner, Refined, surface_mask
+from .refine import PatchAligner, Refined, surface_mask, warm_up_refinement
 
 
 _RANGE = np.array([[1.0, 0.0, 0.0]])
@@ -100,6 +100,7 @@ class LongitudinalSlot:
         self.flow = ExpansionTracker(cfg.flow)
         self.fb = rig.camera.fx * rig.baseline_m
         self.motion = EgoMotionGate()
+        warm_up_refinement()
         self.reset()
 
     def reset(self) -> None:

@@ -122,3 +122,38 @@ def test_mismatched_inputs_raise_instead_of_reading_past_the_arrays():
     img = np.random.default_rng(0).uniform(0, 255, (20, 60)).astype(np.float32)
     with pytest.raises(ValueError, match="must match the patch"):
         PatchAligner(img, img, (20, 2, 40, 12)).refine(np.ones((5, 5), bool), 4.0)
+
+
+WARM_CHECK = """
+import cv2
+from percept.drive import bench as B
+from percept.drive.tasks import TASKS
+from percept.lanes import evidence
+from percept.longitudinal import ground, lift, refine
+from percept.sims import SimWorld, WorldConfig
+from percept.sims.coords import hw_pose
+kernels = [k.dispatcher for m in (evidence, ground, lift, refine) for k in vars(m).values() if hasattr(k, "dispatcher")]
+world = SimWorld(WorldConfig("lead-brake", seed=1, autopilot=True))
+ctx = B.SlotContext(world.cfg.rig, world.dt, None, B.TruthFeed(), start_pose=hw_pose(world.ego))
+slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lateral", "longitudinal")}
+before = [len(k.signatures) for k in kernels]
+refined = 0
+for _ in range(45):
+    frame, _ = world.observe()
+    path = slots["lateral"].step(frame, {})[0]
+    refined += slots["longitudinal"].step(frame, {"lateral": path})[1].refined is not None
+    world.step()
+print(len(kernels), min(before), refined, [len(k.signatures) for k in kernels] == before)
+"""
+
+
+def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
+    import subprocess
+    import sys
+
+    # in a fresh process (this one has called the kernels above already)
+    out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    count, least, refined, unchanged = out.stdout.split()
+    # every kernel loaded by the slots' construction; the lead was refined, so every pass ran in the frames
+    assert int(count) == 5 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"
