@@ -107,9 +107,9 @@ def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
 
 
 WARM_CHECK = """
-from percept.sims import SimWorld, WorldConfig, condition_passes, conditions
+from percept.sims import SimWorld, WorldConfig, condition_passes, conditions, normals
 from percept.sims.render import cull, ground, paint, pedestrian, pixels, spans
-modules = (pixels, cull, spans, pedestrian, ground, paint, condition_passes)
+modules = (pixels, cull, spans, pedestrian, ground, paint, condition_passes, normals)
 kernels = [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
 # the world's renderer and its night effects warm their kernels up when they are built, and so do the other
 # conditions' effects
