@@ -110,3 +110,18 @@ def pairwise_sum(a, lo, n):  # pragma: no cover - compiled
             starts[top + 3], lengths[top + 3], combine[top + 3] = s, half, False
             top += 3
     return sums[0]
+
+
+@njit(cache=True)
+def floor_divide(a, b):  # pragma: no cover - compiled
+    """``a // b`` for floats of one type, as numpy computes it (``npy_divmod``): (a - fmod(a, b)) / b, one less when
+    fmod's sign differs from b's, floored and rounded up from above .5; b != 0."""
+    one = b / b  # 1 in b's own type: a Python 1 would turn float32 arithmetic into float64
+    mod = np.fmod(a, b)
+    div = (a - mod) / b
+    if mod != 0 and (b < 0) != (mod < 0):
+        div -= one
+    fl = np.floor(div)
+    if div - fl > one / (one + one):
+        fl += one
+    return fl

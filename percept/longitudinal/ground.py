@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from percept.compiled import kernel
+from percept.compiled import floor_divide, kernel
 
 from .quantiles import median
 
@@ -112,16 +112,8 @@ def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, ce
             continue
         inside[i] = True
         h[i] = points[i, 2] - (offset + slope * x)
-        # numpy's float32 floor division: (u - fmod(u, c)) / c, floored, one down if fmod's sign differs from c's
-        u = u_px[i]
-        mod = np.fmod(u, cell_px)
-        div = (u - mod) / cell_px
-        if mod != 0 and (cell_px < 0) != (mod < 0):
-            div -= np.float32(1.0)
-        fl = np.floor(div)
-        if div - fl > np.float32(0.5):
-            fl += np.float32(1.0)
-        cu[i], cx[i] = np.int64(fl), np.int64(np.floor(x / cell_m))
+        # numpy's float32 floor division of the column by the cell
+        cu[i], cx[i] = np.int64(floor_divide(u_px[i], cell_px)), np.int64(np.floor(x / cell_m))
         if h[i] > band and h[i] < max_standing and x > 0:
             u_lo, u_hi, x_lo, x_hi = min(u_lo, cu[i]), max(u_hi, cu[i]), min(x_lo, cx[i]), max(x_hi, cx[i])
     standing = np.zeros((max(u_hi - u_lo + 1, 0), max(x_hi - x_lo + 1, 0)), np.bool_)

@@ -10,30 +10,59 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from percept.compiled import floor_divide, kernel
+
 # below this mean intensity (or standard deviation) a frame has nothing to track: dark or featureless
 MIN_CONTRAST_GREY = 2.0
 # FAST's threshold is at least this many times the image's noise sigma (a corner must stand out of the noise)
 NOISE_GAIN = 4.0
-# Immerkaer's noise-estimation kernel, the difference of two Laplacians (blind to planes and ramps), is separable:
-# [[1, -2, 1], [-2, 4, -2], [1, -2, 1]] = [1, -2, 1]^T [1, -2, 1]
-_NOISE_TAPS = np.array([1, -2, 1], np.float32)
 
 
 def noise_sigma(gray: np.ndarray) -> float:
     """The image noise's standard deviation [grey levels], robust to texture and edges: the median absolute
     response to Immerkaer's kernel, on every other pixel (Immerkaer 1996, "Fast noise variance estimation", CVIU
     64(2); the median in place of the mean keeps scene texture out)."""
-    # integer taps on uint8: every response is a whole number within +-16 * 255, exact in int16
-    r = np.abs(cv2.sepFilter2D(gray, cv2.CV_16S, _NOISE_TAPS, _NOISE_TAPS)[1:-1:2, 1:-1:2])
-    if not r.size:
+    if gray.shape[0] < 3 or gray.shape[1] < 3:
         return 0.0  # under 3 x 3 pixels: nothing to measure
-    # the median from the histogram of |r|: the mean of the order statistics (n - 1) // 2 and n // 2, in float32
-    # as numpy's median of the float32 responses gives it
-    below = np.cumsum(np.bincount(r.ravel(), minlength=1))
-    lo, hi = np.searchsorted(below, [(r.size - 1) // 2, r.size // 2], side="right")
+    # the median of |r| from its histogram: the mean of the order statistics (n - 1) // 2 and n // 2, in float32 as
+    # numpy's median of the float32 responses gives it
+    lo, hi = _noise_median_ranks(np.ascontiguousarray(gray, np.uint8))
     med = (np.float32(lo) + np.float32(hi)) / np.float32(2.0)
     # the kernel's gain on white noise is sqrt(36) = 6; 1.4826 MAD = sigma for a normal distribution
     return float(1.4826 * med / 6.0)
+
+
+@kernel()
+def _noise_median_ranks(gray):  # pragma: no cover - compiled
+    """The values of order (n - 1) // 2 and n // 2 of |r| over every other interior pixel (rows and columns 1, 3, ...
+    up to the last but one), r the response to Immerkaer's kernel, the difference of two Laplacians (blind to planes
+    and ramps), [[1, -2, 1], [-2, 4, -2], [1, -2, 1]] = [1, -2, 1]^T [1, -2, 1]: whole numbers within +-16 * 255 (what
+    ``cv2.sepFilter2D`` gave in int16), counted in a histogram."""
+    h, w = gray.shape
+    counts = np.zeros(16 * 255 + 1, np.int64)
+    n = 0
+    for y in range(1, h - 1, 2):
+        for x in range(1, w - 1, 2):
+            r = np.int64(0)
+            for dy in range(3):
+                ty = 1 if dy != 1 else -2
+                row = (np.int64(gray[y + dy - 1, x - 1]) - 2 * np.int64(gray[y + dy - 1, x])
+                       + np.int64(gray[y + dy - 1, x + 1]))
+                r += ty * row
+            counts[abs(r)] += 1
+            n += 1
+    lo_rank, hi_rank = (n - 1) // 2, n // 2
+    lo = hi = -1
+    seen = 0
+    for v in range(counts.size):
+        seen += counts[v]
+        # searchsorted(cumulative counts, rank, side="right"): the first value whose cumulative count exceeds rank
+        if lo < 0 and seen > lo_rank:
+            lo = v
+        if seen > hi_rank:
+            hi = v
+            break
+    return lo, hi
 
 
 def check_intrinsics(K) -> np.ndarray:
@@ -59,16 +88,61 @@ def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], th
     resp = np.float32([k.response for k in kps])
     h, w = gray.shape
     gx, gy = grid
-    cell = (np.minimum(pts[:, 0] * gx // w, gx - 1) + gx * np.minimum(pts[:, 1] * gy // h, gy - 1)).astype(int)
     per_cell = max(1, int(np.ceil(max_corners / (gx * gy))))
-    # strongest first, then the rank of each corner within its cell
-    order = np.lexsort((-resp, cell))
-    c_sorted = cell[order]
-    first = np.searchsorted(c_sorted, c_sorted, side="left")
-    rank = np.arange(len(order)) - first
-    keep = order[rank < per_cell]
+    keep = _strongest_per_cell(pts, resp, gx, gy, w, h, per_cell)
     keep = keep[np.argsort(-resp[keep])][:max_corners]
     return pts[keep]
+
+
+@kernel()
+def _strongest_per_cell(pts, resp, gx, gy, w, h, per_cell):  # pragma: no cover - compiled
+    """Indices of the ``per_cell`` strongest corners (``resp`` (N,) float32) of each of the gx x gy cells of a w x h
+    image, corners (N, 2) float32 [px], cell by cell and strongest first, ties in index order: numpy's
+    ``order = np.lexsort((-resp, cell))`` cut to the first per_cell of each cell, the cell of a corner computed in
+    float32 as numpy does, min(u gx // w, gx - 1) + gx min(v gy // h, gy - 1)."""
+    n = pts.shape[0]
+    fx, fy, fw, fh = np.float32(gx), np.float32(gy), np.float32(w), np.float32(h)
+    cell = np.empty(n, np.int64)
+    for i in range(n):
+        cu = min(floor_divide(pts[i, 0] * fx, fw), np.float32(gx - 1))
+        cv = min(floor_divide(pts[i, 1] * fy, fh), np.float32(gy - 1))
+        cell[i] = np.int64(cu + fx * cv)
+    # the corners of each cell in index order (a counting sort), then each cell's strongest by repeated selection:
+    # the largest response left, the lowest index among equal ones (lexsort's order)
+    ncell = gx * gy
+    starts = np.zeros(ncell + 1, np.int64)
+    for i in range(n):
+        starts[cell[i] + 1] += 1
+    for c in range(ncell):
+        starts[c + 1] += starts[c]
+    members, filled = np.empty(n, np.int64), starts[:-1].copy()
+    for i in range(n):
+        members[filled[cell[i]]] = i
+        filled[cell[i]] += 1
+    taken = np.zeros(n, np.bool_)
+    keep = np.empty(n, np.int64)
+    m = 0
+    for c in range(ncell):
+        for _ in range(min(per_cell, starts[c + 1] - starts[c])):
+            best = -1
+            for k in range(starts[c], starts[c + 1]):
+                i = members[k]
+                if not taken[i] and (best < 0 or resp[i] > resp[best]):
+                    best = i
+            taken[best] = True
+            keep[m] = best
+            m += 1
+    return keep[:m]
+
+
+def warm_up_corners() -> None:
+    """The noise estimate's and the corner selection's compiled passes loaded now (compiled once after an install), on
+    a frame's argument types, not in the first frame."""
+    gray = np.zeros((3, 3), np.uint8)
+    noise_sigma(gray)
+    gray.flags.writeable = False  # a frame's grey image is read-only, a type of its own to numba
+    noise_sigma(gray)
+    _strongest_per_cell(np.zeros((0, 2), np.float32), np.zeros(0, np.float32), 1, 1, 1, 1, 1)
 
 
 def track(prev: np.ndarray, cur: np.ndarray, pts: np.ndarray, win_px: int, levels: int,

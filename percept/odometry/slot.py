@@ -97,13 +97,15 @@ class OdometrySlot:
                 f.predict(w, a, self.dt_s)
             f.update_wheel(v)
         self._frames += 1
-        # the images in grey, shared with the other slots, for VO and the sign search
+        # the left image in grey, shared with the other slots, for VO and the sign search (the right one only where
+        # they read it: a keyframe's stereo matches, a sign's window)
         left = frame.left_gray
         vo = self._visual_odometry(frame, left, upstream, self._prior(w, v))
         sightings: list[LandmarkSighting] = []
         fixes = 0
         if self.finder is not None and left is not None and frame.right is not None:
-            sightings = self.finder.sight(left, frame.right_gray, self.estimate.pose, self.estimate.pose_covariance)
+            sightings = self.finder.sight(left, frame.right_gray_or_bgr(), self.estimate.pose,
+                                          self.estimate.pose_covariance)
             for s in sightings:
                 fixes += self.estimate.update_landmark(self.finder.map.position(s.marker_id)[:2], s.position_v_m[:2],
                                                        s.covariance_xy)
@@ -119,7 +121,7 @@ class OdometrySlot:
         out: it moves); the VO-only chain takes every step, the filters the pose against the last keyframe when the
         keyframe changes (one independent measurement per keyframe span)."""
         lead = upstream.get("longitudinal")
-        step = self.vo.process(left, frame.right_gray, prior, [getattr(lead, "box_px", None)])
+        step = self.vo.process(left, frame.right_gray_or_bgr(), prior, [getattr(lead, "box_px", None)])
         if left is None or frame.right is None:
             self._since_image += 1
             return step  # dropped: the next image's motion is measured from the last image

@@ -19,7 +19,7 @@ import numpy as np
 
 from percept.sensors import to_gray
 
-from .features import check_intrinsics, detect_corners, noise_sigma, pose_covariance, track
+from .features import check_intrinsics, detect_corners, noise_sigma, pose_covariance, track, warm_up_corners
 from .types import VOStep
 
 
@@ -86,6 +86,7 @@ class StereoVO:
             raise ValueError(f"camera_height_m must be positive, got {camera_height_m}")
         self.K, self.baseline_m, self.config = K, float(baseline_m), config
         self.camera_height_m = camera_height_m
+        warm_up_corners()
         self.reset()
 
     def reset(self) -> None:

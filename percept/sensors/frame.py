@@ -79,3 +79,9 @@ class Frame:
     def right_gray(self) -> np.ndarray | None:
         """(H, W) uint8, read-only: ``right`` in grey, converted once."""
         return _read_only_gray(self.right)
+
+    def right_gray_or_bgr(self) -> np.ndarray | None:
+        """``right_gray`` if a slot has converted it already, else ``right`` as it is: for a reader that needs the
+        grey image only now and then (a keyframe, a sign's window) and converts what it reads, so that it shares the
+        conversion when there is one but does not pay for a whole image each frame when there is not."""
+        return self.__dict__.get("right_gray", self.right)

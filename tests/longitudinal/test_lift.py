@@ -130,24 +130,29 @@ from percept.drive import bench as B
 from percept.drive.tasks import TASKS
 from percept.lanes import evidence
 from percept.longitudinal import ground, lift, refine
+from percept.odometry import features
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose
-kernels = [k.dispatcher for m in (evidence, ground, lift, refine) for k in vars(m).values() if hasattr(k, "dispatcher")]
+modules = (evidence, ground, lift, refine, features)
+kernels = [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
 world = SimWorld(WorldConfig("lead-brake", seed=1, autopilot=True))
 ctx = B.SlotContext(world.cfg.rig, world.dt, None, B.TruthFeed(), start_pose=hw_pose(world.ego))
-slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lateral", "longitudinal")}
+slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lateral", "longitudinal", "odometry")}
 before = [len(k.signatures) for k in kernels]
 refined = 0
 for _ in range(45):
     frame, _ = world.observe()
     path = slots["lateral"].step(frame, {})[0]
-    refined += slots["longitudinal"].step(frame, {"lateral": path})[1].refined is not None
+    lead = slots["longitudinal"].step(frame, {"lateral": path})
+    refined += lead[1].refined is not None
+    slots["odometry"].step(frame, {"longitudinal": lead[0]})
     world.step()
 print(len(kernels), min(before), refined, [len(k.signatures) for k in kernels] == before)
 """
 
 
 def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
+    """The lanes', longitudinal and odometry slots' compiled passes."""
     import subprocess
     import sys
 
@@ -155,5 +160,6 @@ def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     count, least, refined, unchanged = out.stdout.split()
-    # every kernel loaded by the slots' construction; the lead was refined, so every pass ran in the frames
-    assert int(count) == 5 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"
+    # every kernel loaded by the slots' construction; the lead was refined (and the odometry started keyframes), so
+    # every pass ran in the frames
+    assert int(count) == 7 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"

@@ -35,3 +35,14 @@ def test_to_gray_takes_grey_or_bgr_and_says_what_else_it_got():
     assert to_gray(np.full((2, 2), 300.0)).tolist() == [[255, 255], [255, 255]]
     with pytest.raises(ValueError, match=r"expected an \(H, W\) or \(H, W, 3\) image, got shape \(2, 2, 4\)"):
         to_gray(np.zeros((2, 2, 4), np.uint8))
+
+
+def test_the_right_image_is_lent_in_grey_once_converted_and_in_colour_before():
+    rng = np.random.default_rng(1)
+    left, right = (rng.integers(0, 256, (8, 12, 3), dtype=np.uint8) for _ in range(2))
+    f = _frame(left, right)
+    # nobody converted it yet: the colour image, not a conversion made for one reader each frame
+    assert f.right_gray_or_bgr() is right
+    grey = f.right_gray
+    assert f.right_gray_or_bgr() is grey
+    assert _frame(None, None).right_gray_or_bgr() is None
