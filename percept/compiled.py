@@ -109,7 +109,8 @@ def pairwise_sum(a, lo, n):  # pragma: no cover - compiled
             starts[top + 2], lengths[top + 2], combine[top + 2] = s + half, m - half, False
             starts[top + 3], lengths[top + 3], combine[top + 3] = s, half, False
             top += 3
-    return sums[0]
+    # numpy's reduction adds the pairwise sum to its identity, +0 (so that a sum of -0s is +0)
+    return a.dtype.type(0) + sums[0]
 
 
 @njit(cache=True)

@@ -98,8 +98,9 @@ def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, ce
                  max_standing):  # pragma: no cover - compiled
     """The ranges x and heights z (N,) float64 of the points (N, 3) [m] that lie on the road plane z = offset +
     slope x: within ``band`` of it, x in (x_min, x_max), |y| < half_width, and in no cell (image column // cell_px
-    x range // cell_m) that also holds a point standing band..max_standing above it at x > 0, among the points
-    of the range cells the fit uses. In numpy's arithmetic (column // cell_px is float32 floor division)."""
+    x range // cell_m) that also holds a point standing band..max_standing above it at x > 0 (not the low parts of
+    what stands on the road: bumpers, tyres), among the points of the range cells the fit uses. In numpy's
+    arithmetic (column // cell_px is float32 floor division)."""
     lo = np.floor(x_min / cell_m) * cell_m
     hi = (np.floor(x_max / cell_m) + 1) * cell_m
     n = points.shape[0]

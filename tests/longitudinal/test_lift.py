@@ -95,6 +95,10 @@ def test_pairwise_sum_equals_numpys_sum_at_every_length(dtype):
         assert pairwise_sum(a, 0, n) == np.sum(a), n
         sequential_differs += dtype == np.float32 and n > 200 and float(np.cumsum(a)[-1]) != float(np.sum(a))
     assert dtype == np.float64 or sequential_differs > 0
+    # a sum of negative zeros is +0 in numpy (its reduction starts from the identity)
+    for n in (3, 8, 200):
+        zeros = np.full(n, -0.0, dtype)
+        assert not np.signbit(pairwise_sum(zeros, 0, n)) and not np.signbit(np.sum(zeros))
 
 
 def test_gauss_newton_sums_equal_numpys():
