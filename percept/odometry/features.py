@@ -19,9 +19,9 @@ NOISE_GAIN = 4.0
 
 
 def noise_sigma(gray: np.ndarray) -> float:
-    """The image noise's standard deviation [grey levels], robust to texture and edges: the median absolute
-    response to Immerkaer's kernel, on every other pixel (Immerkaer 1996, "Fast noise variance estimation", CVIU
-    64(2); the median in place of the mean keeps scene texture out)."""
+    """The noise's standard deviation [grey levels] of ``gray`` ((H, W) uint8), robust to texture and edges: the
+    median absolute response to Immerkaer's kernel, on every other pixel (Immerkaer 1996, "Fast noise variance
+    estimation", CVIU 64(2); the median in place of the mean keeps scene texture out)."""
     if gray.shape[0] < 3 or gray.shape[1] < 3:
         return 0.0  # under 3 x 3 pixels: nothing to measure
     # the median of |r| from its histogram: the mean of the order statistics (n - 1) // 2 and n // 2, in float32 as
