@@ -39,26 +39,48 @@ def surface_mask(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, 
     u0, v0, u1, v1 = box
     w = right.shape[1]
     lo = int(np.floor(d0)) - radius
-    if u0 - lo - radius - 1 < 0 or lo < 1 or u1 - lo + 1 > w:
+    # the candidates d = lo .. lo + 2 radius + 1 read the right image's columns u0 - d .. u1 - d - 1, all of which
+    # must exist (a box nearer the left edge made a crop the costs could not be formed on)
+    if u0 - lo - 2 * radius - 1 < 0 or lo < 1 or u1 - lo + 1 > w:
         return None
     L = left[v0:v1, u0:u1]
     costs = []
     for d in range(lo, lo + 2 * radius + 2):
         # SAD_d(u, v) = box_filter(|L(u, v) - R(u - d, v)|)
         costs.append(cv2.blur(np.abs(L - right[v0:v1, u0 - d:u1 - d]), (block, block)))
-    c = np.stack(costs)
-    k = np.clip(np.argmin(c, axis=0), 1, len(costs) - 2)
-    c0 = np.take_along_axis(c, (k - 1)[None], 0)[0]
-    c1 = np.take_along_axis(c, k[None], 0)[0]
-    c2 = np.take_along_axis(c, (k + 1)[None], 0)[0]
-    den = c0 - 2 * c1 + c2
-    # parabola through three costs: offset = (c0 - c2) / (2 (c0 - 2 c1 + c2))
-    best = lo + k + np.where(den > 1e-6, (c0 - c2) / (2 * np.maximum(den, 1e-6)), 0.0)
-    # texture: how much worse the other disparities match (grey levels); flat sky or paint has none. A real match
-    # is far better than the average candidate; the best of candidates that all miss is not
-    mean = np.mean(c, axis=0)
-    return ((np.abs(best - d0) < tol_px) & (den > 1e-6) & (mean - c1 > min_contrast)
-            & (c1 < max_cost_ratio * mean))
+    return _clear_minimum(tuple(costs), lo, np.float64(d0), tol_px, np.float32(min_contrast),
+                          np.float32(max_cost_ratio))
+
+
+@kernel()
+def _clear_minimum(costs, lo, d0, tol_px, min_contrast, max_cost_ratio):  # pragma: no cover - compiled
+    """The mask of ``surface_mask`` from its block costs (a tuple of (h, w) float32 arrays, one per disparity from lo),
+    per pixel in numpy's types: the first smallest cost's index k (kept off the ends), the parabola's offset
+    (c0 - c2) / (2 max(c0 - 2 c1 + c2, 1e-6)) in float32, the best disparity lo + k + offset in float64, the mean cost
+    summed in order over the disparities in float32."""
+    n = len(costs)
+    h, w = costs[0].shape
+    out = np.empty((h, w), np.bool_)
+    eps = np.float32(1e-6)
+    for y in range(h):
+        for x in range(w):
+            k = 0
+            for i in range(1, n):
+                if costs[i][y, x] < costs[k][y, x]:
+                    k = i
+            k = min(max(k, 1), n - 2)
+            c0, c1, c2 = costs[k - 1][y, x], costs[k][y, x], costs[k + 1][y, x]
+            # den = c0 - 2 c1 + c2; offset = (c0 - c2) / (2 (c0 - 2 c1 + c2))
+            den = (c0 - np.float32(2) * c1) + c2
+            offset = (c0 - c2) / (np.float32(2) * max(den, eps)) if den > eps else np.float32(0)
+            best = np.float64(lo + k) + np.float64(offset)
+            total = costs[0][y, x]
+            for i in range(1, n):
+                total += costs[i][y, x]
+            mean = total / np.float32(n)
+            out[y, x] = (abs(best - d0) < tol_px and den > eps and mean - c1 > min_contrast
+                         and c1 < max_cost_ratio * mean)
+    return out
 
 
 class PatchAligner:
@@ -129,10 +151,11 @@ def _weighted_sums(L, both, keep, huber):  # pragma: no cover - compiled
 
 
 def warm_up_refinement() -> None:
-    """The refinement's compiled sums loaded now (compiled once after an install), on a frame's argument types: the
-    patch a view of a wider crop, its mask an array of its own."""
+    """The refinement's and the surface mask's compiled passes loaded now (compiled once after an install), on a
+    frame's argument types: the patch a view of a wider crop, its mask an array of its own."""
     ramp = np.tile(np.arange(24, dtype=np.float32) * 9, (6, 1))
     PatchAligner(ramp, ramp, (4, 0, 20, 6)).refine(np.ones((6, 16), bool), 2.0, iterations=1)
+    surface_mask(ramp, ramp, (12, 0, 20, 6), 5.0)
 
 
 def refine_disparity(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, int], mask: np.ndarray | None,

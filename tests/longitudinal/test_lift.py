@@ -166,4 +166,42 @@ def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
     count, least, refined, unchanged = out.stdout.split()
     # every kernel loaded by the slots' construction; the lead was refined (and the odometry started keyframes), so
     # every pass ran in the frames
-    assert int(count) == 7 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"
+    assert int(count) == 8 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"
+
+
+def _numpy_surface_mask(left, right, box, d0, radius=3, block=5, tol_px=1.0, min_contrast=3.0, max_cost_ratio=0.5):
+    import cv2
+    u0, v0, u1, v1 = box
+    lo = int(np.floor(d0)) - radius
+    L = left[v0:v1, u0:u1]
+    c = np.stack([cv2.blur(np.abs(L - right[v0:v1, u0 - d:u1 - d]), (block, block))
+                  for d in range(lo, lo + 2 * radius + 2)])
+    k = np.clip(np.argmin(c, axis=0), 1, len(c) - 2)
+    c0, c1, c2 = (np.take_along_axis(c, (k + j)[None], 0)[0] for j in (-1, 0, 1))
+    den = c0 - 2 * c1 + c2
+    best = lo + k + np.where(den > 1e-6, (c0 - c2) / (2 * np.maximum(den, 1e-6)), 0.0)
+    mean = np.mean(c, axis=0)
+    return (np.abs(best - d0) < tol_px) & (den > 1e-6) & (mean - c1 > min_contrast) & (c1 < max_cost_ratio * mean)
+
+
+def test_surface_mask_equals_numpys_and_refuses_a_box_without_room_for_its_candidates():
+    from percept.longitudinal import surface_mask
+
+    rng = np.random.default_rng(4)
+    kept = 0
+    for _ in range(40):
+        h, w = int(rng.integers(6, 30)), int(rng.integers(60, 120))
+        left = rng.uniform(0, 255, (h, w)).astype(np.float32)
+        shift = int(rng.integers(6, 12))
+        right = (np.roll(left, -shift, axis=1) + rng.normal(0, 4, (h, w))).astype(np.float32)
+        box = (int(rng.integers(22, 30)), 0, w - int(rng.integers(1, 5)), h)
+        d0 = shift + float(rng.uniform(-1.0, 1.0))
+        got, ref = surface_mask(left, right, box, d0), _numpy_surface_mask(left, right, box, d0)
+        assert got.dtype == ref.dtype and np.array_equal(got, ref)
+        kept += int(got.sum())
+    assert kept > 1000
+    # at d0 = 8.5 the candidates run to d = 12, left of a box starting at column 10: the old check (room for
+    # d <= 9) let it through, and forming the costs failed on an empty slice; now there is no mask
+    img = rng.uniform(0, 255, (10, 80)).astype(np.float32)
+    assert surface_mask(img, img, (10, 0, 60, 10), 8.5) is None
+    assert surface_mask(img, img, (12, 0, 60, 10), 8.5) is not None
