@@ -24,6 +24,12 @@ def optional(a: np.ndarray | None, dtype, ndim: int = 2) -> np.ndarray:
     return np.zeros((0,) * ndim, dtype) if a is None else a
 
 
+def dispatchers(*modules) -> list:
+    """The numba dispatchers of every ``kernel`` defined in ``modules``: what a warm-up check counts the compiled
+    signatures of."""
+    return [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
+
+
 def kernel(**options) -> Callable[[Callable], Callable]:
     """``@kernel(...)``: ``numba.njit(cache=True, error_model="numpy", **options)``, called through a wrapper that
     turns the SystemError chain of an interrupted call back into KeyboardInterrupt. The dispatcher itself is

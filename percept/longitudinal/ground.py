@@ -105,7 +105,7 @@ def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, ce
     hi = (np.floor(x_max / cell_m) + 1) * cell_m
     n = points.shape[0]
     h, cu, cx = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
-    inside = np.zeros(n, np.bool_)
+    inside, up = np.zeros(n, np.bool_), np.zeros(n, np.bool_)
     u_lo, u_hi, x_lo, x_hi = 1 << 40, -(1 << 40), 1 << 40, -(1 << 40)
     for i in range(n):
         x = points[i, 0]
@@ -115,11 +115,13 @@ def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, ce
         h[i] = points[i, 2] - (offset + slope * x)
         # numpy's float32 floor division of the column by the cell
         cu[i], cx[i] = np.int64(floor_divide(u_px[i], cell_px)), np.int64(np.floor(x / cell_m))
-        if h[i] > band and h[i] < max_standing and x > 0:
+        up[i] = h[i] > band and h[i] < max_standing and x > 0
+        if up[i]:
             u_lo, u_hi, x_lo, x_hi = min(u_lo, cu[i]), max(u_hi, cu[i]), min(x_lo, cx[i]), max(x_hi, cx[i])
+    # the cells holding a standing point, over the box of those cells
     standing = np.zeros((max(u_hi - u_lo + 1, 0), max(x_hi - x_lo + 1, 0)), np.bool_)
     for i in range(n):
-        if inside[i] and h[i] > band and h[i] < max_standing and points[i, 0] > 0:
+        if up[i]:
             standing[cu[i] - u_lo, cx[i] - x_lo] = True
     xs, zs = np.empty(n), np.empty(n)
     m = 0

@@ -129,7 +129,7 @@ def test_mismatched_inputs_raise_instead_of_reading_past_the_arrays():
 
 
 WARM_CHECK = """
-import cv2
+from percept.compiled import dispatchers
 from percept.drive import bench as B
 from percept.drive.tasks import TASKS
 from percept.lanes import evidence
@@ -138,7 +138,7 @@ from percept.odometry import features
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose
 modules = (evidence, ground, lift, refine, features)
-kernels = [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
+kernels = dispatchers(*modules)
 world = SimWorld(WorldConfig("lead-brake", seed=1, autopilot=True))
 ctx = B.SlotContext(world.cfg.rig, world.dt, None, B.TruthFeed(), start_pose=hw_pose(world.ego))
 slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lateral", "longitudinal", "odometry")}

@@ -107,10 +107,11 @@ def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
 
 
 WARM_CHECK = """
+from percept.compiled import dispatchers
 from percept.sims import SimWorld, WorldConfig, condition_passes, conditions, normals
 from percept.sims.render import cull, ground, paint, pedestrian, pixels, spans
 modules = (pixels, cull, spans, pedestrian, ground, paint, condition_passes, normals)
-kernels = [k.dispatcher for m in modules for k in vars(m).values() if hasattr(k, "dispatcher")]
+kernels = dispatchers(*modules)
 # the world's renderer and its night effects warm their kernels up when they are built, and so do the other
 # conditions' effects
 world = SimWorld(WorldConfig("crossing", seed=1, condition="night", autopilot=True))
