@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from percept.compiled import kernel
+
 from .quantiles import median
 
 
@@ -63,6 +65,9 @@ class ExpansionTracker:
     def __init__(self, cfg: FlowConfig = FlowConfig()):
         self.cfg = cfg
         self.history: deque = deque(maxlen=cfg.frames_back + 1)
+        # the compiled pair ratios (compiled once after an install) loaded now, on a frame's argument types
+        no_points = np.zeros((0, 2), np.float32)
+        pair_ratios(no_points, no_points, float(cfg.min_pair_px))
 
     def reset(self) -> None:
         self.history.clear()
@@ -98,17 +103,37 @@ def _expansion(g0: np.ndarray, g1: np.ndarray, box: tuple[int, int, int, int], d
     pb, st2, _ = cv2.calcOpticalFlowPyrLK(g1, g0, p1, None, **lk)
     # forward-backward consistency: the track back from frame 1 must land where it started
     ok = (st1[:, 0] == 1) & (st2[:, 0] == 1) & (np.linalg.norm((pb - p0)[:, 0], axis=1) < cfg.fb_max_px)
-    a, b = p0[ok, 0].astype(np.float64), p1[ok, 0].astype(np.float64)
+    a, b = np.ascontiguousarray(p0[ok, 0]), np.ascontiguousarray(p1[ok, 0])
     if len(a) < 5:
         return None
-    i, j = np.triu_indices(len(a), 1)
-    d0 = np.linalg.norm(a[i] - a[j], axis=1)
-    far = d0 >= cfg.min_pair_px
-    if far.sum() < cfg.min_pairs:
+    ratio = pair_ratios(a, b, float(cfg.min_pair_px))
+    if len(ratio) < cfg.min_pairs:
         return None
-    ratio = np.linalg.norm(b[i] - b[j], axis=1)[far] / d0[far]
     s = float(median(ratio))
     # robust spread (MAD) over about as many independent pairs as features
     mad = 1.4826 * float(median(np.abs(ratio - s)))
     sigma = max(mad, 1e-4) * np.sqrt(np.pi / 2) / np.sqrt(len(a))
     return Expansion(s, sigma, dt, int(len(a)))
+
+
+@kernel()
+def pair_ratios(a, b, min_pair_px):  # pragma: no cover - compiled
+    """|b_i - b_j| / |a_i - a_j| (M,) float64 of every pair i < j (in that order: i, then j) of points a (N, 2)
+    float32 whose distance |a_i - a_j| is at least ``min_pair_px``, b (N, 2) float32 the same points later; in
+    float64 as numpy's ``np.linalg.norm(x, axis=1)`` takes them (sqrt(dx dx + dy dy)), so equal to it bit for
+    bit."""
+    n = a.shape[0]
+    if b.shape[0] != n:
+        raise ValueError("a and b hold different numbers of points")
+    out = np.empty(n * (n - 1) // 2, np.float64)
+    k = 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            dx, dy = np.float64(a[i, 0]) - np.float64(a[j, 0]), np.float64(a[i, 1]) - np.float64(a[j, 1])
+            # d0 = |a_i - a_j|
+            d0 = np.sqrt(dx * dx + dy * dy)
+            if d0 >= min_pair_px:
+                ex, ey = np.float64(b[i, 0]) - np.float64(b[j, 0]), np.float64(b[i, 1]) - np.float64(b[j, 1])
+                out[k] = np.sqrt(ex * ex + ey * ey) / d0
+                k += 1
+    return out[:k]

@@ -79,3 +79,28 @@ def test_ground_contact_needs_an_edge(renderer):
     rig, _ = renderer
     flat = np.full((rig.camera.height, rig.camera.width), 100, np.uint8)
     assert ContactRange(rig).measure(flat, (300, 230, 340, 260), 30.0) is None
+
+
+def _numpy_pair_ratios(a: np.ndarray, b: np.ndarray, min_pair_px: float) -> np.ndarray:
+    """The pairs' ratios as the expansion took them before they were compiled."""
+    a, b = a.astype(np.float64), b.astype(np.float64)
+    i, j = np.triu_indices(len(a), 1)
+    d0 = np.linalg.norm(a[i] - a[j], axis=1)
+    far = d0 >= min_pair_px
+    return np.linalg.norm(b[i] - b[j], axis=1)[far] / d0[far]
+
+
+def test_pair_ratios_equal_numpys_bit_for_bit():
+    from percept.longitudinal.flow import pair_ratios
+
+    rng = np.random.default_rng(5)
+    for n in (0, 1, 2, 7, 40, 80):
+        for spread in (3.0, 60.0, 400.0):
+            a = (rng.random((n, 2)) * spread).astype(np.float32)
+            b = (a * rng.uniform(0.9, 1.1) + rng.normal(0, 0.3, (n, 2))).astype(np.float32)
+            if n > 3:
+                a[3] = a[1]  # a repeated point: a pair at distance 0 is left out
+            got, want = pair_ratios(a, b, 6.0), _numpy_pair_ratios(a, b, 6.0)
+            assert got.dtype == want.dtype and got.tobytes() == want.tobytes(), (n, spread)
+    with pytest.raises(ValueError, match="different numbers of points"):
+        pair_ratios(np.zeros((3, 2), np.float32), np.zeros((2, 2), np.float32), 6.0)

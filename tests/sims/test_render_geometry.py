@@ -144,3 +144,20 @@ def test_without_the_lamp_map_the_frames_are_the_same(rig, road):
     for name in ("left", "right", "depth_m", "ids"):
         assert getattr(lit, name).tobytes() == getattr(plain, name).tobytes(), name
     assert lit.boxes_px == plain.boxes_px and lit.visible == plain.visible
+
+
+def test_prepare_takes_cameras_of_one_orientation_only(rig, bare):
+    from percept.sensors.poses import Transform
+    from percept.sims.render.patches import SUN_DIR
+    from percept.sims.render.raster import prepare
+
+    scene = Scene(EGO, (car(1, EGO.x_m + 15.0),))
+    patches = bare.scene_patches(scene)
+    left, right = (bare._cam_from_world(scene, s) for s in (Side.LEFT, Side.RIGHT))
+    # as np.allclose decides: a rotation 1e-9 off is the same orientation, one 1e-3 rad off is not
+    nudged = Transform(left.R + 1e-9, right.t)
+    assert all(p is not None for p in prepare(patches, rig.camera, [left, nudged], bare.atlas, SUN_DIR))
+    c, s = np.cos(1e-3), np.sin(1e-3)
+    turned = Transform(np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]) @ left.R, right.t)
+    with pytest.raises(ValueError, match="one orientation"):
+        prepare(patches, rig.camera, [left, turned], bare.atlas, SUN_DIR)

@@ -141,7 +141,9 @@ def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transfo
     if not len(batch):
         return [None] * len(cams_from_world)
     R = cams_from_world[0].R
-    if not all(np.allclose(T.R, R) for T in cams_from_world):
+    # np.allclose's test, |R_k - R| <= atol + rtol |R| (rtol 1e-5, atol 1e-8), without its generic machinery
+    # (~18 µs a call)
+    if not all(bool((np.abs(T.R - R) <= 1e-8 + 1e-5 * np.abs(R)).all()) for T in cams_from_world):
         raise ValueError("prepare() needs cameras with one orientation (a rectified rig); render them one by one")
     # shading in the world frame: ambient + diffuse |n·sun| (two-sided lighting); vec3's formulas on the columns
     nw = cross(batch.e1.T, batch.e2.T)
