@@ -27,7 +27,10 @@ from .types import VOStep
 class StereoVOConfig:
     """max_features: corners per keyframe; grid: cells (columns, rows) the corners are spread over;
     fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels (prior_levels when
-    a motion prior says where to start: a shallow pyramid suffices and costs less);
+    a motion prior says where to start: a shallow pyramid suffices and costs less); dark_grey, dark_win_px: from a
+    keyframe whose mean grey level is below dark_grey (night: a scene lit by the car's own lamps) KLT tracks with
+    dark_win_px windows (the beam's light stays put in the image while the road moves through it, a brightness
+    change KLT's constancy assumption cannot explain; a smaller window holds less of it);
     max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
     point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
     ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
@@ -39,6 +42,8 @@ class StereoVOConfig:
     fast_threshold: int = 5
     win_px: int = 15
     levels: int = 3
+    dark_grey: float = 70.0
+    dark_win_px: int = 11
     prior_levels: int = 1
     max_row_err_px: float = 0.7
     min_disparity_px: float = 0.5
@@ -51,8 +56,10 @@ class StereoVOConfig:
     def __post_init__(self) -> None:
         if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:
             raise ValueError("need max_features >= 20, min_inliers >= 6 and keyframe_inliers >= min_inliers")
-        if not (self.win_px >= 5 and self.levels >= 0 and self.ransac_px > 0 and self.min_disparity_px > 0):
-            raise ValueError("win_px >= 5, levels >= 0, ransac_px > 0 and min_disparity_px > 0 are required")
+        if not (min(self.win_px, self.dark_win_px) >= 5 and self.levels >= 0 and self.ransac_px > 0
+                and self.min_disparity_px > 0):
+            raise ValueError("win_px >= 5, dark_win_px >= 5, levels >= 0, ransac_px > 0 and min_disparity_px > 0 "
+                             "are required")
 
 
 def _inverse(T: np.ndarray) -> np.ndarray:
@@ -98,6 +105,7 @@ class StereoVO:
         self._kf_pixels: np.ndarray | None = None  # (N, 2) where they were in the keyframe's left image
         self._movers: list[tuple] = []  # this frame's boxes of things that move
         self._noise: float | None = None  # the keyframe image's noise sigma [grey levels]
+        self._win_px = self.config.win_px  # the KLT window from the keyframe on [px]
         self._prev: np.ndarray | None = None  # previous left image (grey)
         self._T_kf_prev = np.eye(4)  # previous camera in the keyframe's frame
         self._cov_prev = np.zeros((6, 6))
@@ -130,13 +138,14 @@ class StereoVO:
         here)."""
         c = self.config
         self._noise = noise_sigma(gl)
+        self._win_px = c.dark_win_px if cv2.mean(gl)[0] < c.dark_grey else c.win_px
         corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise)
         corners = corners[self._static(corners)]
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
         self._kf_points = self._pixels = self._kf_pixels = None
         if len(corners) < c.min_inliers:
             return VOStep.failed(f"{reason}: only {len(corners)} corners (dark or featureless)", keyframe=True)
-        matched, ok = track(gl, to_gray(right), corners, c.win_px, c.levels, self._disparity_guess(corners))
+        matched, ok = track(gl, to_gray(right), corners, self._win_px, c.levels, self._disparity_guess(corners))
         d = corners[:, 0] - matched[:, 0]
         ok &= (np.abs(corners[:, 1] - matched[:, 1]) <= c.max_row_err_px) & (d >= c.min_disparity_px)
         if ok.sum() < c.min_inliers:
@@ -178,8 +187,8 @@ class StereoVO:
     def _track(self, gl: np.ndarray, T_kf_pred: np.ndarray | None) -> VOStep:
         c = self.config
         expected = None if T_kf_pred is None else self._project(T_kf_pred)
-        moved, ok = track(self._prev, gl, self._pixels, c.win_px, c.levels if expected is None else c.prior_levels,
-                          expected)
+        moved, ok = track(self._prev, gl, self._pixels, self._win_px,
+                          c.levels if expected is None else c.prior_levels, expected)
         ok &= self._static(moved)
         self._kf_points, self._pixels, self._kf_pixels = self._kf_points[ok], moved[ok], self._kf_pixels[ok]
         n = len(self._pixels)

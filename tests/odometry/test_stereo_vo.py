@@ -94,3 +94,30 @@ def test_a_motion_prior_and_mover_boxes_are_used(loop_run):
     vo.reset()
     step = vo.process(shots[0][0].left, shots[0][0].right, movers=[(0, 0, 640, 480)])
     assert not step.ok and "only 0 corners" in step.reason
+
+
+def test_a_dark_keyframe_is_tracked_with_the_smaller_window(loop_run, monkeypatch):
+    from percept.odometry import stereo_vo
+
+    world, shots = loop_run
+    windows = []
+    real_track = stereo_vo.track
+
+    def spy(prev, cur, pts, win_px, levels, guess=None):
+        windows.append(win_px)
+        return real_track(prev, cur, pts, win_px, levels, guess)
+
+    monkeypatch.setattr(stereo_vo, "track", spy)
+    cfg = StereoVOConfig()
+    vo = vo_for(world.cfg.rig)
+    # the same frames at a third of their brightness (a mean grey level of ~45, the night's ~55) and as they are
+    # (~130): each keyframe's stereo match and the tracking from it
+    for scale, want in ((1 / 3, cfg.dark_win_px), (1.0, cfg.win_px)):
+        vo.reset()
+        windows.clear()
+        steps = [vo.process(*[(img.astype(np.float32) * scale).astype(np.uint8) for img in (f.left, f.right)])
+                 for f, _ in shots[:4]]
+        # the first frame starts the keyframe; each later one is measured
+        assert all(s.ok for s in steps[1:]) and len(windows) >= 4 and set(windows) == {want}
+    with pytest.raises(ValueError, match="dark_win_px >= 5"):
+        StereoVOConfig(dark_win_px=3)
