@@ -30,7 +30,9 @@ class StereoVOConfig:
     a motion prior says where to start: a shallow pyramid suffices and costs less); dark_grey, dark_win_px: from a
     keyframe whose mean grey level is below dark_grey (night: a scene lit by the car's own lamps) KLT tracks with
     dark_win_px windows (the beam's light stays put in the image while the road moves through it, a brightness
-    change KLT's constancy assumption cannot explain; a smaller window holds less of it);
+    change KLT's constancy assumption cannot explain; a smaller window holds less of it; the simulator's night
+    frames have a mean grey level of 53-56, every other condition's 129 or more, the KITTI frames in ../shared/data
+    85-107);
     max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
     point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
     ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
