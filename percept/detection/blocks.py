@@ -137,6 +137,10 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
             a = acc[b % 2]
             for cy in range(2):
                 wt = wx[cy, dy]
+                # X_1(dy) = 0 for dy < c/2 and X_0(dy) = 0 for dy >= 3c/2: the +0 those rows would add to the
+                # (non-negative) sums leaves them as they are, so one of the four (k, cy) is skipped in every row
+                if wt == 0:
+                    continue
                 for cx in range(2):
                     o, src = (18 * cx + 9 * cy) * nbx, 9 * cx * nbx
                     for m in range(9 * nbx):
@@ -146,11 +150,14 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
         if y % c == c - 1 and 0 <= done < nby:
             v = acc[done % 2].reshape(36, nbx)
             _l2hys_scales(v, clip, scale1, scale2)
+            # v <- min(v scale1, clip) scale2 in place, over the blocks as vectors; then each block's 36 values out
+            for i in range(36):
+                for bx in range(nbx):
+                    t = v[i, bx] * scale1[bx]
+                    v[i, bx] = (t if t < clip else clip) * scale2[bx]
             for bx in range(nbx):
-                s1, s2 = scale1[bx], scale2[bx]
                 for i in range(36):
-                    t = v[i, bx] * s1
-                    out[bx, done, i] = (t if t < clip else clip) * s2
+                    out[bx, done, i] = v[i, bx]
     return out
 
 
