@@ -167,6 +167,8 @@ class LinearModel:
         (nbx, nby, 36); None without a second stage."""
         if self.second is None:
             return None
+        if not len(x):
+            return np.zeros(0, np.float32)
         # a window's descriptor is its blocks (x + i, y + j), i < 7, j < 15, in OpenCV's order: (N, 7, 15, 36)
         i, j = np.arange(BLOCKS[0]), np.arange(BLOCKS[1])
         d = blocks[np.asarray(x)[:, None, None] + i[None, :, None], np.asarray(y)[:, None, None] + j[None, None, :]]

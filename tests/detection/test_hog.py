@@ -127,6 +127,10 @@ def test_the_second_stage_scores_each_window_as_its_own_model_would():
     x, y = np.nonzero(np.ones_like(full, bool))
     got = cascade.second_scores(blocks, x, y)
     assert got.dtype == np.float32 and np.abs(got - full[x, y]).max() <= 1e-5 * max(1.0, np.abs(full).max())
+    # no window: an empty float32 array, as the product of no descriptors gives
+    none = np.zeros(0, np.intp)
+    empty = cascade.second_scores(blocks, none, none)
+    assert empty.dtype == np.float32 and empty.shape == (0,)
 
 
 def test_a_cascade_saves_and_loads_and_a_bad_second_stage_is_refused(tmp_path):
