@@ -21,6 +21,7 @@ confirms. ``SearchStats`` counts the windows scored against those of the full py
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
@@ -124,19 +125,22 @@ class ConstrainedSearch:
         if z_near > z_far:
             return None
         x = self.cam_x + np.array([z_near, z_far])
-        centre = path.centre_y(x)
-        pts = np.array([[x[k], centre[k] + side * cfg.half_width_m, 0.0] for k in (0, 1) for side in (-1, 1)])
+        centre = path.centre_y(x).tolist()
+        xs = x.tolist()
+        pts = np.array([[xs[k], centre[k] + side * cfg.half_width_m, 0.0] for k in (0, 1) for side in (-1, 1)])
         uv, _ = self.rig.project_vehicle_points(pts)
+        (u_min, v_min), (u_max, v_max) = uv.min(axis=0).tolist(), uv.max(axis=0).tolist()
         # feet rows of the nearest and farthest person; the window reaches 112 s px above the feet and 16 s below
-        v_top = uv[:, 1].min() - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
-        v_bot = uv[:, 1].max() + FEET_MARGIN_PX * scale
-        u0, u1 = uv[:, 0].min() - WINDOW_PX[0] * scale / 2, uv[:, 0].max() + WINDOW_PX[0] * scale / 2
+        v_top = v_min - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
+        v_bot = v_max + FEET_MARGIN_PX * scale
+        u0, u1 = u_min - WINDOW_PX[0] * scale / 2, u_max + WINDOW_PX[0] * scale / 2
         return self._clip((u0, v_top, u1, v_bot), scale)
 
     def _clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
         cam = self.rig.camera
-        b = (int(max(np.floor(box[0]), 0)), int(max(np.floor(box[1]), 0)), int(min(np.ceil(box[2]), cam.width)),
-             int(min(np.ceil(box[3]), cam.height)))
+        # (clipped before rounding: the same whole pixels, and a corner at infinity clips as it did)
+        b = (math.floor(max(box[0], 0)), math.floor(max(box[1], 0)), math.ceil(min(box[2], cam.width)),
+             math.ceil(min(box[3], cam.height)))
         if b[2] - b[0] < WINDOW_PX[0] * scale or b[3] - b[1] < WINDOW_PX[1] * scale:
             return None
         return b

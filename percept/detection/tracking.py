@@ -13,6 +13,7 @@ white-noise-acceleration model (ch. 6) and gating (ch. 7).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Callable
 
 import numpy as np
@@ -99,6 +100,43 @@ class PersonTrack:
     too_fast: bool
 
 
+@dataclass(frozen=True)
+class EgoStep:
+    """The motion model of every track over one frame of the ego's own motion (read-only arrays): rt (2, 2), R(th)^T
+    for the turn th; f (4, 4) and b (4, 2) with x_k+1 = F x_k + B t for the ego's travel t (2,) [m]; q (4, 4) the
+    white-noise acceleration's covariance."""
+
+    rt: np.ndarray
+    f: np.ndarray
+    b: np.ndarray
+    q: np.ndarray
+    travel: np.ndarray
+
+    @classmethod
+    def of(cls, dt: float, ego_speed_mps: float, yaw_rate_rps: float, accel_mps2: float) -> "EgoStep":
+        th = yaw_rate_rps * dt
+        c, s = np.cos(th), np.sin(th)
+        rt = np.array([[c, s], [-s, c]])  # R(th)^T: the old vehicle frame's vectors in the new one
+        # p_k+1 = R^T (p_k + v_k dt - t), v_k+1 = R^T v_k, with the ego's travel t = v_ego dt (cos th/2, sin th/2)
+        # (the chord of its arc): the ego's own motion moves and turns everything the other way
+        f = np.zeros((4, 4))
+        f[:2, :2], f[:2, 2:], f[2:, 2:] = rt, rt * dt, rt
+        b = np.zeros((4, 2))
+        b[:2] = -rt
+        travel = ego_speed_mps * dt * np.array([np.cos(th / 2), np.sin(th / 2)])
+        for a in (rt, f, b, travel):
+            a.flags.writeable = False
+        return cls(rt, f, b, _white_noise(dt, accel_mps2 ** 2), travel)
+
+
+@lru_cache(maxsize=8)
+def _white_noise(dt: float, var: float) -> np.ndarray:
+    """filterpy's white-noise acceleration covariance (4, 4) of (x, y, vx, vy) over dt [s] (read-only)."""
+    q = Q_discrete_white_noise(2, dt, var, block_size=2, order_by_dim=False)
+    q.flags.writeable = False
+    return q
+
+
 class _Track:
     def __init__(self, tid: int, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float,
                  stereo_ok: bool, cfg: TrackConfig):
@@ -112,19 +150,10 @@ class _Track:
         self.predicted = box  # the person box predicted for the current frame
         self.standing = xy.copy()  # the last detection's position, moved by the ego's motion since
 
-    def predict(self, dt: float, ego_speed_mps: float, yaw_rate_rps: float) -> None:
-        th = yaw_rate_rps * dt
-        c, s = np.cos(th), np.sin(th)
-        rt = np.array([[c, s], [-s, c]])  # R(th)^T: the old vehicle frame's vectors in the new one
-        # p_k+1 = R^T (p_k + v_k dt - t), v_k+1 = R^T v_k, with the ego's travel t = v_ego dt (cos th/2, sin th/2)
-        # (the chord of its arc): the ego's own motion moves and turns everything the other way
-        f = np.block([[rt, rt * dt], [np.zeros((2, 2)), rt]])
-        q = Q_discrete_white_noise(2, dt, self.cfg.accel_mps2 ** 2, block_size=2, order_by_dim=False)
-        travel = ego_speed_mps * dt * np.array([np.cos(th / 2), np.sin(th / 2)])
-        b = np.vstack([-rt, np.zeros((2, 2))])
-        self.kf.predict(u=travel, B=b, F=f, Q=q)
-        self.free.predict(f, q, b, travel)
-        self.standing = rt @ (self.standing - travel)
+    def predict(self, step: EgoStep) -> None:
+        self.kf.predict(u=step.travel, B=step.b, F=step.f, Q=step.q)
+        self.free.predict(step.f, step.q, step.b, step.travel)
+        self.standing = step.rt @ (self.standing - step.travel)
 
     def update(self, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float, stereo_ok: bool) -> None:
         self.kf.update(xy, R=r)
@@ -204,8 +233,9 @@ class PersonTracker:
     def predict(self, ego_speed_mps: float, yaw_rate_rps: float = 0.0) -> list[Box]:
         """Advance every track one frame while the ego drives ``ego_speed_mps`` and turns at ``yaw_rate_rps``
         (positive to the left); the predicted person boxes (for the search's regions of interest)."""
+        step = EgoStep.of(self.dt_s, ego_speed_mps, yaw_rate_rps, self.cfg.accel_mps2) if self.tracks else None
         for t in self.tracks:
-            t.predict(self.dt_s, ego_speed_mps, yaw_rate_rps)
+            t.predict(step)
         boxes = [self.predicted_box(t) for t in self.tracks]
         # a track that has walked (or been driven) out of the image, or behind the camera, has gone
         w = self.rig.camera.width

@@ -56,3 +56,26 @@ def test_a_cascade_keeps_what_its_second_stage_confirms(crossing_frame):
         cascade = replace(first, second=first, second_threshold=threshold)
         dets, _ = ConstrainedSearch(rig, cascade).search(frame.left, path)
         assert dets == expected
+
+
+def test_a_region_is_clipped_to_the_same_whole_pixels_as_numpys_floor_and_ceil():
+    """``_clip`` (math.floor / math.ceil after clipping) gives the pixels of int(max(np.floor(u0), 0)), ...,
+    int(min(np.ceil(u1), width)), for corners inside, outside, on whole pixels and at infinity."""
+    rig = StereoRig()
+    search = ConstrainedSearch(rig, LinearModel.inria())
+    cam = rig.camera
+    rng = np.random.default_rng(3)
+    corners = list(rng.uniform(-200, 900, (400, 4))) + [np.array([-np.inf, 3.0, np.inf, np.inf]),
+                                                        np.array([0.0, -0.0, 640.0, 480.0]),
+                                                        np.array([-1.0, 2.0, 603.0, 467.0])]
+    kept = 0
+    for u0, v0, u1, v1 in corners:
+        box = (np.float64(u0), float(v0), np.float64(u1), float(v1))
+        want = (int(max(np.floor(box[0]), 0)), int(max(np.floor(box[1]), 0)), int(min(np.ceil(box[2]), cam.width)),
+                int(min(np.ceil(box[3]), cam.height)))
+        got = search._clip(box, 0.5)
+        small = want[2] - want[0] < 32 or want[3] - want[1] < 64
+        assert got == (None if small else want)
+        assert got is None or all(type(c) is int for c in got)
+        kept += got is not None
+    assert 50 < kept < len(corners)

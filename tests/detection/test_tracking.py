@@ -228,3 +228,25 @@ def test_one_window_ten_metres_nearer_does_not_bring_a_vehicles_free_motion_to_a
         x += (lead - ego) * DT
         (t,) = tr.update([person_box(rig, x, 3.0)], [1.0])
     assert t.free_speed_mps == pytest.approx(lead, abs=3.0) and t.too_fast
+
+
+@pytest.mark.parametrize("yaw_rate", [0.0, 0.31, -0.07])
+def test_the_ego_step_is_the_motion_model_each_track_built_for_itself(yaw_rate):
+    """``EgoStep.of`` (made once a frame for every track, its arrays read-only) holds the matrices each track made
+    with np.block, np.vstack and filterpy's white-noise covariance, bit for bit."""
+    from filterpy.common import Q_discrete_white_noise
+
+    from percept.detection.tracking import EgoStep
+
+    speed, accel = 13.7, TrackConfig().accel_mps2
+    th = yaw_rate * DT
+    c, s = np.cos(th), np.sin(th)
+    rt = np.array([[c, s], [-s, c]])
+    want = dict(rt=rt, f=np.block([[rt, rt * DT], [np.zeros((2, 2)), rt]]), b=np.vstack([-rt, np.zeros((2, 2))]),
+                q=Q_discrete_white_noise(2, DT, accel ** 2, block_size=2, order_by_dim=False),
+                travel=speed * DT * np.array([np.cos(th / 2), np.sin(th / 2)]))
+    step = EgoStep.of(DT, speed, yaw_rate, accel)
+    for name, a in want.items():
+        got = getattr(step, name)
+        assert got.dtype == a.dtype and got.shape == a.shape and got.tobytes() == a.tobytes(), name
+        assert got.flags.c_contiguous and not got.flags.writeable
