@@ -110,10 +110,13 @@ class ConstrainedSearch:
         self.full_windows = int(sum(max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0)
                                     * max(int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0) for s in self.scales))
         # the compiled kernels (the blocks' and the window sums', compiled once after an install) loaded now, on
-        # one window of the strips' kind (BGR uint8, cfg.cell_px cells), not in a timed frame
+        # one window of the strips' kind (BGR uint8, cfg.cell_px cells), not in a timed frame; and the grouping's,
+        # on two windows of the search's kind (whole pixels in int32, float32 scores) grouped into one detection
         c = cfg.cell_px
         window = np.zeros((WINDOW_PX[1] * c // CELL_PX, WINDOW_PX[0] * c // CELL_PX, 3), np.uint8)
         model.score_map(block_grid(window, c))
+        boxes, scores = np.array([[0, 0, 32, 64], [1, 0, 32, 64]], np.int32), np.ones(2, np.float32)
+        second_stage_kept(group(boxes, scores, 1) + lone_windows(boxes, scores), boxes, scores, 0.0)
 
     def region(self, level: int, path: EgoPath) -> tuple[int, int, int, int] | None:
         """The image region (u0, v0, u1, v1) that holds every plausible window at scale ``level``, or None."""

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from percept.compiled import kernel
+
 from .hog import CELL_PX, WINDOW_PX, LinearModel, block_grid
 
 
@@ -82,13 +84,34 @@ def group(boxes: np.ndarray, scores: np.ndarray, group_threshold: int = 2, eps: 
 def _best_of_overlapping(box, boxes: np.ndarray, values: np.ndarray) -> float:
     """The best of ``values`` (N,) over the windows ``boxes`` (N, 4) as (x, y, w, h) that overlap ``box`` (x, y, w, h)
     by IoU >= 0.5 (over every window when none does)."""
+    if not len(values):
+        return float(values.max())  # numpy's error for the best of nothing
     gx, gy, gw, gh = box
-    ix = np.clip(np.minimum(gx + gw, boxes[:, 0] + boxes[:, 2]) - np.maximum(gx, boxes[:, 0]), 0, None)
-    iy = np.clip(np.minimum(gy + gh, boxes[:, 1] + boxes[:, 3]) - np.maximum(gy, boxes[:, 1]), 0, None)
-    inter = ix * iy
-    # IoU = |A n B| / (|A| + |B| - |A n B|)
-    iou = inter / (gw * gh + boxes[:, 2] * boxes[:, 3] - inter)
-    return float(values[iou >= 0.5].max()) if (iou >= 0.5).any() else float(values.max())
+    return float(_best_overlapping(gx, gy, gw, gh, boxes, values))
+
+
+@kernel()
+def _best_overlapping(gx, gy, gw, gh, boxes, values):  # pragma: no cover - compiled
+    """``_best_of_overlapping`` in one pass, in numpy's arithmetic: whole-pixel boxes' sides and areas in integers
+    (int32 in numpy, no box comes near its limits), the IoU as the float64 quotient; the maxima take a NaN as
+    numpy's do."""
+    found = False
+    best = top = values[0]
+    for i in range(boxes.shape[0]):
+        # |A n B| = max(min(x_A + w_A, x_B + w_B) - max(x_A, x_B), 0) max(the same along y, 0)
+        ix = max(min(gx + gw, boxes[i, 0] + boxes[i, 2]) - max(gx, boxes[i, 0]), 0)
+        iy = max(min(gy + gh, boxes[i, 1] + boxes[i, 3]) - max(gy, boxes[i, 1]), 0)
+        inter = ix * iy
+        # IoU = |A n B| / (|A| + |B| - |A n B|)
+        iou = inter / (gw * gh + boxes[i, 2] * boxes[i, 3] - inter)
+        v = values[i]
+        if np.isnan(v) or v > top:
+            top = v
+        if iou >= 0.5:
+            if not found or np.isnan(v) or v > best:
+                best = v
+            found = True
+    return best if found else top
 
 
 def second_stage_kept(dets: list[Detection], boxes: np.ndarray, second: np.ndarray | None,
@@ -109,13 +132,26 @@ def lone_windows(boxes: np.ndarray, scores: np.ndarray, eps: float = 0.2) -> lis
     if not len(boxes):
         return []
     b = boxes.astype(np.float64)
-    delta = eps * (np.minimum(b[:, None, 2], b[None, :, 2]) + np.minimum(b[:, None, 3], b[None, :, 3])) / 2
-    x1, y1 = b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]
-    similar = ((np.abs(b[:, None, 0] - b[None, :, 0]) <= delta) & (np.abs(b[:, None, 1] - b[None, :, 1]) <= delta)
-               & (np.abs(x1[:, None] - x1[None, :]) <= delta) & (np.abs(y1[:, None] - y1[None, :]) <= delta))
-    lone = np.flatnonzero(similar.sum(axis=1) == 1)
-    out = [Detection((float(b[i, 0]), float(b[i, 1]), float(x1[i]), float(y1[i])), float(scores[i])) for i in lone]
+    out = [Detection((float(b[i, 0]), float(b[i, 1]), float(b[i, 0] + b[i, 2]), float(b[i, 1] + b[i, 3])),
+                     float(scores[i])) for i in np.flatnonzero(_lone(b, float(eps)))]
     return sorted(out, key=lambda d: -d.score)
+
+
+@kernel()
+def _lone(b, eps):  # pragma: no cover - compiled
+    """(N,) bool: whether each window of ``b`` (N, 4) float64 (x, y, w, h) is similar to none but itself."""
+    n = b.shape[0]
+    lone = np.empty(n, np.bool_)
+    for i in range(n):
+        similar = 0
+        for j in range(n):
+            # delta = eps (min(w_i, w_j) + min(h_i, h_j)) / 2
+            delta = eps * (min(b[i, 2], b[j, 2]) + min(b[i, 3], b[j, 3])) / 2
+            similar += (abs(b[i, 0] - b[j, 0]) <= delta and abs(b[i, 1] - b[j, 1]) <= delta
+                        and abs((b[i, 0] + b[i, 2]) - (b[j, 0] + b[j, 2])) <= delta
+                        and abs((b[i, 1] + b[i, 3]) - (b[j, 1] + b[j, 3])) <= delta)
+        lone[i] = similar == 1
+    return lone
 
 
 def detect_multiscale(image: np.ndarray, model: LinearModel, step: float = 1.05, threshold: float = 0.0,

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from percept.detection import DESCRIPTOR_LEN, LinearModel, block_grid, detect_multiscale, hog_descriptor
-from percept.detection.pyramid import group, lone_windows, pyramid_scales, second_stage_kept
+from percept.detection.pyramid import (Detection, _best_of_overlapping, group, lone_windows, pyramid_scales,
+                                      second_stage_kept)
 from percept.sensors import iou
 
 VTEST = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "opencv-samples" / "pedestrians" / "vtest.avi"
@@ -158,3 +159,62 @@ def test_the_second_stage_keeps_a_detection_when_one_of_its_windows_passes():
     assert [d.box_px[0] < 100 for d in kept] == [True]
     assert second_stage_kept(dets, boxes, None, -0.5) == dets
     assert second_stage_kept(dets, boxes, np.full(4, -0.5, np.float32), -0.5) == dets
+
+
+def numpy_ious(box, boxes) -> np.ndarray:
+    """The IoU of ``box`` with each of ``boxes`` as ``_best_of_overlapping`` computed them in numpy."""
+    gx, gy, gw, gh = box
+    ix = np.clip(np.minimum(gx + gw, boxes[:, 0] + boxes[:, 2]) - np.maximum(gx, boxes[:, 0]), 0, None)
+    iy = np.clip(np.minimum(gy + gh, boxes[:, 1] + boxes[:, 3]) - np.maximum(gy, boxes[:, 1]), 0, None)
+    inter = ix * iy
+    return inter / (gw * gh + boxes[:, 2] * boxes[:, 3] - inter)
+
+
+def numpy_best_of_overlapping(box, boxes, values) -> float:
+    """``_best_of_overlapping`` as numpy computed it before its compiled pass."""
+    iou = numpy_ious(box, boxes)
+    return float(values[iou >= 0.5].max()) if (iou >= 0.5).any() else float(values.max())
+
+
+def numpy_lone_windows(boxes, scores, eps=0.2) -> list:
+    """``lone_windows`` as numpy computed it before its compiled pass."""
+    b = boxes.astype(np.float64)
+    delta = eps * (np.minimum(b[:, None, 2], b[None, :, 2]) + np.minimum(b[:, None, 3], b[None, :, 3])) / 2
+    x1, y1 = b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]
+    similar = ((np.abs(b[:, None, 0] - b[None, :, 0]) <= delta) & (np.abs(b[:, None, 1] - b[None, :, 1]) <= delta)
+               & (np.abs(x1[:, None] - x1[None, :]) <= delta) & (np.abs(y1[:, None] - y1[None, :]) <= delta))
+    lone = np.flatnonzero(similar.sum(axis=1) == 1)
+    out = [Detection((float(b[i, 0]), float(b[i, 1]), float(x1[i]), float(y1[i])), float(scores[i])) for i in lone]
+    return sorted(out, key=lambda d: -d.score)
+
+
+def random_windows(rng, n: int) -> np.ndarray:
+    """n windows (x, y, w, h) in int32 of a few sizes, crowded enough that some overlap and some group."""
+    w = rng.choice([24, 32, 40, 64], n)
+    return np.column_stack([rng.integers(0, 200, n), rng.integers(0, 120, n), w, 2 * w]).astype(np.int32)
+
+
+def test_the_compiled_overlaps_and_lone_windows_equal_numpys():
+    """The compiled ``_best_of_overlapping`` (integer boxes as ``group`` passes them, float boxes as
+    ``second_stage_kept`` does) and ``lone_windows`` give what the numpy code they replace gave, bit for bit."""
+    rng = np.random.default_rng(11)
+    overlapped = alone = lone = 0
+    for trial in range(300):
+        boxes = random_windows(rng, int(rng.integers(1, 30)))
+        values = rng.normal(0, 1, len(boxes)).astype(np.float32)
+        if trial % 50 == 7:
+            values[rng.integers(0, len(values))] = np.nan
+        gw = int(rng.choice([24, 32, 48]))
+        gx, gy = rng.integers(0, 200, 2).astype(np.int32)
+        for box in [(gx, gy, np.int32(gw), np.int32(2 * gw)), (float(gx) + 0.5, float(gy) - 0.25, gw * 1.1, 2.2 * gw)]:
+            want = numpy_best_of_overlapping(box, boxes, values)
+            got = _best_of_overlapping(box, boxes, values)
+            assert np.asarray(got).tobytes() == np.asarray(want).tobytes()
+            near = bool((numpy_ious(box, boxes) >= 0.5).any())
+            overlapped, alone = overlapped + near, alone + (not near)
+        got, want = lone_windows(boxes, values), numpy_lone_windows(boxes, values)
+        assert [(d.box_px, np.float64(d.score).tobytes(), d.windows) for d in got] == \
+            [(d.box_px, np.float64(d.score).tobytes(), d.windows) for d in want]
+        lone += len(got)
+    # both cases of the overlap (a window at IoU >= 0.5, none) and lone windows came up
+    assert overlapped > 20 and alone > 20 and lone > 100

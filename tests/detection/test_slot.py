@@ -220,3 +220,40 @@ def test_a_track_not_walking_is_judged_where_it_was_last_seen():
     # the same track once its walk is trusted: in the path
     request, _ = slot._request([track(1, 15.0, 1.0, vy=-1.2, standing=(15.0, 3.5))], path, 10.0)
     assert request.reason == "pedestrian in the path"
+
+
+WARM_CHECK = """
+from percept.compiled import dispatchers
+from percept.detection import blocks, hog, pyramid
+from percept.drive import bench as B
+from percept.drive.tasks import TASKS
+from percept.sims import SimWorld, WorldConfig
+from percept.sims.coords import hw_pose
+kernels = dispatchers(blocks, hog, pyramid)
+world = SimWorld(WorldConfig("crossing", seed=1, autopilot=True))
+feed = B.TruthFeed()
+ctx = B.SlotContext(world.cfg.rig, world.dt, None, feed, start_pose=hw_pose(world.ego))
+tasks = {t.name: t for t in TASKS}
+lateral, slot = tasks["lateral"].privileged(ctx), tasks["pedestrians"].vision(ctx)
+before = [len(k.signatures) for k in kernels]
+windows = grouped = lone = 0
+for _ in range(60):
+    frame, feed.truth = world.observe()
+    request, debug = slot.step(frame, {"lateral": lateral.step(frame, {})[0]})
+    grouped += sum(d.windows > 1 for d in debug.detections)
+    lone += sum(d.windows == 1 for d in debug.detections)
+    world.step()
+print(len(kernels), min(before), grouped, lone, [len(k.signatures) for k in kernels] == before)
+"""
+
+
+def test_the_slot_loads_its_compiled_passes_when_built_not_in_a_frame():
+    """The HOG blocks', the window sums' and the grouping's compiled passes, in a fresh process."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    count, least, grouped, lone, unchanged = out.stdout.split()
+    # every kernel loaded by the slot's construction; grouped and lone detections came up, so every pass ran
+    assert int(count) == 4 and int(least) >= 1 and int(grouped) > 5 and int(lone) > 0 and unchanged == "True"
