@@ -11,9 +11,12 @@ through the best cost and its neighbours.
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 
+from percept.compiled import kernel
 from percept.sensors import StereoRig
 
 SIGMA_D_PX = 0.4
@@ -45,14 +48,14 @@ def box_depth(left: np.ndarray, right: np.ndarray, box: tuple[float, float, floa
         return None
     fb = rig.camera.fx * rig.baseline_m
     d0 = fb / max(z_guess_m, 0.5)
-    d_lo, d_hi = max(int(np.floor(0.6 * d0)), 1), int(np.ceil(1.6 * d0)) + 1
+    d_lo, d_hi = max(math.floor(0.6 * d0), 1), math.ceil(1.6 * d0) + 1
     # the right image's columns for disparities d_lo..d_hi: a point at u in the left is at u - d in the right
     s0, s1 = pu0 - d_hi, pu1 - d_lo
     if s0 < 0 or s1 > w:
         return None
     cost = cv2.matchTemplate(_grey(right[pv0:pv1, s0:s1]), patch, cv2.TM_SQDIFF).ravel()
-    k = int(np.argmin(cost))
-    if k == 0 or k == len(cost) - 1 or cost[k] > 0.5 * float(np.median(cost)):
+    k, distinct = best_match(cost)
+    if not distinct:
         return None
     c_m, c_0, c_p = float(cost[k - 1]), float(cost[k]), float(cost[k + 1])
     # parabola through the best cost and its neighbours: offset = (c- - c+) / (2 (c- - 2 c0 + c+))
@@ -65,3 +68,21 @@ def box_depth(left: np.ndarray, right: np.ndarray, box: tuple[float, float, floa
     z = fb / d
     # sigma_Z = Z^2 sigma_d / (f b)
     return z, z * z * SIGMA_D_PX / fb
+
+
+@kernel()
+def best_match(cost):  # pragma: no cover - compiled
+    """The least of the costs (N,) float32 along the strip: its position k (the first of equal ones, as np.argmin)
+    and whether the match is distinct: not at either end of the strip, and costing at most half the median
+    (np.median's: the middle cost, or the float32 mean of the middle two)."""
+    n = cost.shape[0]
+    k = 0
+    for i in range(1, n):
+        if cost[i] < cost[k]:
+            k = i
+    if k == 0 or k == n - 1:
+        return k, False
+    s = np.sort(cost)
+    # numpy's mean of the middle one or two: their float32 sum from +0, divided by their count
+    median = (np.float32(0) + s[n // 2]) if n % 2 else (np.float32(0) + s[n // 2 - 1] + s[n // 2]) / np.float32(2)
+    return k, not cost[k] > 0.5 * np.float64(median)

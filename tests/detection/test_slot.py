@@ -224,36 +224,40 @@ def test_a_track_not_walking_is_judged_where_it_was_last_seen():
 
 WARM_CHECK = """
 from percept.compiled import dispatchers
-from percept.detection import blocks, hog, pyramid
+from percept.detection import blocks, hog, pyramid, stereo_range
 from percept.drive import bench as B
 from percept.drive.tasks import TASKS
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose
-kernels = dispatchers(blocks, hog, pyramid)
+kernels = dispatchers(blocks, hog, pyramid, stereo_range)
 world = SimWorld(WorldConfig("crossing", seed=1, autopilot=True))
 feed = B.TruthFeed()
 ctx = B.SlotContext(world.cfg.rig, world.dt, None, feed, start_pose=hw_pose(world.ego))
 tasks = {t.name: t for t in TASKS}
 lateral, slot = tasks["lateral"].privileged(ctx), tasks["pedestrians"].vision(ctx)
 before = [len(k.signatures) for k in kernels]
-windows = grouped = lone = 0
+grouped = lone = stereo = 0
 for _ in range(60):
     frame, feed.truth = world.observe()
     request, debug = slot.step(frame, {"lateral": lateral.step(frame, {})[0]})
     grouped += sum(d.windows > 1 for d in debug.detections)
     lone += sum(d.windows == 1 for d in debug.detections)
+    stereo = max([stereo] + [t.stereo_hits for t in debug.tracks])
     world.step()
-print(len(kernels), min(before), grouped, lone, [len(k.signatures) for k in kernels] == before)
+print(len(kernels), min(before), grouped, lone, stereo, [len(k.signatures) for k in kernels] == before)
 """
 
 
 def test_the_slot_loads_its_compiled_passes_when_built_not_in_a_frame():
-    """The HOG blocks', the window sums' and the grouping's compiled passes, in a fresh process."""
+    """The HOG blocks', the window sums', the grouping's and the stereo match's compiled passes, in a fresh
+    process."""
     import subprocess
     import sys
 
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
-    count, least, grouped, lone, unchanged = out.stdout.split()
-    # every kernel loaded by the slot's construction; grouped and lone detections came up, so every pass ran
-    assert int(count) == 4 and int(least) >= 1 and int(grouped) > 5 and int(lone) > 0 and unchanged == "True"
+    count, least, grouped, lone, stereo, unchanged = out.stdout.split()
+    # every kernel loaded by the slot's construction; grouped and lone detections and stereo matches came up, so
+    # every pass ran
+    assert int(count) == 5 and int(least) >= 1 and int(grouped) > 5 and int(lone) > 0 and int(stereo) > 3
+    assert unchanged == "True"

@@ -46,3 +46,25 @@ def test_featureless_or_out_of_image_patches_give_nothing():
     left, right = pair(10.0)
     assert box_depth(left, right, (-20.0, 200.0, 30.0, 320.0), rig, 30.0) is None
     assert box_depth(left, right, (300.0, 200.0, 302.0, 320.0), rig, 30.0) is None
+
+
+def test_the_best_match_is_numpys_argmin_and_median_test():
+    """``best_match`` gives np.argmin's position and the test box_depth made with np.median, on costs of odd and even
+    lengths with ties, zeros and matchTemplate's slightly negative float32 rounding."""
+    from percept.detection.stereo_range import best_match
+
+    rng = np.random.default_rng(5)
+    counts = np.zeros(3, int)  # distinct, at an end, not distinct enough
+    for trial, n in enumerate(list(range(1, 12)) + [31, 40, 57, 64] * 30):
+        kind = trial % 3
+        if kind == 0:  # ties, zeros and tiny negatives
+            cost = rng.choice([rng.uniform(0, 1e5), 0.0, -0.5, 7.0], n).astype(np.float32)
+        elif kind == 1:  # a sharp minimum
+            cost = (rng.uniform(0, 1e5, n) * rng.uniform(0, 1, n) ** 4).astype(np.float32)
+        else:  # flat: the least cost near the median
+            cost = rng.uniform(0.4e4, 1.1e4, n).astype(np.float32)
+        k = int(np.argmin(cost))
+        want = not (k == 0 or k == len(cost) - 1 or cost[k] > 0.5 * float(np.median(cost)))
+        assert best_match(cost) == (k, want)
+        counts[0 if want else 1 if k in (0, n - 1) else 2] += 1
+    assert np.all(counts > 10), counts
