@@ -35,7 +35,7 @@ from percept.sensors.vehicle import bumper_gap_m
 from .constrained import FEET_MARGIN_PX, PERSON_PX, ConstrainedSearch, SearchConfig, SearchStats, person_box
 from .hog import WINDOW_PX, LinearModel
 from .pyramid import Detection
-from .stereo_range import best_match, box_depth
+from .stereo_range import best_match, box_depth, texture_side
 from .tracking import PersonTrack, PersonTracker, TrackConfig
 
 DEFAULT_LANE_WIDTH_M = 3.5
@@ -105,7 +105,9 @@ class PedestrianSlot:
                              f"{far_sweep_frames}")
         self.search = ConstrainedSearch(rig, model if model is not None else LinearModel.inria(), search)
         self.tracker = PersonTracker(rig, dt_s, tracking)
-        best_match(np.zeros(3, np.float32))  # the stereo match's compiled pass, loaded now rather than in a frame
+        # the stereo match's compiled passes, loaded now rather than in a frame
+        texture_side(np.zeros((6, 3), np.uint8), 1.0)
+        best_match(np.zeros(3, np.float32))
         # frames between two searches of each level: the far field's levels (people up to far_person_px tall)
         # every far_sweep_frames, the others every sweep_frames
         self.periods = tuple(far_sweep_frames if PERSON_PX * s <= far_person_px else sweep_frames

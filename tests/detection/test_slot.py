@@ -259,5 +259,5 @@ def test_the_slot_loads_its_compiled_passes_when_built_not_in_a_frame():
     count, least, grouped, lone, stereo, unchanged = out.stdout.split()
     # every kernel loaded by the slot's construction; grouped and lone detections and stereo matches came up, so
     # every pass ran
-    assert int(count) == 5 and int(least) >= 1 and int(grouped) > 5 and int(lone) > 0 and int(stereo) > 3
+    assert int(count) == 6 and int(least) >= 1 and int(grouped) > 5 and int(lone) > 0 and int(stereo) > 3
     assert unchanged == "True"

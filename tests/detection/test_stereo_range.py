@@ -68,3 +68,22 @@ def test_the_best_match_is_numpys_argmin_and_median_test():
         assert best_match(cost) == (k, want)
         counts[0 if want else 1 if k in (0, n - 1) else 2] += 1
     assert np.all(counts > 10), counts
+
+
+def test_the_texture_test_decides_as_numpys_std_does():
+    """``texture_side`` is -1 only where np.std is below the threshold and +1 only where it is not, and leaves the
+    patches whose variance is the threshold's to np.std: random patches, patches at and about variance 16."""
+    from percept.detection.stereo_range import MIN_TEXTURE, texture_side
+
+    rng = np.random.default_rng(8)
+    patches = [rng.integers(0, 256, (int(rng.integers(6, 200)), int(rng.integers(3, 120)))).astype(np.uint8) // d
+               for d in rng.choice([1, 8, 16, 32, 64, 255], 300)]
+    patches += [np.tile(np.array([0, 8], np.uint8), (6, 5)), np.tile(np.array([0, 8, 0, 9], np.uint8), (7, 3)),
+                np.tile(np.array([1, 9, 1, 8], np.uint8), (7, 3)), np.full((9, 4), 200, np.uint8)]
+    sides = []
+    for p in patches:
+        side = texture_side(p, MIN_TEXTURE * MIN_TEXTURE)
+        below = float(p.std()) < MIN_TEXTURE
+        assert side == 0 or (side < 0) == below
+        sides.append(side)
+    assert sides[-4] == 0 and sides.count(-1) > 20 and sides.count(1) > 20
