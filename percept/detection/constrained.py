@@ -182,8 +182,8 @@ class ConstrainedSearch:
         x, y = np.nonzero(scores >= cfg.threshold)
         if not len(x):
             # no window at the threshold (most strips): nothing to place, nothing for a second stage to score
-            return np.zeros((0, 4)), np.zeros(0, np.float32), None if self.model.second is None else np.zeros(
-                0, np.float32), scores.size
+            none = np.zeros(0, np.float32)
+            return np.zeros((0, 4)), none, None if self.model.second is None else none, scores.size
         sx, sy = (u1 - u0) / size[0], (v1 - v0) / size[1]
         boxes = np.column_stack([u0 + x * c * sx, v0 + y * c * sy, np.full(len(x), 8 * c * sx),
                                  np.full(len(x), 16 * c * sy)])

@@ -92,10 +92,10 @@ def best_match(cost):  # pragma: no cover - compiled
 
 @kernel()
 def texture_side(patch, var):  # pragma: no cover - compiled
-    """Whether the grey levels' variance (uint8 (h, w)) is surely below ``var`` (-1), surely above it (+1), or too
-    near it (0) for its exact value, from integer sums, to tell which side np.std's rounding puts it: numpy's
-    two-pass variance is within ~1e-13 of the exact one for such patches (its sum of grey levels is exact, the mean
-    and the squares round at 1e-16 each, their sum at log2(n) 1e-16), far inside the 1e-9 kept here."""
+    """Which side of ``var`` the variance of ``patch``'s grey levels (uint8 (h, w)) lies, from exact integer sums:
+    -1 surely below, +1 surely above, 0 too near for np.std's rounding to be told apart. numpy's two-pass variance
+    of such a patch is within ~1e-13 of the exact one (its sum of grey levels is exact, the mean and each square
+    round at 1e-16, their pairwise sum at log2(n) 1e-16), far inside the 1e-9 kept here."""
     n, s, s2 = 0, 0, 0
     for i in range(patch.shape[0]):
         for j in range(patch.shape[1]):

@@ -114,6 +114,8 @@ class EgoStep:
 
     @classmethod
     def of(cls, dt: float, ego_speed_mps: float, yaw_rate_rps: float, accel_mps2: float) -> "EgoStep":
+        """The step over dt [s] at ``ego_speed_mps`` turning at ``yaw_rate_rps``, people's white-noise acceleration
+        ``accel_mps2`` [m/s²]."""
         th = yaw_rate_rps * dt
         c, s = np.cos(th), np.sin(th)
         rt = np.array([[c, s], [-s, c]])  # R(th)^T: the old vehicle frame's vectors in the new one
