@@ -74,11 +74,13 @@ def check_intrinsics(K) -> np.ndarray:
 
 
 def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], threshold: int,
-                   mask: np.ndarray | None = None, noise: float | None = None) -> np.ndarray:
+                   mask: np.ndarray | None = None, noise: float | None = None,
+                   spread: float | None = None) -> np.ndarray:
     """FAST corners, the strongest few per grid cell so that they cover the image: (N, 2) float32 [px]. The
     threshold rises with the image noise (NOISE_GAIN sigma; ``noise``: sigma when already measured) so that noise
-    makes no corners."""
-    if float(cv2.meanStdDev(gray)[1][0, 0]) < MIN_CONTRAST_GREY:
+    makes no corners; none in an image whose grey levels' standard deviation (``spread``, when already measured)
+    is under MIN_CONTRAST_GREY."""
+    if (float(cv2.meanStdDev(gray)[1][0, 0]) if spread is None else spread) < MIN_CONTRAST_GREY:
         return np.zeros((0, 2), np.float32)
     threshold = max(int(threshold), int(round(NOISE_GAIN * (noise_sigma(gray) if noise is None else noise))))
     kps = cv2.FastFeatureDetector_create(threshold, True).detect(gray, mask)

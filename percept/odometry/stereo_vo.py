@@ -140,8 +140,11 @@ class StereoVO:
         here)."""
         c = self.config
         self._noise = noise_sigma(gl)
-        self._win_px = c.dark_win_px if cv2.mean(gl)[0] < c.dark_grey else c.win_px
-        corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise)
+        # the grey levels' mean (dark keyframes track with smaller windows) and spread (featureless ones have no
+        # corners) in one pass
+        mean, spread = (float(m[0, 0]) for m in cv2.meanStdDev(gl))
+        self._win_px = c.dark_win_px if mean < c.dark_grey else c.win_px
+        corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise, spread=spread)
         corners = corners[self._static(corners)]
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
         self._kf_points = self._pixels = self._kf_pixels = None

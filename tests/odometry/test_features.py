@@ -36,3 +36,15 @@ def test_a_flat_or_dark_frame_gives_no_corners():
     dim = np.clip(rng.normal(3, MIN_CONTRAST_GREY / 2, (120, 160)), 0, 255).astype(np.uint8)
     assert len(detect_corners(dim, 100, (4, 3), 5)) == 0
     assert len(detect_corners(_textured(rng, 1.0), 100, (4, 3), 5)) > 20
+
+
+def test_a_spread_measured_already_decides_as_the_image_would():
+    import cv2
+
+    rng = np.random.default_rng(2)
+    img = _textured(rng, 1.0)
+    spread = float(cv2.meanStdDev(img)[1][0, 0])
+    want = detect_corners(img, 100, (4, 3), 5)
+    assert len(want) > 20 and np.array_equal(detect_corners(img, 100, (4, 3), 5, spread=spread), want)
+    # told the image is flat, it finds nothing
+    assert len(detect_corners(img, 100, (4, 3), 5, spread=MIN_CONTRAST_GREY / 2)) == 0
