@@ -106,6 +106,7 @@ class ConstrainedSearch:
         n = int(np.floor(np.log(s_max / s_min) / np.log(cfg.step))) + 1
         self.scales = s_min * cfg.step ** np.arange(n)
         self.cam_x = float(rig.camera_position()[0])
+        self._depths = tuple(self._depth_range(float(s)) for s in self.scales)
         # what a full pyramid over the same scales scores: every window at an 8-pixel stride, for the count
         self.full_windows = int(sum(max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0)
                                     * max(int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0) for s in self.scales))
@@ -118,26 +119,42 @@ class ConstrainedSearch:
         boxes, scores = np.array([[0, 0, 32, 64], [1, 0, 32, 64]], np.int32), np.ones(2, np.float32)
         second_stage_kept(group(boxes, scores, 1) + lone_windows(boxes, scores), boxes, scores, 0.0)
 
-    def region(self, level: int, path: EgoPath) -> tuple[int, int, int, int] | None:
-        """The image region (u0, v0, u1, v1) that holds every plausible window at scale ``level``, or None."""
-        cam, cfg, scale = self.rig.camera, self.cfg, float(self.scales[level])
+    def _depth_range(self, scale: float) -> tuple[float, float] | None:
+        """The camera depths (near, far) [m] of the people a window of ``scale`` holds, within the searched
+        depths; None when there are none."""
+        cam, cfg = self.rig.camera, self.cfg
         h_lo, h_hi = cfg.heights_m
         # Z = fy H / (96 s) for the shortest and the tallest person, within the searched depths
         z_near = max(cam.fy * h_lo / (PERSON_PX * scale), cfg.min_range_m)
         z_far = min(cam.fy * h_hi / (PERSON_PX * scale), cfg.max_range_m)
-        if z_near > z_far:
-            return None
-        x = self.cam_x + np.array([z_near, z_far])
-        centre = path.centre_y(x).tolist()
-        xs = x.tolist()
-        pts = np.array([[xs[k], centre[k] + side * cfg.half_width_m, 0.0] for k in (0, 1) for side in (-1, 1)])
-        uv, _ = self.rig.project_vehicle_points(pts)
-        (u_min, v_min), (u_max, v_max) = uv.min(axis=0).tolist(), uv.max(axis=0).tolist()
-        # feet rows of the nearest and farthest person; the window reaches 112 s px above the feet and 16 s below
-        v_top = v_min - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
-        v_bot = v_max + FEET_MARGIN_PX * scale
-        u0, u1 = u_min - WINDOW_PX[0] * scale / 2, u_max + WINDOW_PX[0] * scale / 2
-        return self._clip((u0, v_top, u1, v_bot), scale)
+        return None if z_near > z_far else (z_near, z_far)
+
+    def region(self, level: int, path: EgoPath) -> tuple[int, int, int, int] | None:
+        """The image region (u0, v0, u1, v1) that holds every plausible window at scale ``level``, or None."""
+        return self.regions((level,), path)[0][1]
+
+    def regions(self, levels: Iterable[int], path: EgoPath) -> list[tuple[int, tuple[int, int, int, int] | None]]:
+        """(level, ``region``) of each of ``levels``; the corridor's corners of every level projected at once (the
+        same values as one level at a time: every step is element by element)."""
+        cfg, levels = self.cfg, tuple(levels)
+        ks = [k for k in levels if self._depths[k] is not None]
+        if not ks:
+            return [(k, None) for k in levels]
+        # the path's centre at the nearest and the farthest person's feet of every level
+        x = self.cam_x + np.array([z for k in ks for z in self._depths[k]])
+        centre, xs = path.centre_y(x).tolist(), x.tolist()
+        pts = np.array([[xs[i], centre[i] + side * cfg.half_width_m, 0.0] for i in range(len(xs)) for side in (-1, 1)])
+        uv = self.rig.project_vehicle_points(pts)[0]
+        found = {}
+        for n, k in enumerate(ks):
+            scale, corners = float(self.scales[k]), uv[4 * n:4 * n + 4]
+            (u_min, v_min), (u_max, v_max) = corners.min(axis=0).tolist(), corners.max(axis=0).tolist()
+            # feet rows of the nearest and farthest person; the window reaches 112 s px above the feet and 16 s below
+            v_top = v_min - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
+            v_bot = v_max + FEET_MARGIN_PX * scale
+            u0, u1 = u_min - WINDOW_PX[0] * scale / 2, u_max + WINDOW_PX[0] * scale / 2
+            found[k] = self._clip((u0, v_top, u1, v_bot), scale)
+        return [(k, found.get(k)) for k in levels]
 
     def _clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
         cam = self.rig.camera
@@ -198,7 +215,7 @@ class ConstrainedSearch:
 
     def _windows(self, image, path, levels, rois) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, SearchStats]:
         """``windows`` and the windows' second-stage scores (N,) (None when the model has no second stage)."""
-        todo = [(k, self.region(k, path)) for k in (range(len(self.scales)) if levels is None else levels)]
+        todo = self.regions(range(len(self.scales)) if levels is None else levels, path)
         todo = [t for t in todo if t[1] is not None] + self._roi_regions(rois)
         boxes, scores, windows = [np.zeros((0, 4))], [np.zeros(0, np.float32)], 0
         second = None if self.model.second is None else [np.zeros(0, np.float32)]
