@@ -144,11 +144,11 @@ class ConstrainedSearch:
         x = self.cam_x + np.array([z for k in ks for z in self._depths[k]])
         centre, xs = path.centre_y(x).tolist(), x.tolist()
         pts = np.array([[xs[i], centre[i] + side * cfg.half_width_m, 0.0] for i in range(len(xs)) for side in (-1, 1)])
-        uv = self.rig.project_vehicle_points(pts)[0]
+        uv = self.rig.project_vehicle_points(pts)[0].tolist()
         found = {}
         for n, k in enumerate(ks):
-            scale, corners = float(self.scales[k]), uv[4 * n:4 * n + 4]
-            (u_min, v_min), (u_max, v_max) = corners.min(axis=0).tolist(), corners.max(axis=0).tolist()
+            scale, (us, vs) = float(self.scales[k]), zip(*uv[4 * n:4 * n + 4])
+            u_min, u_max, v_min, v_max = min(us), max(us), min(vs), max(vs)
             # feet rows of the nearest and farthest person; the window reaches 112 s px above the feet and 16 s below
             v_top = v_min - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
             v_bot = v_max + FEET_MARGIN_PX * scale
