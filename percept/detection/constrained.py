@@ -196,7 +196,7 @@ class ConstrainedSearch:
         crop = cv2.resize(image[v0:v1, u0:u1], size, interpolation=cv2.INTER_LINEAR)
         blocks = block_grid(crop, c)
         scores = self.model.score_map(blocks)
-        x, y = np.nonzero(scores >= cfg.threshold)
+        x, y = (scores >= cfg.threshold).nonzero()
         if not len(x):
             # no window at the threshold (most strips): nothing to place, nothing for a second stage to score
             none = np.zeros(0, np.float32)

@@ -169,9 +169,11 @@ class LinearModel:
             return None
         if not len(x):
             return np.zeros(0, np.float32)
-        # a window's descriptor is its blocks (x + i, y + j), i < 7, j < 15, in OpenCV's order: (N, 7, 15, 36)
-        i, j = np.arange(BLOCKS[0]), np.arange(BLOCKS[1])
-        d = blocks[np.asarray(x)[:, None, None] + i[None, :, None], np.asarray(y)[:, None, None] + j[None, None, :]]
+        # a window's descriptor is its blocks (x + i, y + j), i < 7, j < 15, in OpenCV's order: (N, 7, 15, 36), copied
+        # window by window (a frame's strips hold a few windows each)
+        d = np.empty((len(x), BLOCKS[0], BLOCKS[1], BLOCK_LEN), blocks.dtype)
+        for n, (bx, by) in enumerate(zip(np.asarray(x).tolist(), np.asarray(y).tolist())):
+            d[n] = blocks[bx:bx + BLOCKS[0], by:by + BLOCKS[1]]
         # s2 = b2 + w2 . descriptor
         return (d.reshape(len(x), DESCRIPTOR_LEN) @ self.second.weights + np.float32(self.second.bias)).astype(
             np.float32)
