@@ -225,12 +225,14 @@ class PersonTracker:
         # H = h_px Z / fy
         return xy, r, float(h_px * z / cam.fy), agreed
 
-    def predicted_box(self, t: _Track) -> Box:
-        """The person box the track predicts in the left image: its feet projected, its height above them."""
-        x, y = t.kf.x[0], t.kf.x[1]
-        pts = np.array([[x, y, 0.0], [x, y, t.height_m]])
-        uv, _ = self.rig.project_vehicle_points(pts)
-        return standing_box(uv[0, 0], uv[0, 1], max(uv[0, 1] - uv[1, 1], 1.0))
+    def predicted_boxes(self, tracks: list[_Track]) -> list[Box]:
+        """The person box each track predicts in the left image: its feet projected, its height above them (every
+        track's points projected at once: the same values as one track at a time)."""
+        if not tracks:
+            return []
+        pts = np.array([[t.kf.x[0], t.kf.x[1], z] for t in tracks for z in (0.0, t.height_m)])
+        uv = self.rig.project_vehicle_points(pts)[0].tolist()
+        return [standing_box(feet[0], feet[1], max(feet[1] - head[1], 1.0)) for feet, head in zip(uv[::2], uv[1::2])]
 
     def predict(self, ego_speed_mps: float, yaw_rate_rps: float = 0.0) -> list[Box]:
         """Advance every track one frame while the ego drives ``ego_speed_mps`` and turns at ``yaw_rate_rps``
@@ -238,7 +240,7 @@ class PersonTracker:
         step = EgoStep.of(self.dt_s, ego_speed_mps, yaw_rate_rps, self.cfg.accel_mps2) if self.tracks else None
         for t in self.tracks:
             t.predict(step)
-        boxes = [self.predicted_box(t) for t in self.tracks]
+        boxes = self.predicted_boxes(self.tracks)
         # a track that has walked (or been driven) out of the image, or behind the camera, has gone
         w = self.rig.camera.width
         keep = [i for i, (t, b) in enumerate(zip(self.tracks, boxes)) if t.kf.x[0] - self.cam_x > 0.5
