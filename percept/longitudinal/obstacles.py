@@ -164,10 +164,12 @@ class ObstacleFinder:
         area = np.concatenate([np.full(len(p[0]), p[4], np.float32) for p in parts])
         self.ground.update(pv, u)
         pv[:, 2] = self.ground.height(pv)
-        lateral = np.abs(pv[:, 1] - path.centre_y(pv[:, 0]))
-        stand = (pv[:, 2] > cfg.min_height_m) & (pv[:, 2] < cfg.max_height_m) & (lateral < cfg.half_width_m)
-        debug = {"matched": int(len(z)), "standing": int(stand.sum())}
-        if not stand.any():
+        up = np.flatnonzero((pv[:, 2] > cfg.min_height_m) & (pv[:, 2] < cfg.max_height_m))
+        # the path's centre only at the points that stand up (most are the road's)
+        lateral = np.abs(pv[up, 1] - path.centre_y(pv[up, 0]))
+        stand = up[lateral < cfg.half_width_m]
+        debug = {"matched": int(len(z)), "standing": int(len(stand))}
+        if not len(stand):
             return None, debug
         return self._nearest_group(u[stand], v[stand], z[stand], pv[stand], area[stand]), debug
 

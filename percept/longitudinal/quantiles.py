@@ -39,8 +39,13 @@ def percentiles(a: np.ndarray, qs: tuple[float, ...]) -> list[np.float64]:
 
 
 def median(a: np.ndarray):
-    """``np.median(a)`` for a non-empty 1-D float array without NaN: the middle value, or the mean of the two."""
+    """``np.median(a)`` for a non-empty 1-D float array without NaN: the middle value, or the mean of the two.
+    numpy takes that mean with ``np.mean`` (~10 µs of machinery for two values); its sum starts from 0 (so a -0.0
+    comes out as 0.0) and the result keeps the array's dtype, which the scalar arithmetic below does as well."""
     n, h = a.size, a.size // 2
     if n % 2:
-        return np.mean(np.partition(a, h)[h:h + 1])
-    return np.mean(np.partition(a, (h - 1, h))[h - 1:h + 1])
+        # mean of one value x: (0 + x) / 1
+        return 0.0 + np.partition(a, h)[h]
+    p = np.partition(a, (h - 1, h))
+    # mean of two: (0 + x0 + x1) / 2
+    return (0.0 + p[h - 1] + p[h]) / 2

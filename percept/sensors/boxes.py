@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = ["check_boxes", "iou", "iou_matrix"]
@@ -40,6 +42,28 @@ def iou_matrix(a_boxes: np.ndarray, b_boxes: np.ndarray) -> np.ndarray:
     return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0.0)
 
 
-def iou(a: np.ndarray, b: np.ndarray) -> float:
-    """Intersection over union of two boxes (u0, v0, u1, v1) [px]."""
-    return float(iou_matrix(np.reshape(a, (1, -1)), np.reshape(b, (1, -1)))[0, 0])
+def iou(a, b) -> float:
+    """Intersection over union of two boxes (u0, v0, u1, v1) [px]: ``iou_matrix``'s arithmetic for one pair, in Python
+    floats (the same IEEE doubles, so the same value) rather than (1, 1) arrays, whose checks and ufuncs cost ~30x
+    more."""
+    (au0, av0, au1, av1), (bu0, bv0, bu1, bv1) = _one_box(a, "iou A"), _one_box(b, "iou B")
+    # |A ∩ B| = max(0, min(u1) - max(u0)) * max(0, min(v1) - max(v0))
+    w, h = min(au1, bu1) - max(au0, bu0), min(av1, bv1) - max(av0, bv0)
+    inter = (w if w > 0.0 else 0.0) * (h if h > 0.0 else 0.0)
+    # |A ∪ B| = |A| + |B| - |A ∩ B|
+    union = (au1 - au0) * (av1 - av0) + (bu1 - bu0) * (bv1 - bv0) - inter
+    # IoU = |A ∩ B| / |A ∪ B|, 0 for two boxes of zero area
+    return inter / union if union > 0.0 else 0.0
+
+
+def _one_box(box, what: str) -> tuple[float, float, float, float]:
+    """A box's four coordinates as floats, checked as ``check_boxes`` checks them (a tuple or list of four numbers
+    directly, anything else through it)."""
+    if isinstance(box, (tuple, list)) and len(box) == 4:
+        c = tuple(float(x) for x in box)
+        if not all(math.isfinite(x) for x in c):
+            raise ValueError(f"{what}: box coordinates must be finite")
+        if c[2] < c[0] or c[3] < c[1]:
+            raise ValueError(f"{what}: a box has u1 < u0 or v1 < v0; boxes are (u0, v0, u1, v1)")
+        return c
+    return tuple(check_boxes(np.reshape(box, (1, -1)), what)[0].tolist())

@@ -51,9 +51,12 @@ class LaneEstimate:
     def centre_y(self, x_m: np.ndarray) -> np.ndarray:
         """Lateral position of the lane centre at distances x_m ahead [m]."""
         x = np.asarray(x_m, dtype=float)
+        # without a curvature rate its term is a signed zero wherever x^3 is finite, and so is 0 x (the same sign):
+        # the power (~15 ns a value, the most of this on a frame's thousands of stereo points) is not needed
+        cube = x ** 3 if self.curvature_rate_1pm2 else x
         # y_c = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6
         return (-self.offset_m - np.tan(self.heading_rad) * x + 0.5 * self.curvature_1pm * x * x
-                + self.curvature_rate_1pm2 * x ** 3 / 6)
+                + self.curvature_rate_1pm2 * cube / 6)
 
     def boundary_y(self, x_m: np.ndarray, side: int) -> np.ndarray:
         """side +1: left boundary, -1: right boundary."""
