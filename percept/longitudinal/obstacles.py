@@ -19,8 +19,13 @@ from percept.sensors import EgoPath, Side, StereoRig
 
 from .dense import check_num_disparities
 from .ground import GroundConfig, GroundPlane
+from .groups import first_grounded_blob, range_bins
 from .lift import lift_band
 from .quantiles import median, percentile, percentiles
+
+
+GROUNDED_PERCENTILE = 5
+"""The percentile of a group's heights that must be below ``grounded_m`` (its lowest pixels, but for a few strays)."""
 
 
 @dataclass(frozen=True)
@@ -141,6 +146,10 @@ class ObstacleFinder:
         black = np.zeros((cam.height, cam.width), np.uint8)
         self.find(black, black, EgoPath.straight(0.0))
         self.reset()
+        # and the group search's, which a black frame does not reach: three points standing 20 m ahead
+        pts = np.array([[20.0, 0.0, 0.5]] * 3)
+        one = np.ones(3, np.float32)
+        self._nearest_group(one * 300, one * 200, one * 20, pts, one * 4)
 
     def reset(self) -> None:
         self.ground.reset()
@@ -178,29 +187,36 @@ class ObstacleFinder:
         # range bins of relative width bin_rel: log(Z) in steps of log(1 + bin_rel); points sorted by bin, so that
         # bins b-1..b+1 are one slice and their area a difference of running sums
         k = np.floor(np.log(z) / np.log1p(cfg.bin_rel)).astype(int)
-        order = np.argsort(k, kind="stable")
-        ks = k[order]
-        run = np.concatenate([[0.0], np.cumsum(area[order], dtype=np.float64)])
-        bins = np.unique(ks)
-        los, his = np.searchsorted(ks, bins - 1, "left"), np.searchsorted(ks, bins + 1, "right")
+        order, run, bins, los, his = range_bins(k, area)
         # a full-resolution pixel covers (Z / f)^2 m^2 at range Z: the pixels an area needs there
         needs = np.maximum(cfg.min_area_m2 * (cam.fx / np.exp(bins * np.log1p(cfg.bin_rel))) ** 2, 24)
         # only bins (with their neighbours) holding that much area can hold the obstacle: nearest first
-        for i in np.flatnonzero(run[his] - run[los] >= needs * (1 - 1e-4)):
-            lo, hi, need = los[i], his[i], needs[i]
-            near = np.sort(order[lo:hi])
-            if area[near].sum() < need:
-                continue
-            blob = near[self._largest_blob(u[near], v[near], area[near])]
-            if area[blob].sum() >= need and percentile(pv[blob, 2], 5) < cfg.grounded_m:
-                break
-        else:
+        cands = np.flatnonzero(run[his] - run[los] >= needs * (1 - 1e-4))
+        found, blob = first_grounded_blob(cands, los, his, needs, order, u, v, np.ascontiguousarray(pv[:, 2]), area,
+                                          cfg.blob_cell_px, GROUNDED_PERCENTILE, cfg.grounded_m)
+        if found < 0:
+            # two largest blobs of one area: cv2's labels say which is first
+            blob = self._search(cands[-1 - found:], los, his, needs, order, u, v, pv, area)
+        if not found or blob is None:
             return None
         us, vs = u[blob], v[blob]
         u0, u1 = percentiles(us, (2, 98))
         v0, v1 = percentiles(vs, (2, 98))
         box = (int(max(u0 - 1, 0)), int(max(v0 - 1, 0)), int(min(u1 + 2, cam.width)), int(min(v1 + 2, cam.height)))
         return Obstacle(float(median(z[blob])), box, float(area[blob].sum()))
+
+    def _search(self, cands, los, his, needs, order, u, v, pv, area) -> np.ndarray | None:
+        """``first_grounded_blob``'s search in numpy, where it cannot tell the largest blob: the blob's point indices,
+        or None."""
+        for i in cands:
+            lo, hi, need = los[i], his[i], needs[i]
+            near = np.sort(order[lo:hi])
+            if area[near].sum() < need:
+                continue
+            blob = near[self._largest_blob(u[near], v[near], area[near])]
+            if area[blob].sum() >= need and percentile(pv[blob, 2], GROUNDED_PERCENTILE) < self.cfg.grounded_m:
+                return blob
+        return None
 
     def _largest_blob(self, u: np.ndarray, v: np.ndarray, area: np.ndarray) -> np.ndarray:
         """Indices of the pixels of the largest connected blob (by area) among pixels (u, v) [px]: one object is

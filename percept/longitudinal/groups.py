@@ -1,0 +1,136 @@
+"""The obstacle finder's search for the nearest group of standing pixels, compiled.
+
+Its numpy form (kept as the reference in tests/longitudinal/test_groups.py) spent ~0.3 ms a frame in a dozen small
+calls per range bin tried (a frame tries three on average): the sort, the sums, the grid of image cells and its
+connected components, the percentile. The arithmetic here is numpy's, operation for operation and type for type,
+so the group is the same pixel for pixel. Logarithms and exponentials stay in numpy (its own SIMD functions, which
+need not round as the C library's do).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from percept.compiled import kernel, pairwise_sum
+
+
+@kernel()
+def range_bins(k, area):  # pragma: no cover - compiled
+    """The points' range bins ``k`` (N,) int64 sorted: ``order`` (a stable argsort), the running sums ``run`` (N + 1,)
+    float64 of the points' ``area`` (N,) float32 in that order from 0 (numpy's cumsum), the distinct bins ``bins`` and,
+    for each, the slice [los, his) of the sorted points in bins b - 1 .. b + 1."""
+    order = np.argsort(k, kind="mergesort")
+    n = k.shape[0]
+    ks = k[order]
+    run = np.empty(n + 1)
+    run[0] = 0.0
+    for j in range(n):
+        # run[j + 1] = area[order[0]] + ... + area[order[j]], left to right
+        a = np.float64(area[order[j]])
+        run[j + 1] = a if j == 0 else run[j] + a
+    m = 0
+    for j in range(n):
+        if j == 0 or ks[j] != ks[j - 1]:
+            m += 1
+    bins = np.empty(m, np.int64)
+    m = 0
+    for j in range(n):
+        if j == 0 or ks[j] != ks[j - 1]:
+            bins[m] = ks[j]
+            m += 1
+    los = np.searchsorted(ks, bins - 1, side="left")
+    his = np.searchsorted(ks, bins + 1, side="right")
+    return order, run, bins, los, his
+
+
+@kernel()
+def first_grounded_blob(cands, los, his, needs, order, u, v, h, area, cell, q, grounded):  # pragma: no cover
+    """The first candidate bin c (of ``cands``, indices into ``los``, ``his``, ``needs``) whose points ``order[los:his]``
+    (taken in index order) hold ``needs`` [px] of ``area``, and whose largest blob (by area) of image cells ``cell``
+    [px] square, 8-connected, holds it too with its ``q``-th height percentile below ``grounded`` [m]: (1, the blob's
+    point indices). (0, none) when no candidate has one; (-1 - c, none) when the largest blob at candidate c is not
+    unique (two of equal area: which one is first is cv2's labelling order's to say, so the caller takes it from
+    there)."""
+    empty = np.empty(0, np.int64)
+    cellf = np.float32(cell)
+    for c in range(cands.shape[0]):
+        i = cands[c]
+        lo, hi, need = los[i], his[i], needs[i]
+        near = np.sort(order[lo:hi])
+        a_near = area[near]
+        if pairwise_sum(a_near, 0, a_near.shape[0]) < need:
+            continue
+        # the cells of the points: (u / cell, v / cell) in float32, truncated
+        nn = near.shape[0]
+        cu, cv = np.empty(nn, np.int64), np.empty(nn, np.int64)
+        gw, gh = 0, 0
+        for j in range(nn):
+            cu[j], cv[j] = int(u[near[j]] / cellf), int(v[near[j]] / cellf)
+            gw, gh = max(gw, cu[j] + 2), max(gh, cv[j] + 2)
+        labels = np.zeros((gh, gw), np.int64)
+        for j in range(nn):
+            labels[cv[j], cu[j]] = -1
+        # connected components of the occupied cells (8-neighbours), by flood fill
+        stack = np.empty(gh * gw, np.int64)
+        count = 0
+        for r in range(gh):
+            for s in range(gw):
+                if labels[r, s] != -1:
+                    continue
+                count += 1
+                labels[r, s] = count
+                top = 0
+                stack[0] = r * gw + s
+                while top >= 0:
+                    p = stack[top]
+                    top -= 1
+                    pr, ps = p // gw, p % gw
+                    for dr in range(-1, 2):
+                        for ds in range(-1, 2):
+                            rr, ss = pr + dr, ps + ds
+                            if 0 <= rr < gh and 0 <= ss < gw and labels[rr, ss] == -1:
+                                labels[rr, ss] = count
+                                top += 1
+                                stack[top] = rr * gw + ss
+        # each blob's area, summed in the points' order in float64 (numpy's bincount with weights)
+        sums = np.zeros(count + 1)
+        for j in range(nn):
+            sums[labels[cv[j], cu[j]]] += np.float64(a_near[j])
+        best, ties = 1, 0
+        for b in range(2, count + 1):
+            if sums[b] > sums[best]:
+                best, ties = b, 0
+            elif sums[b] == sums[best]:
+                ties += 1
+        if ties:
+            return -1 - c, empty
+        size = 0
+        for j in range(nn):
+            if labels[cv[j], cu[j]] == best:
+                size += 1
+        blob = np.empty(size, np.int64)
+        size = 0
+        for j in range(nn):
+            if labels[cv[j], cu[j]] == best:
+                blob[size] = near[j]
+                size += 1
+        if pairwise_sum(area[blob], 0, size) >= need and _percentile(h[blob], q) < grounded:
+            return 1, blob
+    return 0, empty
+
+
+@njit(cache=True)
+def _percentile(x, q):  # pragma: no cover - compiled
+    """``np.percentile(x, q)`` of a non-empty float64 array without NaN (quantiles.percentile's arithmetic)."""
+    n = x.shape[0]
+    # virtual index i = (n - 1) q / 100
+    vq = (n - 1) * (q / 100.0)
+    s = np.sort(x)
+    if vq >= n - 1:
+        return s[n - 1]
+    lo = int(vq)
+    x0, x1 = s[lo], s[lo + 1]
+    t = vq - lo
+    d = x1 - x0
+    return x1 - d * (1 - t) if t >= 0.5 else x0 + d * t
