@@ -9,11 +9,14 @@ only near the row the stereo range predicts. Its noise grows as Z^2: dZ/dv = Z^2
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from percept.sensors import StereoRig
+
+from .pixels import RoadPixels, whole
 
 
 @dataclass(frozen=True)
@@ -47,6 +50,7 @@ class ContactRange:
     def __init__(self, rig: StereoRig, cfg: ContactConfig = ContactConfig()):
         self.rig, self.cfg = rig, cfg
         self.cam_x = float(rig.camera_position()[0])
+        self.road = RoadPixels(rig)
 
     def _row(self, range_m: float) -> float:
         """Image row of the road at ``range_m`` ahead of the camera (rows depend on distance only: no roll)."""
@@ -59,8 +63,9 @@ class ContactRange:
         cfg, cam = self.cfg, self.rig.camera
         u0, _, u1, _ = box
         z = range_guess_m + cfg.rear_overhang_m
-        top = int(np.floor(self._row(z * cfg.window[1])))
-        bottom = int(np.ceil(self._row(z * cfg.window[0]))) + 1
+        far, near = z * cfg.window[1], z * cfg.window[0]
+        top = whole(self.road.row(self.cam_x + far), math.floor, lambda: self._row(far))
+        bottom = whole(self.road.row(self.cam_x + near), math.ceil, lambda: self._row(near)) + 1
         top, bottom = max(top, 0), min(bottom, gray.shape[0] - 1)
         k = max(int(round((u1 - u0) * cfg.wheel_frac)), 1)
         if bottom - top < 2 or u1 - u0 < 4:

@@ -102,7 +102,9 @@ def _expansion(g0: np.ndarray, g1: np.ndarray, box: tuple[int, int, int, int], d
     p1, st1, _ = cv2.calcOpticalFlowPyrLK(g0, g1, p0, None, **lk)
     pb, st2, _ = cv2.calcOpticalFlowPyrLK(g1, g0, p1, None, **lk)
     # forward-backward consistency: the track back from frame 1 must land where it started
-    ok = (st1[:, 0] == 1) & (st2[:, 0] == 1) & (np.linalg.norm((pb - p0)[:, 0], axis=1) < cfg.fb_max_px)
+    # (the error's length as np.linalg.norm takes it: sqrt(dx^2 + dy^2) in float32)
+    e = (pb - p0)[:, 0]
+    ok = (st1[:, 0] == 1) & (st2[:, 0] == 1) & (np.sqrt(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1]) < cfg.fb_max_px)
     a, b = np.ascontiguousarray(p0[ok, 0]), np.ascontiguousarray(p1[ok, 0])
     if len(a) < 5:
         return None

@@ -21,6 +21,7 @@ from .dense import check_num_disparities
 from .ground import GroundConfig, GroundPlane
 from .groups import first_grounded_blob, range_bins
 from .lift import lift_band
+from .pixels import RoadPixels, clear
 from .quantiles import median, percentile, percentiles
 
 
@@ -140,6 +141,7 @@ class ObstacleFinder:
         self.near = _Band(rig, cfg.near_scale, split - bn / cfg.near_scale, cam.height, nn, bn, t)
         self.c = rig.camera_position(Side.LEFT)
         self.x_far = np.linspace(cfg.near_m, cfg.max_range_m, 24) + rig.mount_x_m
+        self.road, self.x_far2 = RoadPixels(rig), np.concatenate([self.x_far, self.x_far])
         self.ground = GroundPlane(cfg.ground)
         # the compiled passes (compiled once after an install) loaded now, on a frame's argument types, not in a timed
         # frame: a black frame matches nothing, and the plane fit it starts is forgotten
@@ -155,8 +157,19 @@ class ObstacleFinder:
         self.ground.reset()
 
     def _far_columns(self, path: EgoPath) -> tuple[float, float]:
-        """Image columns the corridor spans beyond near_m (full resolution)."""
+        """Image columns the corridor spans beyond near_m (full resolution). The far band matches the whole columns
+        floor(u0 s) .. ceil(u1 s) at its scale s, which the short projection (``RoadPixels``) gives unless one lies at
+        a whole number, where the rig's projection decides (``_rig_far_columns``)."""
         y = path.centre_y(self.x_far)
+        w = self.cfg.half_width_m
+        u = self.road.columns(self.x_far2, np.concatenate([y + w, y - w]))
+        u0, u1 = float(u.min()), float(u.max()) + 1
+        if clear(u0 * self.far.s) and clear(u1 * self.far.s):
+            return u0, u1
+        return self._rig_far_columns(y)
+
+    def _rig_far_columns(self, y: np.ndarray) -> tuple[float, float]:
+        """``_far_columns`` by the rig's projection, the path's centre at ``x_far`` being ``y``."""
         w = self.cfg.half_width_m
         pts = np.concatenate([np.column_stack([self.x_far, y + side * w, np.zeros_like(y)]) for side in (1, -1)])
         uv, _ = self.rig.project_vehicle_points(pts)

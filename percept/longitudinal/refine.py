@@ -95,7 +95,10 @@ class PatchAligner:
         self.L = left[v0:v1, u0:u1]
         gx = cv2.Sobel(right, cv2.CV_32F, 1, 0, ksize=3, scale=0.125)
         self.right_gx = cv2.merge([right, gx])
-        self.vv, self.uu = np.mgrid[v0:v1, u0:u1].astype(np.float32)
+        # the pixel grid (np.mgrid's, in float32), filled from its row and column
+        self.vv, self.uu = np.empty((2, v1 - v0, u1 - u0), np.float32)
+        self.vv[:] = np.arange(v0, v1, dtype=np.float32)[:, None]
+        self.uu[:] = np.arange(u0, u1, dtype=np.float32)
 
     def refine(self, mask: np.ndarray | None, d0: float, iterations: int = 10, huber: float = 6.0,
                tol: float = 1e-3) -> Refined | None:

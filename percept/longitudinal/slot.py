@@ -173,7 +173,8 @@ class LongitudinalSlot:
             return None
         # the obstacle's own columns: where much of the band matches (stray matches on the road beside it, e.g. on
         # a slanted lane line, would pull the estimate)
-        cols = np.flatnonzero(m.mean(axis=0) >= self.cfg.column_fill)
+        # (the fraction as np.mean takes it: the count over the rows, in float64)
+        cols = np.flatnonzero(np.count_nonzero(m, axis=0) / m.shape[0] >= self.cfg.column_fill)
         if len(cols) == 0 or cols[-1] - cols[0] < 2:
             return None
         m[:, :cols[0]] = False
@@ -216,8 +217,9 @@ class LongitudinalSlot:
             self.kf.x = self.kf.x - self.kf.P[:, 1:2] / self.kf.P[1, 1] * excess
 
     def _apply(self, value: float, R: np.ndarray, i: int) -> None:
-        """The filter's update with one measurement of state ``i``, then the rate floor."""
-        self.kf.update(np.array([[value]]), R=R, H=_H[i])
+        """The filter's update with one measurement of state ``i``, then the rate floor. The measurement goes in as a
+        float: y = z - H x is the same (1, 1) array, and the filter's copy of z (``deepcopy``) is far cheaper."""
+        self.kf.update(value, R=R, H=_H[i])
         self._constrain()
 
     def _new_track(self, z: float, sigma: float) -> None:
