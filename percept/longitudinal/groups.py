@@ -134,3 +134,45 @@ def _percentile(x, q):  # pragma: no cover - compiled
     t = vq - lo
     d = x1 - x0
     return x1 - d * (1 - t) if t >= 0.5 else x0 + d * t
+
+
+@kernel()
+def group_extent(u, v, z, area, blob):  # pragma: no cover - compiled
+    """What the finder reports of a group (``blob``: its point indices): the 2nd and 98th percentiles of its columns
+    and rows ``u``, ``v`` (N,) float32 (float64, as ``np.percentile`` gives for a list of q), the median of its depths
+    ``z`` (N,) float32 (float32, as ``np.median``), and its area (``area`` (N,) float32 summed as ``np.sum``)."""
+    n = blob.shape[0]
+    us, vs, zs, a = u[blob], v[blob], z[blob], area[blob]
+    u0, u1 = _percentile_f32(us, 2), _percentile_f32(us, 98)
+    v0, v1 = _percentile_f32(vs, 2), _percentile_f32(vs, 98)
+    zs.sort()
+    h = n // 2
+    # the mean of the middle value or two, as np.mean sums them: from 0, in float32
+    zero = np.float32(0.0)
+    med = zero + zs[h] if n % 2 else (zero + zs[h - 1] + zs[h]) / np.float32(2.0)
+    return u0, u1, v0, v1, med, pairwise_sum(a, 0, n)
+
+
+@njit(cache=True)
+def _percentile_f32(x, q):  # pragma: no cover - compiled
+    """``np.percentile(x, [q])[0]`` of a non-empty float32 array without NaN, in float64 (quantiles.percentiles'
+    arithmetic: the neighbours' difference in float32, the interpolation in float64)."""
+    n = x.shape[0]
+    vq = (n - 1) * (q / 100.0)
+    s = np.sort(x)
+    if vq >= n - 1:
+        return np.float64(s[n - 1])
+    lo = int(vq)
+    x0, x1 = s[lo], s[lo + 1]
+    t = vq - lo
+    d = x1 - x0
+    return x1 - d * (1 - t) if t >= 0.5 else x0 + d * t
+
+
+def warm_up_groups() -> None:
+    """The group search's compiled passes loaded now (compiled once after an install), on a frame's argument types:
+    one bin of three points at one pixel."""
+    one, idx = np.ones(3, np.float32), np.arange(3, dtype=np.int64)
+    order, run, bins, los, his = range_bins(idx * 0, one)
+    first_grounded_blob(idx[:1], los, his, np.ones(1), order, one, one, np.zeros(3), one, 8, 5, 1.0)
+    group_extent(one, one, one, one, idx)

@@ -19,10 +19,10 @@ from percept.sensors import EgoPath, Side, StereoRig
 
 from .dense import check_num_disparities
 from .ground import GroundConfig, GroundPlane
-from .groups import first_grounded_blob, range_bins
+from .groups import first_grounded_blob, group_extent, range_bins, warm_up_groups
 from .lift import lift_band
 from .pixels import RoadPixels, clear
-from .quantiles import median, percentile, percentiles
+from .quantiles import percentile
 
 
 GROUNDED_PERCENTILE = 5
@@ -148,10 +148,8 @@ class ObstacleFinder:
         black = np.zeros((cam.height, cam.width), np.uint8)
         self.find(black, black, EgoPath.straight(0.0))
         self.reset()
-        # and the group search's, which a black frame does not reach: three points standing 20 m ahead
-        pts = np.array([[20.0, 0.0, 0.5]] * 3)
-        one = np.ones(3, np.float32)
-        self._nearest_group(one * 300, one * 200, one * 20, pts, one * 4)
+        # and the group search's, which a black frame does not reach
+        warm_up_groups()
 
     def reset(self) -> None:
         self.ground.reset()
@@ -212,11 +210,10 @@ class ObstacleFinder:
             blob = self._search(cands[-1 - found:], los, his, needs, order, u, v, pv, area)
         if not found or blob is None:
             return None
-        us, vs = u[blob], v[blob]
-        u0, u1 = percentiles(us, (2, 98))
-        v0, v1 = percentiles(vs, (2, 98))
+        # its box: the 2nd..98th percentiles of its columns and rows; its range: the median depth
+        u0, u1, v0, v1, range_m, support = group_extent(u, v, z, area, blob)
         box = (int(max(u0 - 1, 0)), int(max(v0 - 1, 0)), int(min(u1 + 2, cam.width)), int(min(v1 + 2, cam.height)))
-        return Obstacle(float(median(z[blob])), box, float(area[blob].sum()))
+        return Obstacle(float(range_m), box, float(support))
 
     def _search(self, cands, los, his, needs, order, u, v, pv, area) -> np.ndarray | None:
         """``first_grounded_blob``'s search in numpy, where it cannot tell the largest blob: the blob's point indices,

@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 import pytest
 
-from percept.longitudinal.groups import first_grounded_blob, range_bins
+from percept.longitudinal.groups import first_grounded_blob, group_extent, range_bins
 from percept.longitudinal.obstacles import Obstacle, ObstacleFinder
 from percept.longitudinal.quantiles import median, percentile, percentiles
 from percept.sensors import StereoRig
@@ -110,3 +110,19 @@ def test_two_blobs_of_one_area_are_left_to_the_caller():
             np.full(n + 1, 4, np.float32), 8, 5, 1.0)
     found, blob = first_grounded_blob(*args)
     assert found == 1 and np.array_equal(blob, np.arange(n // 2, n + 1))
+
+
+def test_group_extent_equals_numpys_bit_for_bit():
+    rng = np.random.default_rng(9)
+    for n in list(range(1, 12)) + [50, 51, 300]:
+        for _ in range(30):
+            u = (rng.integers(0, 320, 400) * 2 + 0.5).astype(np.float32)  # pixel centres: many ties
+            v = rng.uniform(0, 480, 400).astype(np.float32)
+            z = rng.uniform(3, 99, 400).astype(np.float32)
+            area = rng.choice(np.array([4.0, 16.0], np.float32), 400)
+            blob = np.sort(rng.choice(400, n, replace=False)).astype(np.int64)
+            got = group_extent(u, v, z, area, blob)
+            want = (*np.percentile(u[blob], [2, 98]), *np.percentile(v[blob], [2, 98]), np.median(z[blob]),
+                    area[blob].sum())
+            # (the kernel's float32 results come back as Python floats: the same values, widened)
+            assert [float(g).hex() for g in got] == [float(w).hex() for w in want]
