@@ -20,7 +20,7 @@ from percept.sensors import EgoPath, Side, StereoRig
 from .dense import check_num_disparities
 from .ground import GroundConfig, GroundPlane
 from .groups import first_grounded_blob, group_extent, range_bins, warm_up_groups
-from .lift import lift_band
+from .lift import lift_bands
 from .pixels import RoadPixels, clear
 from .quantiles import percentile
 
@@ -111,18 +111,15 @@ class _Band:
             return cv2.resize(image, (self.w, h), interpolation=cv2.INTER_AREA)[self.r0:self.r1]
         return cv2.resize(image[self.r0 * k:self.r1 * k], (self.w, self.r1 - self.r0), interpolation=cv2.INTER_AREA)
 
-    def match(self, left: np.ndarray, right: np.ndarray, u0: float, u1: float, origin: np.ndarray, z_min_m: float,
-              z_max_m: float):
-        """Matched pixels with full-resolution columns in [u0, u1) and depth Z in (z_min_m, z_max_m), lifted to the
-        vehicle frame (``lift_band``): (u, v, Z [m], points (N, 3) [m], area [px]); ``left``, ``right``: the band's
-        rows at its scale (``shrink``); ``origin``: the left camera in the vehicle frame [m]."""
+    def match(self, left: np.ndarray, right: np.ndarray, u0: float, u1: float) -> tuple:
+        """The disparities of full-resolution columns [u0, u1), as ``lift_bands`` lifts them to the vehicle frame: (d16,
+        c0, skip, u, v, rays, fb_scaled, area [px]); ``left``, ``right``: the band's rows at its scale (``shrink``)."""
         c0 = max(int(np.floor(u0 * self.s)) - self.nd, 0)
         c1 = min(int(np.ceil(u1 * self.s)) + 1, self.w)
         d16 = self.matcher.compute(left[:, c0:c1], right[:, c0:c1])
         skip = min(self.nd, c1 - c0) if c0 > 0 else 0  # no search room left of the crop
         # Z = f b / d with d = (d16 / 16) / s full-resolution pixels
-        lifted = lift_band(d16, c0, skip, self.u, self.v, self.rays, self.fb * 16.0 * self.s, z_min_m, z_max_m, origin)
-        return (*lifted, 1.0 / self.s ** 2)
+        return d16, c0, skip, self.u, self.v, self.rays, self.fb * 16.0 * self.s, 1.0 / self.s ** 2
 
 
 class ObstacleFinder:
@@ -176,12 +173,9 @@ class ObstacleFinder:
     def find(self, left_gray: np.ndarray, right_gray: np.ndarray, path: EgoPath) -> tuple[Obstacle | None, dict]:
         """The nearest obstacle in the path, and debug data (matched and standing pixel counts)."""
         cfg, cam = self.cfg, self.rig.camera
-        parts = []
-        for band, (u0, u1) in ((self.far, self._far_columns(path)), (self.near, (0.0, float(cam.width)))):
-            parts.append(band.match(band.shrink(left_gray), band.shrink(right_gray), u0, u1, self.c, cfg.min_range_m,
-                                    cfg.max_range_m))
-        u, v, z, pv = (np.concatenate([p[k] for p in parts]) for k in range(4))
-        area = np.concatenate([np.full(len(p[0]), p[4], np.float32) for p in parts])
+        bands = [band.match(band.shrink(left_gray), band.shrink(right_gray), u0, u1)
+                 for band, (u0, u1) in ((self.far, self._far_columns(path)), (self.near, (0.0, float(cam.width))))]
+        u, v, z, pv, area = lift_bands(bands, cfg.min_range_m, cfg.max_range_m, self.c)
         self.ground.update(pv, u)
         pv[:, 2] = self.ground.height(pv)
         up = np.flatnonzero((pv[:, 2] > cfg.min_height_m) & (pv[:, 2] < cfg.max_height_m))

@@ -6,7 +6,7 @@ import pytest
 
 from percept.compiled import pairwise_sum
 from percept.longitudinal.ground import GroundConfig, _road_points
-from percept.longitudinal.lift import lift_band
+from percept.longitudinal.lift import lift_band, lift_bands
 from percept.longitudinal.refine import _weighted_sums
 
 
@@ -39,6 +39,23 @@ def test_lifted_matches_equal_numpys_bit_for_bit(c0, skip):
     for a, b in zip(ref, got):
         assert a.dtype == b.dtype and a.shape == b.shape
         assert a.tobytes() == b.tobytes()
+
+
+def test_two_bands_lift_into_their_concatenation():
+    rng = np.random.default_rng(5)
+    bands, refs = [], []
+    for rows, w, cols, c0, skip, area in ((11, 120, 70, 20, 16, 4.0), (9, 80, 80, 0, 0, 16.0)):
+        d16 = rng.integers(-20, 800, size=(rows, cols)).astype(np.int16)
+        u, v = (rng.uniform(0, 640, (rows, w)).astype(np.float32) for _ in range(2))
+        rays = rng.normal(size=(rows, w, 3)).astype(np.float32)
+        fb = 480.0 * 0.3 * 16.0 / area ** 0.5
+        bands.append((d16, c0, skip, u, v, rays, fb, area))
+        ref = _numpy_lift(d16, c0, skip, u, v, rays, fb, 3.3, 100.0, np.array([0.8, 0.27, 1.4]))
+        refs.append((*ref, np.full(len(ref[0]), area, np.float32)))
+    got = lift_bands(bands, 3.3, 100.0, np.array([0.8, 0.27, 1.4]))
+    for k, g in enumerate(got):
+        want = np.concatenate([r[k] for r in refs])
+        assert g.dtype == want.dtype and g.tobytes() == want.tobytes()
 
 
 def _numpy_road_points(points, u_px, offset, slope, cfg):
