@@ -138,7 +138,9 @@ class ObstacleFinder:
         self.near = _Band(rig, cfg.near_scale, split - bn / cfg.near_scale, cam.height, nn, bn, t)
         self.c = rig.camera_position(Side.LEFT)
         self.x_far = np.linspace(cfg.near_m, cfg.max_range_m, 24) + rig.mount_x_m
-        self.road, self.x_far2 = RoadPixels(rig), np.concatenate([self.x_far, self.x_far])
+        # the road's columns at x_far on either side of the corridor: y = centre +- half_width
+        self.corridor_columns = RoadPixels(rig).columns_along(self.x_far)
+        self.sides = np.array([[1.0], [-1.0]]) * cfg.half_width_m
         self.ground = GroundPlane(cfg.ground)
         # the compiled passes (compiled once after an install) loaded now, on a frame's argument types, not in a timed
         # frame: a black frame matches nothing, and the plane fit it starts is forgotten
@@ -156,8 +158,7 @@ class ObstacleFinder:
         floor(u0 s) .. ceil(u1 s) at its scale s, which the short projection (``RoadPixels``) gives unless one lies at
         a whole number, where the rig's projection decides (``_rig_far_columns``)."""
         y = path.centre_y(self.x_far)
-        w = self.cfg.half_width_m
-        u = self.road.columns(self.x_far2, np.concatenate([y + w, y - w]))
+        u = self.corridor_columns(y + self.sides)
         u0, u1 = float(u.min()), float(u.max()) + 1
         if clear(u0 * self.far.s) and clear(u1 * self.far.s):
             return u0, u1

@@ -42,10 +42,23 @@ class RoadPixels:
 
     def columns(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Image columns of the road points (x, y, 0) (arrays of one shape); nan where not in front of the camera."""
-        R, t = self.R, self.t
+        return self.columns_along(x)(y)
+
+    def columns_along(self, x: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """``columns(x, y)`` for these x and any y (of a shape that broadcasts with x), the x terms done once:
+        u = (fx x_c) / z_c + cx with fx x_c = a + b y and z_c = c + e y."""
+        R, t, fx, cx = self.R, self.t, self.fx, self.cx
+        x = np.asarray(x, dtype=float)
         # x_c = R00 x + R01 y + t0, z_c = R20 x + R21 y + t2
-        xc, zc = R[0][0] * x + R[0][1] * y + t[0], R[2][0] * x + R[2][1] * y + t[2]
-        return np.where(zc > MIN_DEPTH_M, self.fx * xc / np.where(zc > MIN_DEPTH_M, zc, 1.0) + self.cx, np.nan)
+        a, b = fx * (R[0][0] * x + t[0]), fx * R[0][1]
+        c, e = R[2][0] * x + t[2], R[2][1]
+
+        def columns(y: np.ndarray) -> np.ndarray:
+            zc = c + e * y if e else c
+            if np.min(zc) <= MIN_DEPTH_M:
+                return np.full(np.broadcast(x, y).shape, np.nan)
+            return (a + b * y) / zc + cx
+        return columns
 
 
 def clear(value: float) -> bool:

@@ -110,14 +110,20 @@ class PatchAligner:
         L, w = self.L, self.width
         keep = np.ones(L.shape, bool) if mask is None else mask[:L.shape[0], :L.shape[1]]
         d, converged, step = float(d0), False, np.inf
+        first, last, huber32 = np.float32(u0), np.float32(u1 - 1), np.float32(huber)
+        # (the remapped patch has the grid's shape)
+        mismatch = self.uu.shape != L.shape or keep.shape != L.shape
+        shifted = np.empty_like(self.uu)
         for _ in range(iterations):
             # the sampled columns u - d (float32, as remap reads them) must leave room for the cubic kernel
-            if float(np.float32(u0) - np.float32(d)) < 1 or float(np.float32(u1 - 1) - np.float32(d)) > w - 2:
+            d32 = np.float32(d)
+            if float(first - d32) < 1 or float(last - d32) > w - 2:
                 return None
-            both = cv2.remap(self.right_gx, self.uu - d, self.vv, cv2.INTER_CUBIC)
-            if both.shape[:2] != L.shape or keep.shape != L.shape:
+            both = cv2.remap(self.right_gx, np.subtract(self.uu, d, out=shifted), self.vv, cv2.INTER_CUBIC)
+            if mismatch:
                 raise ValueError(f"mask {keep.shape} and box {both.shape[:2]} must match the patch {L.shape}")
-            H, wgr, wrr = (float(s) for s in _weighted_sums(L, both, keep, np.float32(huber)))
+            # (the kernel's float32 sums come back as Python floats)
+            H, wgr, wrr = _weighted_sums(L, both, keep, huber32)
             if H < 1e-3:
                 return None
             # Gauss-Newton: delta = -sum(w g r) / sum(w g^2)

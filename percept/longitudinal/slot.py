@@ -174,7 +174,7 @@ class LongitudinalSlot:
         # the obstacle's own columns: where much of the band matches (stray matches on the road beside it, e.g. on
         # a slanted lane line, would pull the estimate)
         # (the fraction as np.mean takes it: the count over the rows, in float64)
-        cols = np.flatnonzero(np.count_nonzero(m, axis=0) / m.shape[0] >= self.cfg.column_fill)
+        cols = np.flatnonzero(m.sum(axis=0) / m.shape[0] >= self.cfg.column_fill)
         if len(cols) == 0 or cols[-1] - cols[0] < 2:
             return None
         m[:, :cols[0]] = False
