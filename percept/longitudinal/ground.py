@@ -12,6 +12,7 @@ IV 2002, as a plane fit). The correction is applied once it moves a height at ``
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,6 +102,9 @@ def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, ce
     x range // cell_m) that also holds a point standing band..max_standing above it at x > 0 (not the low parts of
     what stands on the road: bumpers, tyres), among the points of the range cells the fit uses. In numpy's
     arithmetic (column // cell_px is float32 floor division)."""
+    # a cell of a power of two pixels divides a column exactly (as a product with its exact inverse), and then the
+    # floor of the quotient is numpy's floor division (npy_divmod) already, without its fmod (~60% of this pass)
+    exact, inverse = math.frexp(cell_px)[0] == 0.5, np.float32(1) / cell_px
     lo = np.floor(x_min / cell_m) * cell_m
     hi = (np.floor(x_max / cell_m) + 1) * cell_m
     n = points.shape[0]
@@ -114,7 +118,8 @@ def _road_points(points, u_px, offset, slope, band, x_min, x_max, half_width, ce
         inside[i] = True
         h[i] = points[i, 2] - (offset + slope * x)
         # numpy's float32 floor division of the column by the cell
-        cu[i], cx[i] = np.int64(floor_divide(u_px[i], cell_px)), np.int64(np.floor(x / cell_m))
+        cu[i] = np.int64(np.floor(u_px[i] * inverse) if exact else floor_divide(u_px[i], cell_px))
+        cx[i] = np.int64(np.floor(x / cell_m))
         up[i] = h[i] > band and h[i] < max_standing and x > 0
         if up[i]:
             u_lo, u_hi, x_lo, x_hi = min(u_lo, cu[i]), max(u_hi, cu[i]), min(x_lo, cx[i]), max(x_hi, cx[i])

@@ -73,7 +73,7 @@ def _numpy_road_points(points, u_px, offset, slope, cfg):
     return x[near], z[near]
 
 
-@pytest.mark.parametrize("cell_px", [16, 12])
+@pytest.mark.parametrize("cell_px", [16, 12, 8, 1])
 def test_road_points_equal_numpys(cell_px):
     cfg = GroundConfig(cell_px=cell_px)
     rng = np.random.default_rng(cell_px)
