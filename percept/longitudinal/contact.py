@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from percept.compiled import kernel
 from percept.sensors import StereoRig
 
 from .pixels import RoadPixels, whole
@@ -51,6 +52,12 @@ class ContactRange:
         self.rig, self.cfg = rig, cfg
         self.cam_x = float(rig.camera_position()[0])
         self.road = RoadPixels(rig)
+        # the compiled edge search (compiled once after an install) loaded now, on a frame's argument types (a
+        # simulated frame's images are read-only, others need not be)
+        strip = np.zeros((3, 4), np.uint8)
+        _tyre_edge(strip, 0, 1, 3, 4)
+        strip.flags.writeable = False
+        _tyre_edge(strip, 0, 1, 3, 4)
 
     def _row(self, range_m: float) -> float:
         """Image row of the road at ``range_m`` ahead of the camera (rows depend on distance only: no roll)."""
@@ -70,13 +77,10 @@ class ContactRange:
         k = max(int(round((u1 - u0) * cfg.wheel_frac)), 1)
         if bottom - top < 2 or u1 - u0 < 4:
             return None
-        strip = gray[top:bottom + 1]
-        cols = np.concatenate([strip[:, u0:u0 + k], strip[:, u1 - k:u1]], axis=1).astype(np.float32)
-        profile = cols.mean(axis=1)
-        # step between row v and v + 1: brighter below where the tyres end and the road begins
-        step = np.diff(profile)
-        i = int(np.argmax(step))
-        if step[i] < cfg.min_step:
+        (a0, a1, _), (b0, b1, _) = slice(u0, u0 + k).indices(gray.shape[1]), slice(u1 - k, u1).indices(gray.shape[1])
+        i, step = _tyre_edge(gray[top:bottom + 1], a0, a1, b0, b1)
+        step = np.float32(step)  # (a float32's value; compared as numpy compares one)
+        if step < cfg.min_step:
             return None
         # the edge lies between the last tyre row and the first road row
         row = top + i + 0.5
@@ -86,4 +90,29 @@ class ContactRange:
         h = self.rig.mount_height_m
         # dZ/dv = Z^2 / (f H)
         sigma = x * x / (cam.fy * h) * cfg.sigma_row_px
-        return Contact(float(x - cfg.rear_overhang_m), float(sigma), float(row), float(step[i]))
+        return Contact(float(x - cfg.rear_overhang_m), float(sigma), float(row), float(step))
+
+
+@kernel()
+def _tyre_edge(strip, a0, a1, b0, b1):  # pragma: no cover - compiled
+    """The strongest dark-to-bright step down the rows of ``strip`` (rows, w) uint8 in the mean grey level of its
+    columns a0..a1 and b0..b1 (the box's outer columns): (i, step), the step from row i to i + 1, the first largest.
+    In numpy's arithmetic (the columns as float32, np.mean along the rows, np.diff, np.argmax): the sums of whole grey
+    levels are exact in any order (below 2^24: up to 65 793 columns), the mean their float32 quotient by the count."""
+    rows = strip.shape[0]
+    count = np.float32((a1 - a0) + (b1 - b0))
+    profile = np.empty(rows, np.float32)
+    for r in range(rows):
+        total = 0.0
+        for c in range(a0, a1):
+            total += strip[r, c]
+        for c in range(b0, b1):
+            total += strip[r, c]
+        profile[r] = np.float32(total) / count
+    # step between row v and v + 1: brighter below where the tyres end and the road begins
+    best, i = profile[1] - profile[0], 0
+    for r in range(1, rows - 1):
+        step = profile[r + 1] - profile[r]
+        if step > best:
+            best, i = step, r
+    return i, best

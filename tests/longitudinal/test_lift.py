@@ -150,11 +150,11 @@ from percept.compiled import dispatchers
 from percept.drive import bench as B
 from percept.drive.tasks import TASKS
 from percept.lanes import evidence
-from percept.longitudinal import flow, ground, groups, lift, refine
+from percept.longitudinal import contact, flow, ground, groups, lift, refine
 from percept.odometry import features
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose
-modules = (evidence, flow, ground, groups, lift, refine, features)
+modules = (evidence, contact, flow, ground, groups, lift, refine, features)
 kernels = dispatchers(*modules)
 world = SimWorld(WorldConfig("lead-brake", seed=1, autopilot=True))
 ctx = B.SlotContext(world.cfg.rig, world.dt, None, B.TruthFeed(), start_pose=hw_pose(world.ego))
@@ -183,7 +183,7 @@ def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
     count, least, refined, unchanged = out.stdout.split()
     # every kernel loaded by the slots' construction; the lead was refined (and the odometry started keyframes), so
     # every pass ran in the frames
-    assert int(count) == 12 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"
+    assert int(count) == 13 and int(least) >= 1 and int(refined) > 10 and unchanged == "True"
 
 
 def _numpy_surface_mask(left, right, box, d0, radius=3, block=5, tol_px=1.0, min_contrast=3.0, max_cost_ratio=0.5):
