@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 from filterpy.common import Q_discrete_white_noise
 
-from percept.sensors import StereoRig, iou_matrix
+from percept.sensors import StereoRig, iou
 
 from .constrained import standing_box
 from .free_motion import FreeMotion, constant_velocity_filter
@@ -271,7 +271,7 @@ class PersonTracker:
         for mi, ((xy, r, hm, ok), b, s) in enumerate(meas):
             # a detection on a person already tracked (a second window on them) starts no track of its own
             taken = [t.box if t.misses == 0 else t.predicted for t in self.tracks]
-            if mi not in used and not (taken and iou_matrix(np.array([b]), np.array(taken)).max() > 0.3):
+            if mi not in used and not any(iou(b, other) > 0.3 for other in taken):
                 self.tracks.append(_Track(self._next_id, xy, r, hm, b, s, ok, self.cfg))
                 self._next_id += 1
         return [self._public(t) for t in self.tracks]
@@ -283,12 +283,11 @@ class PersonTracker:
         cands = []
         if not meas or not self.tracks:
             return []
-        overlaps = iou_matrix(np.array([b for _, b, _ in meas]), np.array([t.predicted for t in self.tracks]))
         for ti, t in enumerate(self.tracks):
             hx = t.kf.H @ t.kf.x
             hp = t.kf.H @ t.kf.P @ t.kf.H.T
             for mi, ((xy, r, _, _), box, _) in enumerate(meas):
-                overlap = float(overlaps[mi, ti])
+                overlap = iou(box, t.predicted)
                 d = xy - hx
                 # d^2 = (z - H x)^T S^-1 (z - H x), S = H P H^T + R
                 d2 = float(d @ np.linalg.solve(hp + r, d))
