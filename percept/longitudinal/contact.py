@@ -17,8 +17,6 @@ import numpy as np
 from percept.compiled import kernel
 from percept.sensors import StereoRig
 
-from .pixels import RoadPixels, whole
-
 
 @dataclass(frozen=True)
 class ContactConfig:
@@ -51,7 +49,6 @@ class ContactRange:
     def __init__(self, rig: StereoRig, cfg: ContactConfig = ContactConfig()):
         self.rig, self.cfg = rig, cfg
         self.cam_x = float(rig.camera_position()[0])
-        self.road = RoadPixels(rig)
         # the compiled edge search (compiled once after an install) loaded now, on a frame's argument types (a
         # simulated frame's images are read-only, others need not be)
         strip = np.zeros((3, 4), np.uint8)
@@ -59,10 +56,11 @@ class ContactRange:
         strip.flags.writeable = False
         _tyre_edge(strip, 0, 1, 3, 4)
 
-    def _row(self, range_m: float) -> float:
-        """Image row of the road at ``range_m`` ahead of the camera (rows depend on distance only: no roll)."""
-        uv, _ = self.rig.project_vehicle_points(np.array([[self.cam_x + range_m, 0.0, 0.0]]))
-        return float(uv[0, 1])
+    def _rows(self, *ranges_m: float) -> list[float]:
+        """Image rows of the road at ``ranges_m`` ahead of the camera (rows depend on distance only: no roll), in one
+        projection."""
+        uv, _ = self.rig.project_vehicle_points(np.array([[self.cam_x + r, 0.0, 0.0] for r in ranges_m]))
+        return uv[:, 1].tolist()
 
     def measure(self, gray: np.ndarray, box: tuple[int, int, int, int], range_guess_m: float) -> Contact | None:
         """The contact range of the obstacle in ``box`` (u0, v0, u1, v1) of the grey left image, searched between
@@ -70,9 +68,8 @@ class ContactRange:
         cfg, cam = self.cfg, self.rig.camera
         u0, _, u1, _ = box
         z = range_guess_m + cfg.rear_overhang_m
-        far, near = z * cfg.window[1], z * cfg.window[0]
-        top = whole(self.road.row(self.cam_x + far), math.floor, lambda: self._row(far))
-        bottom = whole(self.road.row(self.cam_x + near), math.ceil, lambda: self._row(near)) + 1
+        v_far, v_near = self._rows(z * cfg.window[1], z * cfg.window[0])
+        top, bottom = int(math.floor(v_far)), int(math.ceil(v_near)) + 1
         top, bottom = max(top, 0), min(bottom, gray.shape[0] - 1)
         k = max(int(round((u1 - u0) * cfg.wheel_frac)), 1)
         if bottom - top < 2 or u1 - u0 < 4:

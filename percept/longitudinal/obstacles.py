@@ -21,7 +21,6 @@ from .dense import check_num_disparities
 from .ground import GroundConfig, GroundPlane
 from .groups import first_grounded_blob, group_extent, range_bins, warm_up_groups
 from .lift import lift_bands
-from .pixels import RoadPixels, clear
 from .quantiles import percentile
 
 
@@ -138,9 +137,6 @@ class ObstacleFinder:
         self.near = _Band(rig, cfg.near_scale, split - bn / cfg.near_scale, cam.height, nn, bn, t)
         self.c = rig.camera_position(Side.LEFT)
         self.x_far = np.linspace(cfg.near_m, cfg.max_range_m, 24) + rig.mount_x_m
-        # the road's columns at x_far on either side of the corridor: y = centre +- half_width
-        self.corridor_columns = RoadPixels(rig).columns_along(self.x_far)
-        self.sides = np.array([[1.0], [-1.0]]) * cfg.half_width_m
         self.ground = GroundPlane(cfg.ground)
         # the compiled passes (compiled once after an install) loaded now, on a frame's argument types, not in a timed
         # frame: a black frame matches nothing, and the plane fit it starts is forgotten
@@ -154,18 +150,8 @@ class ObstacleFinder:
         self.ground.reset()
 
     def _far_columns(self, path: EgoPath) -> tuple[float, float]:
-        """Image columns the corridor spans beyond near_m (full resolution). The far band matches the whole columns
-        floor(u0 s) .. ceil(u1 s) at its scale s, which the short projection (``RoadPixels``) gives unless one lies at
-        a whole number, where the rig's projection decides (``_rig_far_columns``)."""
+        """Image columns the corridor spans beyond near_m (full resolution)."""
         y = path.centre_y(self.x_far)
-        u = self.corridor_columns(y + self.sides)
-        u0, u1 = float(u.min()), float(u.max()) + 1
-        if clear(u0 * self.far.s) and clear(u1 * self.far.s):
-            return u0, u1
-        return self._rig_far_columns(y)
-
-    def _rig_far_columns(self, y: np.ndarray) -> tuple[float, float]:
-        """``_far_columns`` by the rig's projection, the path's centre at ``x_far`` being ``y``."""
         w = self.cfg.half_width_m
         pts = np.concatenate([np.column_stack([self.x_far, y + side * w, np.zeros_like(y)]) for side in (1, -1)])
         uv, _ = self.rig.project_vehicle_points(pts)
