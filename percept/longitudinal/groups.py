@@ -122,13 +122,14 @@ def first_grounded_blob(cands, los, his, needs, order, u, v, h, area, cell, q, g
 
 @njit(cache=True)
 def _percentile(x, q):  # pragma: no cover - compiled
-    """``np.percentile(x, q)`` of a non-empty float64 array without NaN (quantiles.percentile's arithmetic)."""
+    """``np.percentile(x, q)`` of a non-empty float64 or float32 array without NaN, in float64 (quantiles.percentile's
+    and percentiles' arithmetic: the neighbours' difference in the array's type, the interpolation in float64)."""
     n = x.shape[0]
     # virtual index i = (n - 1) q / 100
     vq = (n - 1) * (q / 100.0)
     s = np.sort(x)
     if vq >= n - 1:
-        return s[n - 1]
+        return np.float64(s[n - 1])
     lo = int(vq)
     x0, x1 = s[lo], s[lo + 1]
     t = vq - lo
@@ -143,30 +144,14 @@ def group_extent(u, v, z, area, blob):  # pragma: no cover - compiled
     ``z`` (N,) float32 (float32, as ``np.median``), and its area (``area`` (N,) float32 summed as ``np.sum``)."""
     n = blob.shape[0]
     us, vs, zs, a = u[blob], v[blob], z[blob], area[blob]
-    u0, u1 = _percentile_f32(us, 2), _percentile_f32(us, 98)
-    v0, v1 = _percentile_f32(vs, 2), _percentile_f32(vs, 98)
+    u0, u1 = _percentile(us, 2), _percentile(us, 98)
+    v0, v1 = _percentile(vs, 2), _percentile(vs, 98)
     zs.sort()
     h = n // 2
     # the mean of the middle value or two, as np.mean sums them: from 0, in float32
     zero = np.float32(0.0)
     med = zero + zs[h] if n % 2 else (zero + zs[h - 1] + zs[h]) / np.float32(2.0)
     return u0, u1, v0, v1, med, pairwise_sum(a, 0, n)
-
-
-@njit(cache=True)
-def _percentile_f32(x, q):  # pragma: no cover - compiled
-    """``np.percentile(x, [q])[0]`` of a non-empty float32 array without NaN, in float64 (quantiles.percentiles'
-    arithmetic: the neighbours' difference in float32, the interpolation in float64)."""
-    n = x.shape[0]
-    vq = (n - 1) * (q / 100.0)
-    s = np.sort(x)
-    if vq >= n - 1:
-        return np.float64(s[n - 1])
-    lo = int(vq)
-    x0, x1 = s[lo], s[lo + 1]
-    t = vq - lo
-    d = x1 - x0
-    return x1 - d * (1 - t) if t >= 0.5 else x0 + d * t
 
 
 def warm_up_groups() -> None:
