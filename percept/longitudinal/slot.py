@@ -18,28 +18,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.kalman import KalmanFilter
 
 from percept.sensors import EgoMotionGate, EgoPath, Frame, Lead, ObjectKind, StereoRig, iou
 
 from .contact import Contact, ContactConfig, ContactRange
 from .flow import Expansion, ExpansionTracker, FlowConfig
 from .obstacles import Obstacle, ObstacleConfig, ObstacleFinder
+from .range_filter import RANGE, RATE, RangeFilter
 from .refine import PatchAligner, Refined, surface_mask, warm_up_refinement
-
-
-_RANGE, _RATE = 0, 1
-"""The measured states, as indices into the filter's state (range [m], range rate [m/s], range acceleration
-[m/s²])."""
-_H = (np.array([[1.0, 0.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]))
-"""Their measurement rows H, by index i: H x = x[i] and H P H^T = P[i, i] (exactly: the other terms are 0 times a
-finite value)."""
-
-
-def _inverse_1x1(S: np.ndarray) -> np.ndarray:
-    """The filter's ``inv`` for its (1, 1) innovation covariance: [[1 / s]], what ``np.linalg.inv``'s LU solve gives
-    bit for bit, without its ~10 µs of generic machinery on every update."""
-    return 1.0 / S
 
 
 OUTLINE_COLS = 2
@@ -120,7 +106,7 @@ class LongitudinalSlot:
         self._drop_track()
 
     def _drop_track(self) -> None:
-        self.kf: KalmanFilter | None = None
+        self.track: RangeFilter | None = None
         self.hits = self.misses = self.outliers = 0
         self.box: tuple | None = None
         self.flow.reset()
@@ -151,7 +137,7 @@ class LongitudinalSlot:
             # the ground contact still update the filter: a far box that never refines (the road's end at night,
             # where contact edges jump between rows metres apart) is not followed for longer than hold_s
             self._miss()
-        state = None if self.kf is None else (float(self.kf.x[0, 0]), float(self.kf.x[1, 0]))
+        state = None if self.track is None else (self.track.range_m, self.track.rate_mps)
         return self._lead(), LeadDebug(ob, ref, z, contact, expansion, used, state, self.hits, self.misses)
 
     def _refine(self, left: np.ndarray, right: np.ndarray, ob: Obstacle) -> Refined | None:
@@ -202,76 +188,44 @@ class LongitudinalSlot:
         return ref
 
     def _predict(self) -> None:
-        if self.kf is not None:
-            self.kf.predict()
-            self._constrain()
-
-    def _constrain(self) -> None:
-        """Hold the range rate at or above this frame's floor, -(v_ego + reverse_mps): a lead is at most standing
-        still (a far box at the road's end, pulled about by contact edges, otherwise closed at 33 m/s on a car doing
-        10). Estimate projection (Simon, "Kalman filtering with state constraints", IET Control Theory Appl. 4(8),
-        2010) onto D x >= d, D = [0 1 0]: x <- x - P D^T (D P D^T)^-1 (D x - d), which also moves the range and
-        acceleration by their correlation with the rate."""
-        excess = float(self.kf.x[1, 0]) - self._rate_floor_mps
-        if excess < 0:
-            self.kf.x = self.kf.x - self.kf.P[:, 1:2] / self.kf.P[1, 1] * excess
-
-    def _apply(self, value: float, R: np.ndarray, i: int) -> None:
-        """The filter's update with one measurement of state ``i``, then the rate floor. The measurement goes in as a
-        float: y = z - H x is the same (1, 1) array, and the filter's copy of z (``deepcopy``) is far cheaper."""
-        self.kf.update(value, R=R, H=_H[i])
-        self._constrain()
+        """The track one frame ahead, then this frame's floor on its range rate."""
+        if self.track is not None:
+            self.track.predict(self._rate_floor_mps)
 
     def _new_track(self, z: float, sigma: float) -> None:
-        kf = KalmanFilter(dim_x=3, dim_z=1)
-        kf.inv = _inverse_1x1
-        dt, q = self.dt, self.cfg.jerk_sigma_mps3 ** 2
-        kf.F = np.array([[1.0, dt, dt * dt / 2], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
-        kf.H = _H[_RANGE]
-        # white jerk (Bar-Shalom, Estimation with Applications to Tracking, 6.2.3):
-        # Q = q [[dt^5/20, dt^4/8, dt^3/6], [dt^4/8, dt^3/3, dt^2/2], [dt^3/6, dt^2/2, dt]]
-        kf.Q = q * np.array([[dt ** 5 / 20, dt ** 4 / 8, dt ** 3 / 6], [dt ** 4 / 8, dt ** 3 / 3, dt ** 2 / 2],
-                             [dt ** 3 / 6, dt ** 2 / 2, dt]])
-        kf.x = np.array([[z], [0.0], [0.0]])
-        kf.P = np.diag([sigma ** 2, 10.0 ** 2, 5.0 ** 2])
-        self.kf, self.hits, self.misses, self.outliers = kf, 1, 0, 0
+        self.track = RangeFilter(z, sigma, self.dt, self.cfg.jerk_sigma_mps3, self._rate_floor_mps)
+        self.hits, self.misses, self.outliers = 1, 0, 0
         self.flow.reset()
 
     def _miss(self) -> None:
         self.misses += 1
-        if self.kf is not None and self.misses * self.dt > self.cfg.hold_s:
+        if self.track is not None and self.misses * self.dt > self.cfg.hold_s:
             self._drop_track()
 
     def _gated_update(self, value: float, sigma: float, i: int) -> bool:
         """One measurement ``value`` of state ``i`` with noise ``sigma``, unless it is beyond the gate; True if used."""
-        # innovation variance s = H P H^T + R = P[i, i] + sigma^2, innovation value - H x = value - x[i]
-        s = float(self.kf.P[i, i] + sigma ** 2)
-        innovation = value - float(self.kf.x[i, 0])
-        if innovation * innovation > self.cfg.gate_sigma ** 2 * s:
-            return False
-        self._apply(value, np.array([[sigma ** 2]]), i)
-        return True
+        return self.track.gated_update(value, sigma, i, self.cfg.gate_sigma)
 
     def _update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
         """The range measurements: stereo (which also starts and replaces tracks), then ground contact."""
-        if ref is None and (self.kf is None or self.hits < self.cfg.confirm):
+        if ref is None and (self.track is None or self.hits < self.cfg.confirm):
             # a group whose disparity does not refine (no surface with a clear match: chance matches on the dark,
             # noisy background at the road's far end at night) neither starts nor confirms a track
             return ()
         sd = max(ref.sigma_px if ref is not None else 1.0, self.cfg.sigma_d_px)
         # stereo range noise: sigma_Z = Z^2 sigma_d / (f b), for an unrefined range at the track's range (at its
         # own, a chance match 60 m off a track at 12 m would pass the gate)
-        at = z if ref is not None else float(self.kf.x[0, 0])
+        at = z if ref is not None else self.track.range_m
         sigma = at * at * sd / self.fb
         if ref is None:
             # nor replaces one or passes for a lead manoeuvring: it only updates a confirmed track it agrees with
-            if not self._gated_update(z, sigma, _RANGE):
+            if not self._gated_update(z, sigma, RANGE):
                 return ()
             self.box, used = ob.box_px, ("stereo",)
         else:
             previous, self.box = self.box, ob.box_px
-            overlap = 0.0 if self.kf is None else iou(previous, ob.box_px)
-            if self.kf is None or (self.hits < self.cfg.confirm and overlap < self.cfg.same_object_iou):
+            overlap = 0.0 if self.track is None else iou(previous, ob.box_px)
+            if self.track is None or (self.hits < self.cfg.confirm and overlap < self.cfg.same_object_iou):
                 # a track is confirmed only by an obstacle that stays where it was in the image (rain streaks
                 # and matches made by chance jump about)
                 self._new_track(z, sigma)
@@ -279,7 +233,7 @@ class LongitudinalSlot:
             used, restarted = self._refined_update(z, sigma, overlap)
             if restarted:
                 return used
-        if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, _RANGE):
+        if contact is not None and self._gated_update(contact.range_m, contact.sigma_m, RANGE):
             used += ("contact",)
         if used:
             self.hits += 1
@@ -289,7 +243,7 @@ class LongitudinalSlot:
         """A refined stereo range of a track's obstacle (``overlap``: its box's IoU with the last one), gated: two
         outliers in a row are a new lead when the box moved, else the lead manoeuvring. (used cues, whether a new
         track was started)."""
-        if self._gated_update(z, sigma, _RANGE):
+        if self._gated_update(z, sigma, RANGE):
             self.outliers = 0
             return ("stereo",), False
         self.outliers += 1
@@ -299,21 +253,20 @@ class LongitudinalSlot:
             self._new_track(z, sigma)  # the lead changed (a cut-in, the lead leaving): follow the new one
             return ("stereo",), True
         # the same object, manoeuvring (braking hard): open the filter up and take the measurement
-        self.kf.P += np.diag([sigma ** 2, self.cfg.manoeuvre_rate_mps ** 2, self.cfg.manoeuvre_accel_mps2 ** 2])
-        self._apply(z, np.array([[sigma ** 2]]), _RANGE)
+        self.track.manoeuvre(z, sigma, self.cfg.manoeuvre_rate_mps, self.cfg.manoeuvre_accel_mps2)
         self.outliers = 0
         return ("stereo",), False
 
     def _update_rate(self, e: Expansion) -> bool:
         """The range rate from the image's expansion at the current range: dZ/dt = -Z (s - 1) / dt."""
-        z = float(self.kf.x[0, 0])
+        z = self.track.range_m
         sigma = z * e.sigma / e.dt_s
-        return self._gated_update(e.range_rate_mps(z), sigma, _RATE)
+        return self._gated_update(e.range_rate_mps(z), sigma, RATE)
 
     def _lead(self) -> Lead | None:
-        if self.kf is None or self.hits < self.cfg.confirm:
+        if self.track is None or self.hits < self.cfg.confirm:
             return None
-        rng, rate = float(self.kf.x[0, 0]), float(self.kf.x[1, 0])
+        rng, rate = self.track.range_m, self.track.rate_mps
         confidence = max(0.0, 1.0 - self.misses * self.dt / self.cfg.hold_s)
         # whatever stands in the path is followed like a vehicle; people are the pedestrian slot's to yield to
         return Lead(rng, rate, ObjectKind.VEHICLE, confidence, Lead.time_to_contact(rng, rate), self.box)

@@ -69,7 +69,7 @@ def test_a_range_that_does_not_refine_neither_starts_a_track_nor_drags_one_away(
     ob = Obstacle(61.0, (309, 239, 316, 250), 28.0)
     # chance matches on the dark background at the road's far end: a coarse range without a refined disparity
     for _ in range(5):
-        assert slot._update(61.0, None, ob, None) == () and slot.kf is None
+        assert slot._update(61.0, None, ob, None) == () and slot.track is None
     refined = Refined(slot.fb / 12.0, 0.02, 200, True)
     car = Obstacle(12.0, (290, 220, 350, 290), 2000.0)
     for _ in range(slot.cfg.confirm):
@@ -77,7 +77,7 @@ def test_a_range_that_does_not_refine_neither_starts_a_track_nor_drags_one_away(
         assert slot._update(12.0, refined, car, None) == ("stereo",)
     # confirmed at 12 m: the far match's noise is taken at the track's range, so it is no measurement of it ...
     slot._predict()
-    assert slot._update(61.0, None, ob, None) == () and slot.kf.x[0, 0] == pytest.approx(12.0, abs=0.2)
+    assert slot._update(61.0, None, ob, None) == () and slot.track.range_m == pytest.approx(12.0, abs=0.2)
     # ... while a coarse range near the track still updates it (a lead whose face did not refine this frame)
     slot._predict()
     assert slot._update(12.3, None, car, None) == ("stereo",)
@@ -120,7 +120,7 @@ def test_a_track_whose_range_stops_refining_is_dropped_after_hold_s():
     hold = int(slot.cfg.hold_s * 15)
     assert out[9 + hold][0] is not None and out[9 + hold][0].confidence < 0.2
     assert all(lead is None for lead, _ in out[11 + hold:])
-    assert slot.kf is None
+    assert slot.track is None
     # while a refined range now and then keeps it
     slot, out = run_script([(60.0, True), (60.0, False), (60.0, False)] * 10)
     assert all(lead is not None for lead, _ in out[6:])  # confirmed by its third refined range
