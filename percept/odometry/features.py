@@ -7,15 +7,19 @@ of an estimate from the Jacobian of its cost).
 
 from __future__ import annotations
 
+from operator import attrgetter
+
 import cv2
 import numpy as np
+from numba import njit
 
-from percept.compiled import floor_divide, kernel
+from percept.compiled import kernel
 
 # below this mean intensity (or standard deviation) a frame has nothing to track: dark or featureless
 MIN_CONTRAST_GREY = 2.0
 # FAST's threshold is at least this many times the image's noise sigma (a corner must stand out of the noise)
 NOISE_GAIN = 4.0
+_RESPONSE = attrgetter("response")  # a keypoint's FAST score
 
 
 def noise_sigma(gray: np.ndarray) -> float:
@@ -32,6 +36,14 @@ def noise_sigma(gray: np.ndarray) -> float:
     return float(1.4826 * med / 6.0)
 
 
+@njit(cache=True)
+def _row_second_difference(gray, y, out):  # pragma: no cover - compiled
+    """out[j] = g(y, x - 1) - 2 g(y, x) + g(y, x + 1) at the odd columns x = 2 j + 1 of the uint8 image g."""
+    for j in range(out.shape[0]):
+        x = 2 * j + 1
+        out[j] = np.int32(gray[y, x - 1]) - 2 * np.int32(gray[y, x]) + np.int32(gray[y, x + 1])
+
+
 @kernel()
 def _noise_median_ranks(gray):  # pragma: no cover - compiled
     """The values of order (n - 1) // 2 and n // 2 of |r| over every other interior pixel (rows and columns 1, 3, ...
@@ -39,23 +51,36 @@ def _noise_median_ranks(gray):  # pragma: no cover - compiled
     and ramps), [[1, -2, 1], [-2, 4, -2], [1, -2, 1]] = [1, -2, 1]^T [1, -2, 1]: whole numbers within +-16 * 255 (what
     ``cv2.sepFilter2D`` gave in int16), counted in a histogram."""
     h, w = gray.shape
-    counts = np.zeros(16 * 255 + 1, np.int64)
+    # separable: r = t(y - 1) - 2 t(y) + t(y + 1) with the row's second difference t = g(x - 1) - 2 g(x) + g(x + 1) at
+    # the odd columns; the even row below a sampled row is the one above the next
+    m = (w - 1) // 2
+    above, mid, below, r = np.empty(m, np.int32), np.empty(m, np.int32), np.empty(m, np.int32), np.empty(m, np.int32)
+    # four histograms, counted in turn (most responses fall in the few lowest bins: one histogram would wait on its
+    # own last increment), added up as the ranks are searched
+    counts = np.zeros((4, 16 * 255 + 1), np.int64)
     n = 0
+    _row_second_difference(gray, 0, above)
     for y in range(1, h - 1, 2):
-        for x in range(1, w - 1, 2):
-            r = np.int64(0)
-            for dy in range(3):
-                ty = 1 if dy != 1 else -2
-                row = (np.int64(gray[y + dy - 1, x - 1]) - 2 * np.int64(gray[y + dy - 1, x])
-                       + np.int64(gray[y + dy - 1, x + 1]))
-                r += ty * row
-            counts[abs(r)] += 1
-            n += 1
+        _row_second_difference(gray, y, mid)
+        _row_second_difference(gray, y + 1, below)
+        for j in range(m):
+            r[j] = abs(above[j] - 2 * mid[j] + below[j])
+        j = 0
+        while j + 4 <= m:
+            counts[0, r[j]] += 1
+            counts[1, r[j + 1]] += 1
+            counts[2, r[j + 2]] += 1
+            counts[3, r[j + 3]] += 1
+            j += 4
+        for k in range(j, m):
+            counts[0, r[k]] += 1
+        n += m
+        above, below = below, above
     lo_rank, hi_rank = (n - 1) // 2, n // 2
     lo = hi = -1
     seen = 0
-    for v in range(counts.size):
-        seen += counts[v]
+    for v in range(counts.shape[1]):
+        seen += counts[0, v] + counts[1, v] + counts[2, v] + counts[3, v]
         # searchsorted(cumulative counts, rank, side="right"): the first value whose cumulative count exceeds rank
         if lo < 0 and seen > lo_rank:
             lo = v
@@ -87,13 +112,27 @@ def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], th
     if not kps:
         return np.zeros((0, 2), np.float32)
     pts = cv2.KeyPoint_convert(kps).astype(np.float32).reshape(-1, 2)
-    resp = np.float32([k.response for k in kps])
+    resp = np.fromiter(map(_RESPONSE, kps), np.float32, len(kps))
     h, w = gray.shape
     gx, gy = grid
     per_cell = max(1, int(np.ceil(max_corners / (gx * gy))))
     keep = _strongest_per_cell(pts, resp, gx, gy, w, h, per_cell)
     keep = keep[np.argsort(-resp[keep])][:max_corners]
     return pts[keep]
+
+
+@njit(cache=True, error_model="numpy")
+def _floor_quotient(a, b):  # pragma: no cover - compiled
+    """floor(a / b) of float32 a and b > 0 as an int64, exact (numpy's ``a // b`` wherever the multiple of b below a
+    is a float32, as for a corner's cell): the quotient in float64, then moved to the multiple q with
+    q b <= a < (q + 1) b, products exact in float64 for whole q under 2^29 (no fmod, which costs most of the pass)."""
+    a64, b64 = np.float64(a), np.float64(b)
+    q = np.floor(a64 / b64)
+    if q * b64 > a64:
+        q -= 1.0
+    elif (q + 1.0) * b64 <= a64:
+        q += 1.0
+    return np.int64(q)
 
 
 @kernel()
@@ -104,35 +143,33 @@ def _strongest_per_cell(pts, resp, gx, gy, w, h, per_cell):  # pragma: no cover 
     float32 as numpy does, min(u gx // w, gx - 1) + gx min(v gy // h, gy - 1)."""
     n = pts.shape[0]
     fx, fy, fw, fh = np.float32(gx), np.float32(gy), np.float32(w), np.float32(h)
-    cell = np.empty(n, np.int64)
-    for i in range(n):
-        cu = min(floor_divide(pts[i, 0] * fx, fw), np.float32(gx - 1))
-        cv = min(floor_divide(pts[i, 1] * fy, fh), np.float32(gy - 1))
-        cell[i] = np.int64(cu + fx * cv)
-    # the corners of each cell in index order (a counting sort), then each cell's strongest by repeated selection:
-    # the largest response left, the lowest index among equal ones (lexsort's order)
+    # one pass in index order keeps each cell's strongest so far, strongest first: a corner enters when its cell is
+    # not full or it beats the cell's weakest (strictly: on a tie the earlier index ranks first, lexsort's order),
+    # behind every kept one at least as strong
     ncell = gx * gy
-    starts = np.zeros(ncell + 1, np.int64)
+    top = np.empty((ncell, max(per_cell, 1)), np.int64)
+    count = np.zeros(ncell, np.int64)
     for i in range(n):
-        starts[cell[i] + 1] += 1
-    for c in range(ncell):
-        starts[c + 1] += starts[c]
-    members, filled = np.empty(n, np.int64), starts[:-1].copy()
-    for i in range(n):
-        members[filled[cell[i]]] = i
-        filled[cell[i]] += 1
-    taken = np.zeros(n, np.bool_)
+        cu = min(_floor_quotient(pts[i, 0] * fx, fw), gx - 1)
+        cv = min(_floor_quotient(pts[i, 1] * fy, fh), gy - 1)
+        c = cu + gx * cv
+        r = resp[i]
+        k = count[c]
+        if k == per_cell:
+            if not (k > 0 and r > resp[top[c, k - 1]]):
+                continue
+            k -= 1  # the weakest leaves
+        else:
+            count[c] = k + 1
+        while k > 0 and resp[top[c, k - 1]] < r:
+            top[c, k] = top[c, k - 1]
+            k -= 1
+        top[c, k] = i
     keep = np.empty(n, np.int64)
     m = 0
     for c in range(ncell):
-        for _ in range(min(per_cell, starts[c + 1] - starts[c])):
-            best = -1
-            for k in range(starts[c], starts[c + 1]):
-                i = members[k]
-                if not taken[i] and (best < 0 or resp[i] > resp[best]):
-                    best = i
-            taken[best] = True
-            keep[m] = best
+        for j in range(count[c]):
+            keep[m] = top[c, j]
             m += 1
     return keep[:m]
 
