@@ -71,14 +71,22 @@ class _Ekf(ExtendedKalmanFilter):
     def predict_x(self, u=None) -> None:
         yaw_rate, accel, dt = u
         x = self.x
-        w = yaw_rate - x[BG, 0]
-        course = x[YAW, 0] + slip_angle(w, x[V, 0], self.slip_arm_m)
+        # the state's elements as Python floats (the same doubles, without numpy's scalar overhead)
+        v, yaw = x.item(V), x.item(YAW)
+        w = yaw_rate - x.item(BG)
+        course = yaw + slip_angle(w, v, self.slip_arm_m)
         # the centre moves along heading + slip for one step, then the heading and speed change (explicit Euler,
         # as the vehicle model integrates): p += v dt (cos, sin)(psi + beta); psi += w dt; v += (a - b_a) dt
-        x[X, 0] += x[V, 0] * dt * math.cos(course)
-        x[Y, 0] += x[V, 0] * dt * math.sin(course)
-        x[YAW, 0] = wrap_angle(x[YAW, 0] + w * dt)
-        x[V, 0] = max(x[V, 0] + (accel - x[BA, 0]) * dt, 0.0)
+        x[X, 0] = x.item(X) + v * dt * math.cos(course)
+        x[Y, 0] = x.item(Y) + v * dt * math.sin(course)
+        x[YAW, 0] = _wrap(yaw + w * dt)
+        x[V, 0] = max(v + (accel - x.item(BA)) * dt, 0.0)
+
+
+def _wrap(angle_rad: float) -> float:
+    """``wrap_angle`` of one float, in floats: the same bits (Python's float % is numpy's, fmod then the divisor's
+    sign) [rad]."""
+    return (angle_rad + math.pi) % (2 * math.pi) - math.pi
 
 
 def slip_angle(yaw_rate_rps: float, speed_mps: float, arm_m: float) -> float:
@@ -93,6 +101,32 @@ def _angle_residual(index: int):
         r[index] = wrap_angle(r[index])
         return r
     return residual
+
+
+_ANGLE_RESIDUAL = {2: _angle_residual(2)}  # the residual of a measurement whose element 2 is an angle
+
+
+def _wheel_speed(s: np.ndarray) -> np.ndarray:
+    """The wheel speed the state ``s`` (12, 1) predicts: scale x speed, (1, 1) [m/s]."""
+    return np.array([[s.item(KW) * s.item(V)]])
+
+
+def _wheel_jacobian(s: np.ndarray) -> np.ndarray:
+    """(1, 12) d(k_w v) / ds: k_w for the speed, v for the scale."""
+    h = np.zeros((1, N_STATE))
+    h[0, V], h[0, KW] = s.item(KW), s.item(V)
+    return h
+
+
+def _relative_motion(s: np.ndarray) -> np.ndarray:
+    """The motion since the clone that the state ``s`` (12, 1) predicts, (3, 1) (dx, dy [m], dyaw [rad]) in the
+    clone's vehicle frame."""
+    c, sn = math.cos(s.item(YAWC)), math.sin(s.item(YAWC))
+    d0, d1 = s.item(X) - s.item(XC), s.item(Y) - s.item(YC)
+    k = 1.0 + s.item(SV)
+    # [dx, dy] = (1 + s_vo) R(-psi_c) (p - p_c); dyaw = psi - psi_c + b_vo |p - p_c|
+    return np.array([[k * (c * d0 + sn * d1)], [k * (-sn * d0 + c * d1)],
+                     [_wrap(s.item(YAW) - s.item(YAWC)) + s.item(BV) * math.hypot(d0, d1)]])
 
 
 class PoseFilter:
@@ -111,6 +145,13 @@ class PoseFilter:
                              noise.vo_yaw_drift_sigma_rad_per_m ** 2, 1e-6, 1e-6, 1e-8])
         self._last_input = (0.0, 0.0)
         self._started = False
+        self._F = np.eye(N_STATE)  # the step's Jacobian: its off-diagonal terms are rewritten by every prediction
+        self._Q: dict[tuple[float, bool], np.ndarray] = {}  # process noise by (dt, good sample)
+        self._wheel_R = np.array([[noise.wheel_sigma_mps ** 2]])
+        # visual odometry's covariance scaled: Sigma = D Sigma_vo D, D = diag(sqrt(k_t), sqrt(k_t), sqrt(k_r)), by
+        # elements Sigma_vo * (d d^T)
+        d = np.sqrt([noise.vo_scale_translation, noise.vo_scale_translation, noise.vo_scale_rotation])
+        self._vo_D2 = np.outer(d, d)
         self.rejected = 0  # sensor samples rejected as NaN or absurd
         self.gated = 0  # measurements refused by the innovation gate
         self._refused = 0  # landmark sightings refused in a row
@@ -132,26 +173,35 @@ class PoseFilter:
     def predict(self, yaw_rate_rps: float, accel_mps2: float, dt: float) -> bool:
         """Propagate by ``dt`` [s] with one IMU sample; an absurd or NaN sample is replaced by the last good one
         (with widened noise) and False is returned."""
-        n = self.noise
         good = plausible_yaw_rate(yaw_rate_rps) and plausible_accel(accel_mps2)
         if good:
             self._last_input = (yaw_rate_rps, accel_mps2)
         else:
             self.rejected += 1
         w, a = self._last_input
-        widen = 1.0 if good else 25.0
-        x = self.kf.x[:, 0]
-        v, arm = max(x[V], 1.0), self.kf.slip_arm_m
-        beta = slip_angle(w - x[BG], x[V], arm)
-        c, s = math.cos(x[YAW] + beta), math.sin(x[YAW] + beta)
+        x = self.kf.x
+        xv, bg, arm = x.item(V), x.item(BG), self.kf.slip_arm_m
+        v = max(xv, 1.0)
+        beta = slip_angle(w - bg, xv, arm)
+        c, s = math.cos(x.item(YAW) + beta), math.sin(x.item(YAW) + beta)
         # Jacobian of the step: d beta / d v = -r l_r / (v^2 cos beta), d beta / d b_g = -l_r / (v cos beta)
-        db_dv, db_dbg = -(w - x[BG]) * arm / (v * v * math.cos(beta)), -arm / (v * math.cos(beta))
-        F = np.eye(N_STATE)
-        F[X, YAW], F[X, V], F[X, BG] = -x[V] * dt * s, dt * c - x[V] * dt * s * db_dv, -x[V] * dt * s * db_dbg
-        F[Y, YAW], F[Y, V], F[Y, BG] = x[V] * dt * c, dt * s + x[V] * dt * c * db_dv, x[V] * dt * c * db_dbg
+        db_dv, db_dbg = -(w - bg) * arm / (v * v * math.cos(beta)), -arm / (v * math.cos(beta))
+        F = self._F
+        F[X, YAW], F[X, V], F[X, BG] = -xv * dt * s, dt * c - xv * dt * s * db_dv, -xv * dt * s * db_dbg
+        F[Y, YAW], F[Y, V], F[Y, BG] = xv * dt * c, dt * s + xv * dt * c * db_dv, xv * dt * c * db_dbg
         F[YAW, BG] = -dt
         F[V, BA] = -dt
         self.kf.F = F
+        Q = self._Q.get((dt, good))
+        if Q is None:
+            Q = self._Q[dt, good] = self._process_noise(dt, 1.0 if good else 25.0)
+        self.kf.Q = Q
+        self.kf.predict(u=(w, a, dt))
+        return good
+
+    def _process_noise(self, dt: float, widen: float) -> np.ndarray:
+        """(12, 12) process noise of a step of ``dt`` [s], the IMU's white noise variances times ``widen``."""
+        n = self.noise
         Q = np.zeros((N_STATE, N_STATE))
         Q[YAW, YAW] = widen * (n.gyro_sigma_rps * dt) ** 2
         Q[V, V] = widen * (n.accel_sigma_mps2 * dt) ** 2
@@ -160,9 +210,7 @@ class PoseFilter:
         Q[BA, BA] = n.accel_bias_walk ** 2 * dt
         Q[SV, SV] = (n.vo_bias_walk * n.vo_scale_sigma) ** 2 * dt
         Q[BV, BV] = (n.vo_bias_walk * n.vo_yaw_drift_sigma_rad_per_m) ** 2 * dt
-        self.kf.Q = Q
-        self.kf.predict(u=(w, a, dt))
-        return good
+        return Q
 
     def update_wheel(self, wheel_speed_mps: float) -> bool:
         """Wheel speed = scale x speed. Rejects NaN and absurd readings (returns False)."""
@@ -172,67 +220,52 @@ class PoseFilter:
         if not self._started:
             self.kf.x[V, 0] = max(wheel_speed_mps, 0.0)
             self._started = True
-        x = self.kf.x[:, 0]
-
-        def H(_x):
-            h = np.zeros((1, N_STATE))
-            h[0, V], h[0, KW] = x[KW], x[V]
-            return h
-        self.kf.update(np.array([[wheel_speed_mps]]), H, lambda s: np.array([[s[KW, 0] * s[V, 0]]]),
-                       R=np.array([[self.noise.wheel_sigma_mps ** 2]]))
+        self.kf.update(np.array([[wheel_speed_mps]]), _wheel_jacobian, _wheel_speed, R=self._wheel_R)
         return True
 
     def clone(self) -> None:
         """Remember the current pose as the one of the last processed image (with its correlations)."""
         x, P = self.kf.x, self.kf.P
-        x[[XC, YC, YAWC]] = x[[X, Y, YAW]]
-        P[[XC, YC, YAWC], :] = P[[X, Y, YAW], :]
-        P[:, [XC, YC, YAWC]] = P[:, [X, Y, YAW]]
+        # the clone's (XC, YC, YAWC) and the pose's (X, Y, YAW) are each three consecutive elements
+        x[XC:YAWC + 1] = x[X:YAW + 1]
+        P[XC:YAWC + 1, :] = P[X:YAW + 1, :]
+        P[:, XC:YAWC + 1] = P[:, X:YAW + 1]
 
     def update_relative(self, dx_m: float, dy_m: float, dyaw_rad: float, cov: np.ndarray) -> bool:
         """Visual odometry: the vehicle's motion since the clone, in the clone's vehicle frame (dx forward, dy
         left [m], dyaw [rad]) with its (3, 3) covariance. Gated; False when rejected."""
-        x = self.kf.x[:, 0]
-
-        def hx(s):
-            c, sn = math.cos(s[YAWC, 0]), math.sin(s[YAWC, 0])
-            d = s[[X, Y], 0] - s[[XC, YC], 0]
-            k = 1.0 + s[SV, 0]
-            # [dx, dy] = (1 + s_vo) R(-psi_c) (p - p_c); dyaw = psi - psi_c + b_vo |p - p_c|
-            return np.array([[k * (c * d[0] + sn * d[1])], [k * (-sn * d[0] + c * d[1])],
-                             [wrap_angle(s[YAW, 0] - s[YAWC, 0]) + s[BV, 0] * math.hypot(d[0], d[1])]])
-
-        c, sn = math.cos(x[YAWC]), math.sin(x[YAWC])
-        d = x[[X, Y]] - x[[XC, YC]]
-        base = np.array([c * d[0] + sn * d[1], -sn * d[0] + c * d[1]])
-        k = 1.0 + x[SV]
+        x = self.kf.x
+        c, sn = math.cos(x.item(YAWC)), math.sin(x.item(YAWC))
+        d0, d1 = x.item(X) - x.item(XC), x.item(Y) - x.item(YC)
+        base0, base1 = c * d0 + sn * d1, -sn * d0 + c * d1
+        k = 1.0 + x.item(SV)
         Hm = np.zeros((3, N_STATE))
-        Hm[0, [X, Y, XC, YC, YAWC, SV]] = k * c, k * sn, -k * c, -k * sn, k * base[1], base[0]
-        Hm[1, [X, Y, XC, YC, YAWC, SV]] = -k * sn, k * c, k * sn, -k * c, -k * base[0], base[1]
+        Hm[0, X], Hm[0, Y], Hm[0, XC], Hm[0, YC] = k * c, k * sn, -k * c, -k * sn
+        Hm[0, YAWC], Hm[0, SV] = k * base1, base0
+        Hm[1, X], Hm[1, Y], Hm[1, XC], Hm[1, YC] = -k * sn, k * c, k * sn, -k * c
+        Hm[1, YAWC], Hm[1, SV] = -k * base0, base1
         # d dyaw / d b_vo = |p - p_c| (its dependence on the positions, b_vo d|d|/dp, is negligible)
-        Hm[2, [YAW, YAWC, BV]] = 1.0, -1.0, math.hypot(d[0], d[1])
-        n = self.noise
-        # Sigma = D Sigma_vo D, D = diag(sqrt(k_t), sqrt(k_t), sqrt(k_r))
-        d = np.sqrt([n.vo_scale_translation, n.vo_scale_translation, n.vo_scale_rotation])
-        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, hx, cov * np.outer(d, d), 2)
+        Hm[2, YAW], Hm[2, YAWC], Hm[2, BV] = 1.0, -1.0, math.hypot(d0, d1)
+        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, _relative_motion, cov * self._vo_D2, 2)
 
     def update_landmark(self, landmark_xy_m: np.ndarray, measured_xy_m: np.ndarray, cov: np.ndarray) -> bool:
         """A mapped landmark at world ``landmark_xy_m`` (2,) seen at ``measured_xy_m`` (2,) in the vehicle frame
         with (2, 2) covariance. Gated against wrong matches; False when rejected."""
         L = np.asarray(landmark_xy_m, float)
-        x = self.kf.x[:, 0]
-        c, sn = math.cos(x[YAW]), math.sin(x[YAW])
+        lx, ly = L.item(0), L.item(1)
+        yaw = self.kf.x.item(YAW)
+        c, sn = math.cos(yaw), math.sin(yaw)
 
         def hx(s):
-            cc, ss = math.cos(s[YAW, 0]), math.sin(s[YAW, 0])
-            d = L - s[[X, Y], 0]
+            cc, ss = math.cos(s.item(YAW)), math.sin(s.item(YAW))
+            d0, d1 = lx - s.item(X), ly - s.item(Y)
             # landmark in the vehicle frame: R(-psi) (L - p)
-            return np.array([[cc * d[0] + ss * d[1]], [-ss * d[0] + cc * d[1]]])
+            return np.array([[cc * d0 + ss * d1], [-ss * d0 + cc * d1]])
 
         h = hx(self.kf.x)
         Hm = np.zeros((2, N_STATE))
-        Hm[0, [X, Y, YAW]] = -c, -sn, h[1, 0]
-        Hm[1, [X, Y, YAW]] = sn, -c, -h[0, 0]
+        Hm[0, X], Hm[0, Y], Hm[0, YAW] = -c, -sn, h.item(1)
+        Hm[1, X], Hm[1, Y], Hm[1, YAW] = sn, -c, -h.item(0)
         accepted = self._gated_update(np.asarray(measured_xy_m, float).reshape(2, 1), Hm, hx, cov, None)
         self._refused = 0 if accepted else self._refused + 1
         if self._refused >= self.noise.lockout_sightings:
@@ -243,7 +276,7 @@ class PoseFilter:
         return accepted
 
     def _gated_update(self, z: np.ndarray, Hm: np.ndarray, hx, R: np.ndarray, angle_index: int | None) -> bool:
-        if not (np.all(np.isfinite(z)) and np.all(np.isfinite(R))):
+        if not (np.isfinite(z).all() and np.isfinite(R).all()):
             self.rejected += 1
             return False
         y = z - hx(self.kf.x)
@@ -254,6 +287,6 @@ class PoseFilter:
         if float((y.T @ np.linalg.solve(S, y))[0, 0]) > GATE_CHI2[len(z)]:
             self.gated += 1
             return False
-        residual = _angle_residual(angle_index) if angle_index is not None else np.subtract
+        residual = _ANGLE_RESIDUAL[angle_index] if angle_index is not None else np.subtract
         self.kf.update(z, lambda _s: Hm, hx, R=R, residual=residual)
         return True
