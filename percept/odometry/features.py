@@ -201,8 +201,9 @@ def track(prev: np.ndarray, cur: np.ndarray, pts: np.ndarray, win_px: int, level
             flags=cv2.OPTFLOW_USE_INITIAL_FLOW)
     p1 = p1.reshape(-1, 2)
     h, w = cur.shape[:2]
-    ok = (st.ravel() == 1) & np.all(np.isfinite(p1), axis=1)
-    ok &= (p1[:, 0] >= 0) & (p1[:, 0] <= w - 1) & (p1[:, 1] >= 0) & (p1[:, 1] <= h - 1)
+    # inside the image (a NaN or infinite position fails these comparisons too)
+    u, v = p1[:, 0], p1[:, 1]
+    ok = (st.ravel() == 1) & (u >= 0) & (u <= w - 1) & (v >= 0) & (v <= h - 1)
     return p1, ok
 
 

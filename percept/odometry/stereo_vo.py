@@ -12,6 +12,7 @@ odometry" (CVPR); Geiger, Ziegler & Stiller 2011, "StereoScan" (IV); Hartley & Z
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import cv2
@@ -73,19 +74,34 @@ class StereoVOConfig:
                              "ransac_px > 0 and min_disparity_px > 0 are required")
 
 
+_LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
+
+
 def _inverse(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
+    """The inverse of the rigid (4, 4) transform ``T``."""
+    R = T[:3, :3]
+    out = np.empty((4, 4))
     # T^-1 = [R^T, -R^T t]
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    out[:3, :3] = R.T
+    out[:3, 3] = -R.T @ T[:3, 3]
+    out[3] = _LAST_ROW
     return out
 
 
 def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
-    T = np.eye(4)
+    """(4, 4) [R(rvec), t] of a rotation vector and a translation (3, 1)."""
+    T = np.empty((4, 4))
     T[:3, :3] = cv2.Rodrigues(rvec)[0]
     T[:3, 3] = tvec.ravel()
+    T[3] = _LAST_ROW
     return T
+
+
+def _lengths(d: np.ndarray) -> np.ndarray:
+    """The lengths of the rows of ``d`` (N, 2) in its own float type: sqrt(dx^2 + dy^2), as
+    ``np.linalg.norm(d, axis=1)`` computes them (two squares, one sum: the same bits)."""
+    d = d * d
+    return np.sqrt(d[:, 0] + d[:, 1])
 
 
 RANSAC_SEED = 1234
@@ -161,7 +177,8 @@ class StereoVO:
         else:
             self._win_px, self._prior_levels, self._free_win_px = c.lit_win_px, c.lit_prior_levels, c.win_px
         corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise, spread=spread)
-        corners = corners[self._static(corners)]
+        if self._movers:
+            corners = corners[self._static(corners)]
         self._prev, self._T_kf_prev, self._cov_prev = gl, np.eye(4), np.zeros((6, 6))
         self._kf_points = self._pixels = self._kf_pixels = None
         if len(corners) < c.min_inliers:
@@ -212,7 +229,8 @@ class StereoVO:
             moved, ok = track(self._prev, gl, self._pixels, self._free_win_px, c.levels)
         else:
             moved, ok = track(self._prev, gl, self._pixels, self._win_px, self._prior_levels, expected)
-        ok &= self._static(moved)
+        if self._movers:
+            ok &= self._static(moved)
         self._kf_points, self._pixels, self._kf_pixels = self._kf_points[ok], moved[ok], self._kf_pixels[ok]
         n = len(self._pixels)
         if n < c.min_inliers:
@@ -220,8 +238,8 @@ class StereoVO:
         use = np.arange(n)
         if expected is not None:
             # |seen - expected| against the gate, which widens with the point's motion since the keyframe
-            off = np.linalg.norm(self._pixels - expected[ok], axis=1)
-            flow = np.linalg.norm(self._pixels - self._kf_pixels, axis=1)
+            off = _lengths(self._pixels - expected[ok])
+            flow = _lengths(self._pixels - self._kf_pixels)
             agree = np.flatnonzero(off < c.prior_gate_px + c.prior_gate_frac * flow)
             if len(agree) >= max(c.min_inliers, n // 3):
                 use = agree
@@ -246,20 +264,22 @@ class StereoVO:
         c = self.config
         T = _inverse(T_kf_pred)
         rvec, tvec = cv2.Rodrigues(T[:3, :3])[0], T[:3, 3].reshape(3, 1).copy()
-        idx = use
+        points, pixels = self._kf_points[use], self._pixels[use]
+        idx, kept_points, kept_pixels = use, points, pixels
         for cut_px in (3.0 * c.ransac_px, c.ransac_px):
-            rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
-            seen = cv2.projectPoints(self._kf_points[use], rvec, tvec, self.K, None)[0].reshape(-1, 2)
-            idx = use[np.linalg.norm(seen - self._pixels[use], axis=1) < cut_px]
+            rvec, tvec = cv2.solvePnPRefineLM(kept_points, kept_pixels, self.K, None, rvec, tvec)
+            seen = cv2.projectPoints(points, rvec, tvec, self.K, None)[0].reshape(-1, 2)
+            keep = _lengths(seen - pixels) < cut_px
+            idx, kept_points, kept_pixels = use[keep], points[keep], pixels[keep]
             if len(idx) < max(c.min_inliers, len(use) // 2):
                 return None
-        rvec, tvec = cv2.solvePnPRefineLM(self._kf_points[idx], self._pixels[idx], self.K, None, rvec, tvec)
+        rvec, tvec = cv2.solvePnPRefineLM(kept_points, kept_pixels, self.K, None, rvec, tvec)
         return idx, rvec, tvec
 
     def _solved(self, n: int, idx: np.ndarray, rvec: np.ndarray, tvec: np.ndarray) -> VOStep:
         """The step from the pose (rvec, tvec: keyframe -> current camera) found on the inliers ``idx`` of the
         ``n`` tracked points."""
-        if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+        if not all(map(math.isfinite, rvec.ravel().tolist() + tvec.ravel().tolist())):
             return VOStep.failed("PnP diverged", tracked=n)
         # keep the inliers only: outliers (moving objects, bad tracks) would pull later frames too
         self._kf_points, self._pixels = self._kf_points[idx], self._pixels[idx]
