@@ -10,6 +10,7 @@ Hartley & Zisserman, sec. 12 (triangulation; for a rectified pair Z = f b / d).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -66,6 +67,8 @@ class LandmarkFinder:
         self._params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
         self.detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(ARUCO_DICTIONARY), self._params)
         self._v_from_c = rig.cam_from_vehicle(Side.LEFT).inverse()
+        # the map's ground positions and heights, apart [m]
+        self._map_xy, self._map_z = landmarks.positions_m[:, :2], landmarks.positions_m[:, 2]
 
     def expected(self, pose: Pose2D, pose_cov: np.ndarray) -> list[tuple[int, tuple[int, int, int, int], float]]:
         """Mapped signs that should be in view at ``pose``: (marker id, left-image window (u0, v0, u1, v1), the
@@ -73,24 +76,28 @@ class LandmarkFinder:
         if not len(self.map):
             return []
         c = self.config
-        xy = pose.to_vehicle_xy(self.map.positions_m[:, :2])
-        pts = np.column_stack([xy, self.map.positions_m[:, 2]])
+        xy = pose.to_vehicle_xy(self._map_xy)
+        pts = np.empty((len(xy), 3))
+        pts[:, :2] = xy
+        pts[:, 2] = self._map_z
         uv, z = self.rig.project_vehicle_points(pts)
         cam = self.rig.camera
-        # the pose's position uncertainty seen at depth z, and its heading uncertainty, in pixels
-        pos_sigma = float(np.sqrt(max(np.trace(pose_cov[:2, :2]), 0.0)))
-        yaw_sigma = float(np.sqrt(max(pose_cov[2, 2], 0.0)))
+        # the pose's position uncertainty seen at depth z, and its heading uncertainty, in pixels (variances read
+        # as floats: trace = var x + var y)
+        pos_sigma = math.sqrt(max(pose_cov[0, 0].item() + pose_cov[1, 1].item(), 0.0))
+        yaw_sigma = math.sqrt(max(pose_cov[2, 2].item(), 0.0))
         out = []
-        for k in np.flatnonzero((z >= c.min_range_m) & (z <= c.max_range_m)):
-            half = c.margin_px + cam.fx * (0.6 / z[k] + c.sigma_window * (pos_sigma / z[k] + yaw_sigma))
-            u, v = uv[k]
+        for k, (zk, (u, v)) in enumerate(zip(z.tolist(), uv.tolist())):
+            if not c.min_range_m <= zk <= c.max_range_m:
+                continue
+            half = c.margin_px + cam.fx * (0.6 / zk + c.sigma_window * (pos_sigma / zk + yaw_sigma))
             box = (int(max(u - half, 0)), int(max(v - half, 0)), int(min(u + half, cam.width)),
                    int(min(v + half, cam.height)))
             if box[2] - box[0] >= 16 and box[3] - box[1] >= 16:
                 # the marker's perimeter face on: 4 f s / Z
-                perimeter = 4.0 * cam.fx * c.marker_side_m / z[k]
+                perimeter = 4.0 * cam.fx * c.marker_side_m / zk
                 rate = c.min_perimeter_share * perimeter / max(box[2] - box[0], box[3] - box[1])
-                out.append((self.map.ids[k], box, float(np.clip(rate, MIN_PERIMETER_RATE, 1.0))))
+                out.append((self.map.ids[k], box, min(max(rate, MIN_PERIMETER_RATE), 1.0)))
         return out
 
     def _find(self, image: np.ndarray, box: tuple[int, int, int, int], marker_id: int,

@@ -153,9 +153,9 @@ class OdometrySlot:
             return None
         dt = self._since_image * self.dt_s
         # planar motion at constant speed and yaw rate: the heading turns by w dt, the chord lies at half of it
-        T = np.eye(4)
-        T[:2, :2] = [[math.cos(w * dt), -math.sin(w * dt)], [math.sin(w * dt), math.cos(w * dt)]]
-        T[:2, 3] = v * dt * math.cos(w * dt / 2), v * dt * math.sin(w * dt / 2)
+        c, s = math.cos(w * dt), math.sin(w * dt)
+        T = np.array([[c, -s, 0.0, v * dt * math.cos(w * dt / 2)], [s, c, 0.0, v * dt * math.sin(w * dt / 2)],
+                      [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
         return self._T_cv @ T @ self._T_vc
 
     def _vehicle(self, T_cam: np.ndarray) -> np.ndarray:
