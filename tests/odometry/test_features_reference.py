@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from percept.odometry.features import _strongest_per_cell, noise_sigma
+from percept.odometry.features import _floor_quotient, _strongest_per_cell, noise_sigma
 
 _TAPS = np.array([1, -2, 1], np.float32)
 
@@ -49,3 +49,15 @@ def test_strongest_per_cell_equals_lexsorts_cut():
             got = _strongest_per_cell(pts, resp, 10, 6, 640, 480, per_cell)
             ref = _numpy_strongest(pts, resp, 10, 6, 640, 480, per_cell)
             assert got.dtype == ref.dtype and np.array_equal(got, ref)
+
+
+def test_floor_quotient_equals_numpys_floor_division():
+    rng = np.random.default_rng(7)
+    # a corner's cell: u gx // w in float32, u over the image and beyond, at the cell borders and just beside them
+    for w, gx in ((640, 10), (480, 6)):
+        a = (np.float32(gx) * rng.uniform(-5.0, w + 5.0, 20000).astype(np.float32)).astype(np.float32)
+        borders = np.float32(w) * np.arange(-1, gx + 2, dtype=np.float32)
+        a = np.concatenate([a, borders, np.nextafter(borders, np.float32(-np.inf)),
+                            np.nextafter(borders, np.float32(np.inf))])
+        ref = (a // np.float32(w)).astype(np.int64)
+        assert [_floor_quotient(x, np.float32(w)) for x in a] == ref.tolist()
