@@ -18,10 +18,10 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from percept.compiled import kernel
 from percept.sensors import to_gray
 
 from .features import check_intrinsics, detect_corners, noise_sigma, pose_covariance, track, warm_up_corners
+from .point_cuts import agreeing, warm_up_cuts, within
 from .types import VOStep
 
 
@@ -98,62 +98,6 @@ def _matrix(rvec: np.ndarray, tvec: np.ndarray) -> np.ndarray:
     return T
 
 
-@kernel()
-def _within(seen, pixels, points, use, cut_px):  # pragma: no cover - compiled
-    """The rows of ``use`` (N,), ``points`` (N, 3) and ``pixels`` (N, 2) float32 whose reprojection ``seen`` (N, 2)
-    float64 lies closer than ``cut_px`` to the pixel, in one pass: numpy's
-    ``keep = np.linalg.norm(seen - pixels, axis=1) < cut_px; use[keep], points[keep], pixels[keep]`` (the same
-    arithmetic: float64 differences, two squares, one sum, sqrt)."""
-    n = seen.shape[0]
-    keep = np.empty(n, np.int64)
-    m = 0
-    for i in range(n):
-        du = seen[i, 0] - np.float64(pixels[i, 0])
-        dv = seen[i, 1] - np.float64(pixels[i, 1])
-        if np.sqrt(du * du + dv * dv) < cut_px:
-            keep[m] = i
-            m += 1
-    idx = np.empty(m, use.dtype)
-    kept_points, kept_pixels = np.empty((m, 3), points.dtype), np.empty((m, 2), pixels.dtype)
-    for j in range(m):
-        i = keep[j]
-        idx[j] = use[i]
-        for k in range(3):
-            kept_points[j, k] = points[i, k]
-        kept_pixels[j, 0], kept_pixels[j, 1] = pixels[i, 0], pixels[i, 1]
-    return idx, kept_points, kept_pixels
-
-
-@kernel()
-def _agreeing(pixels, expected, kf_pixels, gate_px, gate_frac):  # pragma: no cover - compiled
-    """Indices of the tracked ``pixels`` (N, 2) float32 that lie within gate_px + gate_frac x (their motion since the
-    keyframe, from ``kf_pixels`` (N, 2) float32) of where the prior put them, ``expected`` (N, 2) float64: numpy's
-    ``np.flatnonzero(norm(pixels - expected) < gate_px + gate_frac * norm(pixels - kf_pixels))`` with the same
-    arithmetic: the offset in float64, the motion and the gate in float32 (numpy's type for a float32 array and
-    Python floats)."""
-    n = pixels.shape[0]
-    g0, g1 = np.float32(gate_px), np.float32(gate_frac)
-    out = np.empty(n, np.intp)
-    m = 0
-    for i in range(n):
-        du = np.float64(pixels[i, 0]) - expected[i, 0]
-        dv = np.float64(pixels[i, 1]) - expected[i, 1]
-        fu = pixels[i, 0] - kf_pixels[i, 0]
-        fv = pixels[i, 1] - kf_pixels[i, 1]
-        flow = np.sqrt(fu * fu + fv * fv)
-        if np.sqrt(du * du + dv * dv) < np.float64(g0 + g1 * flow):
-            out[m] = i
-            m += 1
-    return out[:m]
-
-
-def _warm_up_within() -> None:
-    """``_within`` and ``_agreeing`` loaded now on the argument types of a step (compiled once after an install),
-    not in a frame."""
-    _within(np.zeros((0, 2)), np.zeros((0, 2), np.float32), np.zeros((0, 3)), np.zeros(0, np.intp), 1.0)
-    _agreeing(np.zeros((0, 2), np.float32), np.zeros((0, 2)), np.zeros((0, 2), np.float32), 3.0, 0.15)
-
-
 RANSAC_SEED = 1234
 
 
@@ -171,7 +115,7 @@ class StereoVO:
         self.K, self.baseline_m, self.config = K, float(baseline_m), config
         self.camera_height_m = camera_height_m
         warm_up_corners()
-        _warm_up_within()
+        warm_up_cuts()
         self.reset()
 
     def reset(self) -> None:
@@ -289,7 +233,7 @@ class StereoVO:
         use = np.arange(n)
         if expected is not None:
             # |seen - expected| against the gate, which widens with the point's motion since the keyframe
-            agree = _agreeing(self._pixels, expected[ok], self._kf_pixels, c.prior_gate_px, c.prior_gate_frac)
+            agree = agreeing(self._pixels, expected[ok], self._kf_pixels, c.prior_gate_px, c.prior_gate_frac)
             if len(agree) >= max(c.min_inliers, n // 3):
                 use = agree
                 # the prior agrees with most points: start from it instead of sampling minimal solutions
@@ -318,7 +262,7 @@ class StereoVO:
         for cut_px in (3.0 * c.ransac_px, c.ransac_px):
             rvec, tvec = cv2.solvePnPRefineLM(kept_points, kept_pixels, self.K, None, rvec, tvec)
             seen = cv2.projectPoints(points, rvec, tvec, self.K, None)[0].reshape(-1, 2)
-            idx, kept_points, kept_pixels = _within(seen, pixels, points, use, cut_px)
+            idx, kept_points, kept_pixels = within(seen, pixels, points, use, cut_px)
             if len(idx) < max(c.min_inliers, len(use) // 2):
                 return None
         rvec, tvec = cv2.solvePnPRefineLM(kept_points, kept_pixels, self.K, None, rvec, tvec)

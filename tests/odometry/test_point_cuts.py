@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from percept.odometry.stereo_vo import _agreeing, _within
+from percept.odometry.point_cuts import agreeing, within
 
 
 def _unit(rng, n):
@@ -19,7 +19,7 @@ def test_within_equals_numpys_cut():
         # half the reprojections exactly at the cut's distance (in float64), the rest anywhere near
         seen = pixels + np.where(rng.random((n, 1)) < 0.5, 0.7 * _unit(rng, n), rng.normal(0, 1, (n, 2)))
         keep = np.linalg.norm(seen - pixels, axis=1) < 0.7
-        idx, kept_points, kept_pixels = _within(seen, pixels, points, use, 0.7)
+        idx, kept_points, kept_pixels = within(seen, pixels, points, use, 0.7)
         for got, ref in ((idx, use[keep]), (kept_points, points[keep]), (kept_pixels, pixels[keep])):
             assert got.dtype == ref.dtype and np.array_equal(got, ref)
 
@@ -33,5 +33,5 @@ def test_agreeing_equals_numpys_gate():
         # offsets at the gate, 3 + 0.15 |motion| (float32, as numpy makes it), where float64 arithmetic would differ
         expected = px + (3.0 + 0.15 * flow).astype(np.float64)[:, None] * _unit(rng, n)
         ref = np.flatnonzero(np.linalg.norm(px - expected, axis=1) < 3.0 + 0.15 * flow)
-        got = _agreeing(px, expected, kf, 3.0, 0.15)
+        got = agreeing(px, expected, kf, 3.0, 0.15)
         assert got.dtype == ref.dtype and np.array_equal(got, ref)
