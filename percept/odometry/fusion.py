@@ -79,14 +79,8 @@ class _Ekf(ExtendedKalmanFilter):
         # as the vehicle model integrates): p += v dt (cos, sin)(psi + beta); psi += w dt; v += (a - b_a) dt
         x[X, 0] = x.item(X) + v * dt * math.cos(course)
         x[Y, 0] = x.item(Y) + v * dt * math.sin(course)
-        x[YAW, 0] = _wrap(yaw + w * dt)
+        x[YAW, 0] = wrap_angle(yaw + w * dt)
         x[V, 0] = max(v + (accel - x.item(BA)) * dt, 0.0)
-
-
-def _wrap(angle_rad: float) -> float:
-    """``wrap_angle`` of one float, in floats: the same bits (Python's float % is numpy's, fmod then the divisor's
-    sign) [rad]."""
-    return (angle_rad + math.pi) % (2 * math.pi) - math.pi
 
 
 def slip_angle(yaw_rate_rps: float, speed_mps: float, arm_m: float) -> float:
@@ -126,7 +120,7 @@ def _relative_motion(s: np.ndarray) -> np.ndarray:
     k = 1.0 + s.item(SV)
     # [dx, dy] = (1 + s_vo) R(-psi_c) (p - p_c); dyaw = psi - psi_c + b_vo |p - p_c|
     return np.array([[k * (c * d0 + sn * d1)], [k * (-sn * d0 + c * d1)],
-                     [_wrap(s.item(YAW) - s.item(YAWC)) + s.item(BV) * math.hypot(d0, d1)]])
+                     [wrap_angle(s.item(YAW) - s.item(YAWC)) + s.item(BV) * math.hypot(d0, d1)]])
 
 
 class PoseFilter:

@@ -26,7 +26,10 @@ def rot_z(yaw_rad: float) -> np.ndarray:
 
 
 def wrap_angle(angle_rad: float | np.ndarray) -> float | np.ndarray:
-    """Wrap to [-pi, pi)."""
+    """Wrap to [-pi, pi). A float stays a float: Python's float % is numpy's (fmod, then the divisor's sign), so it
+    gives the same bits without an array's overhead."""
+    if isinstance(angle_rad, float):
+        return (angle_rad + math.pi) % (2 * math.pi) - math.pi
     return (np.asarray(angle_rad) + math.pi) % (2 * math.pi) - math.pi
 
 
