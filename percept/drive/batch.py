@@ -29,6 +29,7 @@ from percept.outputs import write_json_atomic
 from percept.sims import WorldConfig
 
 from .config import DriveConfig
+from .environment import environments, numeric_environment
 from .loop import run_drive
 from .resume import (COUNTS, GROUPS, RunFiles, differences, refuse_other_settings, run_path, run_settings,
                      scan_runs)
@@ -122,12 +123,13 @@ def _worker_init() -> None:
 
 def run_job(plan: EvalPlan, job: Job) -> dict:
     """Run one job (in a worker, on one thread: OpenCV's and numpy's BLAS, so that workers do not contend for the
-    cores); the run JSON, or {"scenario", "condition", "seed", "error", "traceback"}."""
+    cores); the run JSON with the worker's ``environment`` (``numeric_environment``: what its numbers depend on besides
+    the code), or {"scenario", "condition", "seed", "error", "traceback"}."""
     cv2.setNumThreads(1)
     try:
         cfg = plan.config(job)
         with threadpool_limits(1):
-            return run_drive(cfg, render=cfg.needs_cameras)
+            return {**run_drive(cfg, render=cfg.needs_cameras), "environment": numeric_environment()}
     except Exception as e:  # noqa: BLE001 - one failed run must not take the batch down; it is reported
         return {"scenario": job.scenario, "condition": job.condition, "seed": job.seed,
                 "error": f"{type(e).__name__}: {e}", "traceback": traceback.format_exc()}
@@ -248,4 +250,5 @@ def summarize(plan: EvalPlan, results: list[dict]) -> dict:
             g["pedestrian_stops"] = {"stopped": int(sum(stops)), "crossings": len(stops)} if stops else None
             groups.append(g)
     # the slots and the duration are in the summary's ``settings`` (what the runs were made with)
-    return {"seeds": list(plan.seeds), "groups": groups}
+    return {"seeds": list(plan.seeds), "groups": groups, "environments": environments(results)}
+

@@ -16,6 +16,7 @@ import numpy as np
 
 from percept.outputs import write_text_atomic
 
+from .environment import environments
 from .resume import COUNTS, GROUPS
 
 HIGHER_IS_BETTER = frozenset({
@@ -124,6 +125,20 @@ def _fmt(v, spec: str = "{:.3g}") -> str:
     return "—" if v is None else spec.format(v)
 
 
+def _environment_lines(results: list[dict]) -> list[str]:
+    """Where the runs were driven (``batch.environments``): the same code gives other numbers, slightly, with other
+    numeric libraries or CPU code paths."""
+    lines = []
+    for env in environments(results):
+        if "numpy" in env:
+            lines.append(f"Driven on {env['cpu']} ({env['machine']}): Python {env['python']}, numpy {env['numpy']}, "
+                         f"OpenCV {env['opencv']}, numba {env['numba']}, BLAS {env['blas']}; OpenCV's CPU features "
+                         f"{env['opencv_cpu']}: {env['runs']} runs.")
+        else:
+            lines.append(f"Environment not recorded: {env['runs']} runs (made by an older percept).")
+    return lines + [""] if lines else []
+
+
 def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, tasks, plots: list[str]) -> str:
     """The evaluation as Markdown: settings, safety, headline metrics (``rows`` from ``metric_rows``), failures
     with reproduction commands."""
@@ -133,6 +148,7 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
     lines = [f"# Evaluation: {len(ok)} runs", "",
              f"Scenarios {', '.join(plan.scenarios)}; conditions {', '.join(plan.conditions)}; seeds "
              f"{_seed_text(plan.seeds)}; slots: {slots}; percept {settings.get('percept')}.", "",
+             *_environment_lines(results),
              "## Safety (totals over the seeds)", "",
              "| scenario | condition | runs | failed | collisions | pedestrian collisions | lane departures | "
              "phantom brakes | missed stops | false stops | brakes for no one |",

@@ -53,6 +53,14 @@ def test_eval_writes_runs_and_a_summary_and_resumes(tmp_path):
                                                                   "min": min(gaps)})
     # a metric no run has stays null; privileged lateral has no estimate to score
     assert lb["lane"]["offset_rmse_m"] is None and lb["pedestrian_stops"] is None
+    # each run records what its numbers depend on besides the code, and the summary lists where the runs came from
+    import numpy as np
+
+    env = one[0]["environment"]
+    assert env["numpy"] == np.__version__ and env["blas"] and env["opencv_cpu"] and env["cpu"]
+    assert s["environments"] == [{**env, "runs": 4}]
+    md = (tmp_path / "summary.md").read_text()
+    assert f"numpy {np.__version__}" in md and "4 runs." in md
     # the same command again reuses the finished runs instead of driving them again
     stamp = {p: p.stat().st_mtime_ns for p in (tmp_path / "runs").iterdir()}
     r = runner.invoke(app, args)

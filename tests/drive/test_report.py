@@ -83,6 +83,8 @@ def test_reports_are_written_and_readable(tmp_path):
     written = write_reports(PLAN, runs, SETTINGS, tmp_path, TASKS)
     md = (tmp_path / "summary.md").read_text()
     assert "| highway | clear | 5 | 0 | 1 | 0 | 0 | 0 | 0 | 0 | 0 |" in md  # the safety totals
+    # these runs carry no environment (as an older percept's): said so, not invented
+    assert "Environment not recorded: 5 runs" in md
     assert "seed 4: 1 collisions" in md and "`percept drive --scenario highway --seed 4" in md
     pngs = [p for p in written if p.suffix == ".png"]
     names = {p.name for p in pngs}
