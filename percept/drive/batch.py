@@ -251,4 +251,3 @@ def summarize(plan: EvalPlan, results: list[dict]) -> dict:
             groups.append(g)
     # the slots and the duration are in the summary's ``settings`` (what the runs were made with)
     return {"seeds": list(plan.seeds), "groups": groups, "environments": environments(results)}
-

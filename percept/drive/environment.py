@@ -35,7 +35,8 @@ def _opencv_version(module_version: str) -> str:
     """The installed OpenCV wheel's own version (its build number too: 5.0.0.93), else the module's."""
     from importlib.metadata import PackageNotFoundError, version
 
-    for wheel in ("opencv-contrib-python-headless", "opencv-python-headless", "opencv-contrib-python", "opencv-python"):
+    wheels = ("opencv-contrib-python-headless", "opencv-python-headless", "opencv-contrib-python", "opencv-python")
+    for wheel in wheels:
         try:
             return version(wheel)
         except PackageNotFoundError:
@@ -45,8 +46,8 @@ def _opencv_version(module_version: str) -> str:
 
 @lru_cache(maxsize=1)
 def numeric_environment() -> dict:
-    """This process's numeric environment: Python, numpy, OpenCV and numba versions, the BLAS library numpy uses
-    with the kernels it chose (``threadpoolctl``), OpenCV's CPU features (``cv2.getCPUFeaturesLine``: a ``*`` marks
+    """This process's numeric environment: Python, numpy, OpenCV and numba versions, every BLAS library loaded (numpy's,
+    scipy's, OpenCV's) with the kernels it chose (``threadpoolctl``), OpenCV's CPU features (``cv2.getCPUFeaturesLine``: a ``*`` marks
     code it dispatches to), the CPU model and architecture. A JSON object of strings."""
     import cv2
     import numba
