@@ -46,9 +46,10 @@ def _opencv_version(module_version: str) -> str:
 
 @lru_cache(maxsize=1)
 def numeric_environment() -> dict:
-    """This process's numeric environment: Python, numpy, OpenCV and numba versions, every BLAS library loaded (numpy's,
-    scipy's, OpenCV's) with the kernels it chose (``threadpoolctl``), OpenCV's CPU features (``cv2.getCPUFeaturesLine``: a ``*`` marks
-    code it dispatches to), the CPU model and architecture. A JSON object of strings."""
+    """This process's numeric environment: Python, numpy, OpenCV and numba versions, every BLAS library loaded
+    (numpy's, scipy's, OpenCV's) with the kernels it chose (``threadpoolctl``), OpenCV's CPU features
+    (``cv2.getCPUFeaturesLine``: a ``*`` marks code it dispatches to), the CPU model and architecture. A JSON object
+    of strings."""
     import cv2
     import numba
     import numpy as np
