@@ -132,3 +132,18 @@ def floor_divide(a, b):  # pragma: no cover - compiled
     if div - fl > one / (one + one):
         fl += one
     return fl
+
+
+@njit(cache=True, error_model="numpy")
+def floor_quotient(a, b):  # pragma: no cover - compiled
+    """floor(a / b) of float32 a and b > 0 as an int64, exactly numpy's ``a // b`` (``floor_divide``) wherever the
+    multiple of b below a is a float32, as for a corner's grid cell (tests/odometry/test_features_reference.py): the
+    quotient in float64, then moved to the multiple q with q b <= a < (q + 1) b, the products exact in float64 for
+    whole q under 2^29. No ``fmod``, which cost most of the corner selection's pass."""
+    a64, b64 = np.float64(a), np.float64(b)
+    q = np.floor(a64 / b64)
+    if q * b64 > a64:
+        q -= 1.0
+    elif (q + 1.0) * b64 <= a64:
+        q += 1.0
+    return np.int64(q)

@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 from numba import njit
 
-from percept.compiled import kernel
+from percept.compiled import floor_quotient, kernel
 
 # below this mean intensity (or standard deviation) a frame has nothing to track: dark or featureless
 MIN_CONTRAST_GREY = 2.0
@@ -121,20 +121,6 @@ def detect_corners(gray: np.ndarray, max_corners: int, grid: tuple[int, int], th
     return pts[keep]
 
 
-@njit(cache=True, error_model="numpy")
-def _floor_quotient(a, b):  # pragma: no cover - compiled
-    """floor(a / b) of float32 a and b > 0 as an int64, exact (numpy's ``a // b`` wherever the multiple of b below a
-    is a float32, as for a corner's cell): the quotient in float64, then moved to the multiple q with
-    q b <= a < (q + 1) b, products exact in float64 for whole q under 2^29 (no fmod, which costs most of the pass)."""
-    a64, b64 = np.float64(a), np.float64(b)
-    q = np.floor(a64 / b64)
-    if q * b64 > a64:
-        q -= 1.0
-    elif (q + 1.0) * b64 <= a64:
-        q += 1.0
-    return np.int64(q)
-
-
 @kernel()
 def _strongest_per_cell(pts, resp, gx, gy, w, h, per_cell):  # pragma: no cover - compiled
     """Indices of the ``per_cell`` strongest corners (``resp`` (N,) float32) of each of the gx x gy cells of a w x h
@@ -150,8 +136,8 @@ def _strongest_per_cell(pts, resp, gx, gy, w, h, per_cell):  # pragma: no cover 
     top = np.empty((ncell, max(per_cell, 1)), np.int64)
     count = np.zeros(ncell, np.int64)
     for i in range(n):
-        cu = min(_floor_quotient(pts[i, 0] * fx, fw), gx - 1)
-        cv = min(_floor_quotient(pts[i, 1] * fy, fh), gy - 1)
+        cu = min(floor_quotient(pts[i, 0] * fx, fw), gx - 1)
+        cv = min(floor_quotient(pts[i, 1] * fy, fh), gy - 1)
         c = cu + gx * cv
         r = resp[i]
         k = count[c]

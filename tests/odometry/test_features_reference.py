@@ -4,7 +4,8 @@ import cv2
 import numpy as np
 import pytest
 
-from percept.odometry.features import _floor_quotient, _strongest_per_cell, noise_sigma
+from percept.compiled import floor_quotient
+from percept.odometry.features import _strongest_per_cell, noise_sigma
 
 _TAPS = np.array([1, -2, 1], np.float32)
 
@@ -60,4 +61,4 @@ def test_floor_quotient_equals_numpys_floor_division():
         a = np.concatenate([a, borders, np.nextafter(borders, np.float32(-np.inf)),
                             np.nextafter(borders, np.float32(np.inf))])
         ref = (a // np.float32(w)).astype(np.int64)
-        assert [_floor_quotient(x, np.float32(w)) for x in a] == ref.tolist()
+        assert [floor_quotient(x, np.float32(w)) for x in a] == ref.tolist()
