@@ -34,3 +34,23 @@ def test_only_contiguous_float32_is_filled():
         standard_normal_f32(rng, np.empty(10, np.float64))
     with pytest.raises(ValueError, match="C-contiguous float32"):
         standard_normal_f32(rng, np.empty((10, 10), np.float32)[:, ::2])
+
+
+def test_a_kept_half_is_drawn_first():
+    """PCG64 gives 64 bits at a time, numpy hands out their low half and keeps the high half for the next uint32:
+    after an odd number of uint32s the fill starts from the kept half, as numpy's draws do."""
+    a, b = np.random.default_rng(11), np.random.default_rng(11)
+    for g in (a, b):
+        g.standard_normal(1, dtype=np.float32)
+    assert b.bit_generator.state["has_uint32"] == 1
+    ref = a.standard_normal((5, 9), dtype=np.float32)
+    assert standard_normal_f32(b, np.empty((5, 9), np.float32)).tobytes() == ref.tobytes()
+    assert a.bit_generator.state == b.bit_generator.state
+
+
+@pytest.mark.parametrize("bits", [np.random.MT19937, np.random.Philox, np.random.SFC64])
+def test_other_bit_generators_draw_as_numpy(bits):
+    a, b = np.random.Generator(bits(3)), np.random.Generator(bits(3))
+    ref = a.standard_normal((40, 7), dtype=np.float32)
+    assert standard_normal_f32(b, np.empty((40, 7), np.float32)).tobytes() == ref.tobytes()
+    assert a.random() == b.random()
