@@ -77,16 +77,23 @@ def _lcg_step(typingctx, hi, lo, inc_hi, inc_lo):
 
 
 @njit(cache=True, inline="always")
+def _step64(hi, lo, inc_hi, inc_lo):  # pragma: no cover - compiled
+    """numpy's ``pcg64_random_r``: the state (hi, lo) stepped, and the new state's 64-bit output. Returns
+    (hi, lo, output)."""
+    hi, lo = _lcg_step(hi, lo, inc_hi, inc_lo)
+    # XSL-RR: (high ^ low) rotated right by the state's top 6 bits
+    x, rot = hi ^ lo, hi >> np.uint64(58)
+    return hi, lo, (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
+
+
+@njit(cache=True, inline="always")
 def _next_uint32(pcg, inc_hi, inc_lo):  # pragma: no cover - compiled
     """numpy's ``pcg64_next32``; pcg: (state high, state low, has_uint32, uinteger) uint64, updated in place."""
     if pcg[2]:
         pcg[2] = 0
         return np.uint32(pcg[3])
-    hi, lo = _lcg_step(pcg[0], pcg[1], inc_hi, inc_lo)
-    pcg[0], pcg[1] = hi, lo
-    # XSL-RR: (high ^ low) rotated right by the state's top 6 bits
-    x, rot = hi ^ lo, hi >> np.uint64(58)
-    v = (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
+    pcg[0], pcg[1], v = _step64(pcg[0], pcg[1], inc_hi, inc_lo)
+    # the low half now, the high half kept for the next call
     pcg[2], pcg[3] = 1, v >> np.uint64(32)
     return np.uint32(v & np.uint64(0xFFFFFFFF))
 
@@ -128,17 +135,14 @@ def _rare(r, pcg, inc_hi, inc_lo):  # pragma: no cover - compiled
 @kernel()
 def _fill(flat, pcg, inc_hi, inc_lo):  # pragma: no cover - compiled
     """``flat`` filled with draws; the common draw (99 %: its layer's rectangle) with the generator's state in
-    locals, the others by ``_draw`` on the state written back to ``pcg``."""
+    locals (``_next_uint32``'s steps, unrolled), the others by ``_rare`` on the state written back to ``pcg``."""
     hi, lo, has, kept = pcg[0], pcg[1], pcg[2], pcg[3]
     i, n = 0, flat.size
     while i < n:
         if has:
             has, r = 0, np.uint32(kept)
         else:
-            hi, lo = _lcg_step(hi, lo, inc_hi, inc_lo)
-            # XSL-RR: (high ^ low) rotated right by the state's top 6 bits
-            x, rot = hi ^ lo, hi >> np.uint64(58)
-            v = (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
+            hi, lo, v = _step64(hi, lo, inc_hi, inc_lo)
             has, kept, r = 1, v >> np.uint64(32), np.uint32(v & np.uint64(0xFFFFFFFF))
         idx = r & 0xFF
         rabs = (r >> 9) & 0x7FFFFF
