@@ -44,11 +44,11 @@ class FusionNoise:
     own variances of translation and of yaw (its covariance comes from the reprojection residuals alone and leaves
     out the keyframe points' depth error; these factors were measured from its innovations on `loop`);
     vo_step_floor: standard deviations (along [m], across [m], yaw [rad]) added to every keyframe span's relative
-    motion, whatever its residuals say. Measured against the truth (2026-11-28, 2 362 spans of `loop` and
-    `lead-brake` in clear, `lead-brake` and `highway` in rain), a span's along-track error had a standard deviation
-    of 3.2-3.7 cm by day (spans of ~5 m) and 2.8 cm in rain (~2 m), across 1.4-1.8 and 0.8 cm, in yaw ~1.5e-4 rad:
-    about the same whatever the span's length, while the residuals' covariance varied far more from span to span (a
-    span's squared error over its own variance had a median of 2.1-3.0 and a 90th percentile of 20-27 before the
+    motion, whatever its residuals say, below the spans' errors as measured against the truth (2026-11-28,
+    ``tools/vo_span_errors.py``, 2 362 spans of `loop` and `lead-brake` in clear, `lead-brake` and `highway` in
+    rain: standard deviations of 4.0-5.5 cm along, 1.2-2.8 cm across and 1.7-2.5e-4 rad in yaw, by day over spans
+    of 5 frames as in rain over 2), while the residuals' covariance varied far more from span to span (a span's
+    squared error over its own variance had a median of 2.6-3.0 and a 90th percentile of 20-27 before the
     scale factors). Without the floor, on `lead-brake` seed 2 (odometry alone on vision) the second span, 7.5 cm
     (1.5 %) short, set the filter's speed 0.6 m/s low with a standard deviation of 6 cm/s, the gate refused three of
     the next five spans, and the estimate stayed outside its 3-sigma bound to the end;
