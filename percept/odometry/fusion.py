@@ -43,6 +43,15 @@ class FusionNoise:
     rejected); vo_scale_translation, vo_scale_rotation: multiply the visual odometry's
     own variances of translation and of yaw (its covariance comes from the reprojection residuals alone and leaves
     out the keyframe points' depth error; these factors were measured from its innovations on `loop`);
+    vo_step_floor: standard deviations (along [m], across [m], yaw [rad]) added to every keyframe span's relative
+    motion, whatever its residuals say, below the spans' errors as measured against the truth (2026-11-28,
+    ``tools/vo_span_errors.py``, 2 362 spans of `loop` and `lead-brake` in clear, `lead-brake` and `highway` in
+    rain: standard deviations of 4.0-5.5 cm along, 1.2-2.8 cm across and 1.7-2.5e-4 rad in yaw, by day over spans
+    of 5 frames as in rain over 2), while the residuals' covariance varied far more from span to span (a span's
+    squared error over its own variance had a median of 2.6-3.0 and a 90th percentile of 20-27 before the
+    scale factors). Without the floor, on `lead-brake` seed 2 (odometry alone on vision) the second span, 7.5 cm
+    (1.5 %) short, set the filter's speed 0.6 m/s low with a standard deviation of 6 cm/s, the gate refused three of
+    the next five spans, and the estimate stayed outside its 3-sigma bound to the end;
     lockout_sightings, lockout_widen: after this many landmark sightings refused in a row, the pose variances are
     multiplied by lockout_widen."""
 
@@ -59,6 +68,7 @@ class FusionNoise:
     vo_bias_walk: float = 0.2
     vo_scale_translation: float = 9.0
     vo_scale_rotation: float = 4.0
+    vo_step_floor: tuple[float, float, float] = (0.03, 0.015, 1.5e-4)
     lockout_sightings: int = 3
     lockout_widen: float = 4.0
 
@@ -146,6 +156,8 @@ class PoseFilter:
         # elements Sigma_vo * (d d^T)
         d = np.sqrt([noise.vo_scale_translation, noise.vo_scale_translation, noise.vo_scale_rotation])
         self._vo_D2 = np.outer(d, d)
+        # ... plus the floor's variances on the diagonal
+        self._vo_floor = np.diag(np.square(noise.vo_step_floor))
         self.rejected = 0  # sensor samples rejected as NaN or absurd
         self.gated = 0  # measurements refused by the innovation gate
         self._refused = 0  # landmark sightings refused in a row
@@ -240,7 +252,8 @@ class PoseFilter:
         Hm[1, YAWC], Hm[1, SV] = -k * base0, base1
         # d dyaw / d b_vo = |p - p_c| (its dependence on the positions, b_vo d|d|/dp, is negligible)
         Hm[2, YAW], Hm[2, YAWC], Hm[2, BV] = 1.0, -1.0, math.hypot(d0, d1)
-        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, _relative_motion, cov * self._vo_D2, 2)
+        return self._gated_update(np.array([[dx_m], [dy_m], [dyaw_rad]]), Hm, _relative_motion,
+                                  cov * self._vo_D2 + self._vo_floor, 2)
 
     def update_landmark(self, landmark_xy_m: np.ndarray, measured_xy_m: np.ndarray, cov: np.ndarray) -> bool:
         """A mapped landmark at world ``landmark_xy_m`` (2,) seen at ``measured_xy_m`` (2,) in the vehicle frame

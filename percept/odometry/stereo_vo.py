@@ -28,13 +28,18 @@ from .types import VOStep
 @dataclass(frozen=True)
 class StereoVOConfig:
     """max_features: corners per keyframe; grid: cells (columns, rows) the corners are spread over;
-    fast_threshold: FAST's intensity threshold; win_px: KLT window; levels: KLT pyramid levels (prior_levels when
-    a motion prior says where to start: a shallow pyramid suffices and costs less); dark_grey, dark_win_px: from a
-    keyframe whose mean grey level is below dark_grey (night: a scene lit by the car's own lamps) KLT tracks with
-    dark_win_px windows (the beam's light stays put in the image while the road moves through it, a brightness
-    change KLT's constancy assumption cannot explain; a smaller window holds less of it; the simulator's night
-    frames have a mean grey level of 53-56, every other condition's 129 or more, the KITTI frames in ../shared/data
-    85-107);
+    fast_threshold: FAST's intensity threshold; levels: KLT pyramid levels without a motion prior; win_px and
+    prior_levels: KLT's window and, when a motion prior says where to start, its pyramid levels (a shallow pyramid
+    suffices and costs less) from a keyframe of low contrast, whose grey levels' standard deviation is below
+    low_contrast_grey (the simulator's rain: 25.5-32.2 on 2 700 frames; a large window holds enough texture through
+    the streaks); lit_win_px and lit_prior_levels: the same from a keyframe in daylight with contrast (glare's frames:
+    40.2-48.4 on 1 080; the KITTI frames in ../shared/data 51.5-66.6): small windows on one level, about
+    1 ms a frame less, VO as accurate by day and better in glare (README, Odometry); there, tracking without a prior
+    keeps win_px windows on levels (a motion nothing predicts needs the larger window); dark_grey, dark_win_px: from
+    a keyframe whose mean grey level is below dark_grey (night: a scene lit by the car's own lamps) KLT tracks with
+    dark_win_px windows and prior_levels (the beam's light stays put in the image while the road moves through it, a
+    brightness change KLT's constancy assumption cannot explain; a smaller window holds less of it; the simulator's
+    night frames have a mean grey level of 53-56, every other condition's 129 or more, the KITTI frames 85-107);
     max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
     point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
     ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
@@ -49,6 +54,9 @@ class StereoVOConfig:
     dark_grey: float = 70.0
     dark_win_px: int = 11
     prior_levels: int = 1
+    low_contrast_grey: float = 36.0
+    lit_win_px: int = 11
+    lit_prior_levels: int = 0
     max_row_err_px: float = 0.7
     min_disparity_px: float = 0.5
     min_inliers: int = 12
@@ -60,10 +68,11 @@ class StereoVOConfig:
     def __post_init__(self) -> None:
         if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:
             raise ValueError("need max_features >= 20, min_inliers >= 6 and keyframe_inliers >= min_inliers")
-        if not (min(self.win_px, self.dark_win_px) >= 5 and self.levels >= 0 and self.ransac_px > 0
+        if not (min(self.win_px, self.dark_win_px, self.lit_win_px) >= 5
+                and min(self.levels, self.prior_levels, self.lit_prior_levels) >= 0 and self.ransac_px > 0
                 and self.min_disparity_px > 0):
-            raise ValueError("win_px >= 5, dark_win_px >= 5, levels >= 0, ransac_px > 0 and min_disparity_px > 0 "
-                             "are required")
+            raise ValueError("win_px, dark_win_px and lit_win_px >= 5, levels, prior_levels and lit_prior_levels >= 0, "
+                             "ransac_px > 0 and min_disparity_px > 0 are required")
 
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
@@ -119,6 +128,8 @@ class StereoVO:
         self._movers: list[tuple] = []  # this frame's boxes of things that move
         self._noise: float | None = None  # the keyframe image's noise sigma [grey levels]
         self._win_px = self.config.win_px  # the KLT window from the keyframe on [px]
+        self._prior_levels = self.config.prior_levels  # KLT's pyramid levels with a motion prior, likewise
+        self._free_win_px = self.config.win_px  # the KLT window of tracking without a motion prior [px]
         self._prev: np.ndarray | None = None  # previous left image (grey)
         self._T_kf_prev = np.eye(4)  # previous camera in the keyframe's frame
         self._cov_prev = np.zeros((6, 6))
@@ -152,9 +163,14 @@ class StereoVO:
         c = self.config
         self._noise = noise_sigma(gl)
         # the grey levels' mean (dark keyframes track with smaller windows) and spread (featureless ones have no
-        # corners) in one pass
+        # corners; low-contrast ones track with larger windows on a pyramid) in one pass
         mean, spread = (float(m[0, 0]) for m in cv2.meanStdDev(gl))
-        self._win_px = c.dark_win_px if mean < c.dark_grey else c.win_px
+        if mean < c.dark_grey:
+            self._win_px, self._prior_levels, self._free_win_px = c.dark_win_px, c.prior_levels, c.dark_win_px
+        elif spread < c.low_contrast_grey:
+            self._win_px, self._prior_levels, self._free_win_px = c.win_px, c.prior_levels, c.win_px
+        else:
+            self._win_px, self._prior_levels, self._free_win_px = c.lit_win_px, c.lit_prior_levels, c.win_px
         corners = detect_corners(gl, c.max_features, c.grid, c.fast_threshold, noise=self._noise, spread=spread)
         if self._movers:
             corners = corners[self._static(corners)]
@@ -204,8 +220,10 @@ class StereoVO:
     def _track(self, gl: np.ndarray, T_kf_pred: np.ndarray | None) -> VOStep:
         c = self.config
         expected = None if T_kf_pred is None else self._project(T_kf_pred)
-        moved, ok = track(self._prev, gl, self._pixels, self._win_px,
-                          c.levels if expected is None else c.prior_levels, expected)
+        if expected is None:
+            moved, ok = track(self._prev, gl, self._pixels, self._free_win_px, c.levels)
+        else:
+            moved, ok = track(self._prev, gl, self._pixels, self._win_px, self._prior_levels, expected)
         if self._movers:
             ok &= self._static(moved)
         self._kf_points, self._pixels, self._kf_pixels = self._kf_points[ok], moved[ok], self._kf_pixels[ok]

@@ -139,3 +139,36 @@ def test_nearest_target_compares_bumper_gaps_of_the_lead_and_the_request():
     assert t.source == "lead" and t.gap_m == pytest.approx(30.0 - offset) and t.closing_mps == 2.0
     assert nearest_target(None, None) is None
     assert nearest_target(Lead(1.0, 0.0), None).gap_m == 0.0  # inside the bumper: no negative gaps
+
+
+
+def _yield_to_a_person(rate_mps, gap0_m=34.3, v0_mps=12.58, dt=1 / 15):
+    """A point-mass car yielding to a person standing ``gap0_m`` beyond the bumper under the agent's two laws: how
+    many times the command went below -3 m/s^2 above 2 m/s (the scorer's phantom-brake onsets), and the gap left at
+    a standstill [m]. ``rate_mps(v, k)``: the request's range rate at frame k."""
+    following, braking = Following(set_speed_mps=v0_mps), EmergencyBraking()
+    v, gap, onsets, was = v0_mps, gap0_m, 0, False
+    for k in range(15 * 20):
+        req = BrakingRequest(gap + EGO_LENGTH_M / 2 - CAMERA_MOUNT_X_M, rate_mps(v, k), "pedestrian in the path")
+        target = nearest_target(None, req)
+        follow, _ = following.update(target, v)
+        a, _ = braking.update(target, v, follow, dt)
+        hard = a < -3.0 and v >= 2.0
+        onsets, was = onsets + (hard and not was), hard
+        v = max(v + a * dt, 0.0)
+        gap -= v * dt
+        if v < 0.05:
+            break
+    return onsets, gap
+
+
+def test_yielding_on_the_ego_speed_brakes_once_and_stops_before_the_person():
+    # crossing seed 7 (clear): a person 34 m ahead, the car at 12.6 m/s. The request's range rate is the ego's speed
+    # (the pedestrian slot's): one smooth braking, below -3 m/s^2 once, stopped just beyond the 4 m margin
+    onsets, gap = _yield_to_a_person(lambda v, k: -v)
+    assert onsets == 1 and 4.0 <= gap < 4.0 + 1.0
+    # with the track's own x speed in it, read 0.7 +- 0.3 m/s away from the car (as it was there), the following
+    # law's standing test (v - closing < 1 m/s) flips frame to frame between its capped stop and its damped law
+    wobble = (0.7, 1.0, 0.4, 1.1, 0.6, 0.9)
+    onsets, _ = _yield_to_a_person(lambda v, k: wobble[k % len(wobble)] - v)
+    assert onsets > 2

@@ -222,6 +222,16 @@ def test_a_track_not_walking_is_judged_where_it_was_last_seen():
     assert request.reason == "pedestrian in the path"
 
 
+def test_the_request_closes_at_the_ego_speed_whatever_the_tracks_own_x_speed():
+    # crossing seed 7: a person crossing 35 m ahead, the track's x speed read +0.7 m/s (depth noise grows with Z^2);
+    # the request's range rate is the ego's speed alone, as for a person standing on the road
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    path = EgoPath.straight(12.6)
+    for vx in (0.7, -0.5, 0.0):
+        request, _ = slot._request([track(1, 35.0, 0.5, vx=vx, vy=-1.2)], path, 12.6)
+        assert request.range_rate_mps == -12.6
+
+
 WARM_CHECK = """
 from percept.compiled import dispatchers
 from percept.detection import blocks, hog, pyramid, stereo_range

@@ -103,3 +103,27 @@ def test_nan_and_absurd_samples_are_rejected_never_propagated():
 def test_noise_settings_are_used():
     loose = PoseFilter(Pose2D(0, 0, 0), FusionNoise(wheel_scale_sigma=0.1))
     assert loose.kf.P[5, 5] == pytest.approx(0.01)
+
+
+def test_a_span_that_claims_millimetres_cannot_pin_the_filter():
+    """A keyframe span's relative motion that claims 2 mm (its residuals' say) is still only as good as the floor
+    (FusionNoise.vo_step_floor, 3 cm along): the filter's position after it is not surer than that, so that the
+    spans after it, which disagree with it by a few centimetres, are not refused by the gate."""
+    f = PoseFilter(Pose2D(0.0, 0.0, 0.0))
+    f.clone()
+    for k in range(4):
+        if k:
+            f.predict(0.0, 0.0, DT)
+        f.update_wheel(SPEED)
+    sure = np.diag([0.002, 0.002, 1e-5]) ** 2
+    assert f.update_relative(3 * DT * SPEED - 0.075, 0.0, 0.0, sure)
+    along = math.sqrt(f.kf.P[0, 0])
+    floor = FusionNoise().vo_step_floor[0]
+    assert 0.8 * floor < along < floor
+    f.clone()
+    for _ in range(3):
+        f.predict(0.0, 0.0, DT)
+        f.update_wheel(SPEED)
+    # the next span, true to the wheel, disagrees with the first by 7.5 cm: measured, not refused
+    assert f.update_relative(3 * DT * SPEED, 0.0, 0.0, sure)
+    assert f.gated == 0

@@ -96,28 +96,47 @@ def test_a_motion_prior_and_mover_boxes_are_used(loop_run):
     assert not step.ok and "only 0 corners" in step.reason
 
 
-def test_a_dark_keyframe_is_tracked_with_the_smaller_window(loop_run, monkeypatch):
+def test_each_keyframe_light_picks_its_window_and_pyramid(loop_run, monkeypatch):
     from percept.odometry import stereo_vo
 
     world, shots = loop_run
-    windows = []
+    calls = []
     real_track = stereo_vo.track
 
     def spy(prev, cur, pts, win_px, levels, guess=None):
-        windows.append(win_px)
+        calls.append((win_px, levels, guess is not None))
         return real_track(prev, cur, pts, win_px, levels, guess)
 
     monkeypatch.setattr(stereo_vo, "track", spy)
     cfg = StereoVOConfig()
     vo = vo_for(world.cfg.rig)
-    # the same frames at a third of their brightness (a mean grey level of ~45, the night's ~55) and as they are
-    # (~130): each keyframe's stereo match and the tracking from it
-    for scale, want in ((1 / 3, cfg.dark_win_px), (1.0, cfg.win_px)):
+
+    def dark(img):  # a third of the brightness: a mean grey level of ~45 (the night's ~55)
+        return (img.astype(np.float32) / 3).astype(np.uint8)
+
+    def flat(img):  # half the contrast about mid-grey: a spread of ~21 (the rain's 26-27)
+        return (128 + (img.astype(np.float32) - 128) / 2).astype(np.uint8)
+
+    # each keyframe's stereo match (cfg.levels, from the road's disparity guess), then the tracking from it with the
+    # motion prior (the car's true motion, as the slot gives it from wheel speed and gyro)
+    for look, win, levels in ((dark, cfg.dark_win_px, cfg.prior_levels), (flat, cfg.win_px, cfg.prior_levels),
+                              (lambda img: img, cfg.lit_win_px, cfg.lit_prior_levels)):
         vo.reset()
-        windows.clear()
-        steps = [vo.process(*[(img.astype(np.float32) * scale).astype(np.uint8) for img in (f.left, f.right)])
-                 for f, _ in shots[:4]]
+        calls.clear()
+        steps = []
+        for k, (f, _) in enumerate(shots[:4]):
+            prior = None
+            if k:
+                prior = np.eye(4)
+                # forward along the camera's z by the distance travelled
+                prior[2, 3] = travelled(shots[k - 1][1], shots[k][1])
+            steps.append(vo.process(look(f.left), look(f.right), prior))
         # the first frame starts the keyframe; each later one is measured
-        assert all(s.ok for s in steps[1:]) and len(windows) >= 4 and set(windows) == {want}
-    with pytest.raises(ValueError, match="dark_win_px >= 5"):
+        assert all(s.ok for s in steps[1:]) and len(calls) >= 4
+        # keyframes' stereo matches on cfg.levels, the tracking on the prior's levels, all with the light's window
+        assert calls[0] == (win, cfg.levels, True) and (win, levels, True) in calls[1:]
+        assert set(calls) <= {(win, cfg.levels, True), (win, levels, True)}
+    with pytest.raises(ValueError, match="dark_win_px and lit_win_px >= 5"):
         StereoVOConfig(dark_win_px=3)
+    with pytest.raises(ValueError, match="lit_prior_levels >= 0"):
+        StereoVOConfig(lit_prior_levels=-1)
