@@ -175,13 +175,18 @@ class PedestrianSlot:
             return None, None
         x, t, c = best
         why = "pedestrian in the path" if c.now else "pedestrian stepping into the path"
+        return self._braking_request(x, speed, why, t.track_id), t.track_id
+
+    def _braking_request(self, x_m: float, speed_mps: float, why: str, track_id: int,
+                         withdrawn: bool = False) -> BrakingRequest:
+        """The request about a track whose feet are x_m ahead of the vehicle frame's origin."""
         # range: the left camera's depth of the feet; its rate: the ego's speed alone, the person taken to stand along
         # the road. The track's own x speed comes from depths whose noise grows with Z^2: for a person crossing 35 m
         # ahead (`crossing` seed 7) it put the closing speed 0.7-1.3 m/s below the car's, and the following law's
         # standing test (ego speed - closing < 1 m/s) flipped frame to frame, its command swinging between -2.7 and
         # -4.2 m/s^2. People cross; one walking along the path at 1.5 m/s changes the closing speed by a tenth at
         # 15 m/s, and the yield law does not read it.
-        return BrakingRequest(x - self.cam_x, -speed, why, ObjectKind.PEDESTRIAN, t.track_id), t.track_id
+        return BrakingRequest(x_m - self.cam_x, -speed_mps, why, ObjectKind.PEDESTRIAN, track_id, withdrawn=withdrawn)
 
     def _can_wait(self, x_m: float, speed_mps: float, t: PersonTrack) -> bool:
         """Whether the car could drive one more frame towards a young track at x_m and still stop short of it (at
@@ -207,5 +212,5 @@ class PedestrianSlot:
             return None
         t = self.asked[max(self.asked)]
         self.asked = {}
-        return BrakingRequest(t.position_m[0] - self.cam_x, t.velocity_mps[0] - speed,
-                              "moves like a vehicle, not a person", ObjectKind.PEDESTRIAN, t.track_id, withdrawn=True)
+        return self._braking_request(t.position_m[0], speed, "moves like a vehicle, not a person", t.track_id,
+                                     withdrawn=True)

@@ -167,8 +167,9 @@ def test_yielding_on_the_ego_speed_brakes_once_and_stops_before_the_person():
     # (the pedestrian slot's): one smooth braking, below -3 m/s^2 once, stopped just beyond the 4 m margin
     onsets, gap = _yield_to_a_person(lambda v, k: -v)
     assert onsets == 1 and 4.0 <= gap < 4.0 + 1.0
-    # with the track's own x speed in it, read 0.7 +- 0.3 m/s away from the car (as it was there), the following
-    # law's standing test (v - closing < 1 m/s) flips frame to frame between its capped stop and its damped law
+    # with the track's own x speed in it, the closing speed 0.4-1.1 m/s below the car's (it read 0.7-1.3 there),
+    # the following law's standing test (v - closing < 1 m/s) flips frame to frame between its capped stop and its
+    # damped law
     wobble = (0.7, 1.0, 0.4, 1.1, 0.6, 0.9)
     onsets, _ = _yield_to_a_person(lambda v, k: wobble[k % len(wobble)] - v)
     assert onsets > 2

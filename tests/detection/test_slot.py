@@ -223,7 +223,8 @@ def test_a_track_not_walking_is_judged_where_it_was_last_seen():
 
 
 def test_the_request_closes_at_the_ego_speed_whatever_the_tracks_own_x_speed():
-    # crossing seed 7: a person crossing 35 m ahead, the track's x speed read +0.7 m/s (depth noise grows with Z^2);
+    # crossing seed 7: a person crossing 35 m ahead, the closing speed read 0.7-1.3 m/s short of the car's (the
+    # track's x speed, from depths whose noise grows with Z^2);
     # the request's range rate is the ego's speed alone, as for a person standing on the road
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(12.6)
