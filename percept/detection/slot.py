@@ -98,8 +98,8 @@ class PedestrianSlot:
     """``step(frame, upstream)`` -> (BrakingRequest or None, PedestrianDebug); upstream["lateral"]: the ego path."""
 
     def __init__(self, rig: StereoRig, dt_s: float, model: LinearModel | None = None,
-                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 6,
-                 far_sweep_frames: int = 3, far_person_px: float = 50.0):
+                 search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 8,
+                 far_sweep_frames: int = 3, far_person_px: float = 40.0):
         if sweep_frames < 1 or far_sweep_frames < 1:
             raise ValueError(f"sweep_frames and far_sweep_frames must be at least 1, got {sweep_frames} and "
                              f"{far_sweep_frames}")
@@ -109,7 +109,10 @@ class PedestrianSlot:
         texture_side(np.zeros((6, 3), np.uint8), 1.0)
         best_match(np.zeros(3, np.float32))
         # frames between two searches of each level: the far field's levels (people up to far_person_px tall)
-        # every far_sweep_frames, the others every sweep_frames
+        # every far_sweep_frames, the others every sweep_frames. Every crossing person of b02c612's strict
+        # evaluations (90 runs) was first found 28.3 m away or farther, beyond the depths of the fourth level
+        # (people of 41.5 px, feet at 28.1 m at most): the three smallest levels keep every third frame; the ones
+        # above them, which find again people whose track was lost, every eighth (a quarter of the slot's time)
         self.periods = tuple(far_sweep_frames if PERSON_PX * s <= far_person_px else sweep_frames
                              for s in self.search.scales)
         self.cam_x = float(rig.camera_position()[0])

@@ -74,6 +74,16 @@ def test_the_far_fields_levels_are_searched_more_often_than_the_near_ones():
     assert 0 < sum(heights <= 50) < len(heights)
 
 
+def test_by_default_the_levels_where_crossing_people_are_first_found_are_searched_every_third_frame():
+    """The defaults: the three smallest levels (people up to 34.6 px, the only ones that reach the 28.3 m and more
+    at which every crossing person of b02c612's evaluations was first found) every third frame, the others every
+    eighth."""
+    slot = PedestrianSlot(StereoRig(), 1 / 15)
+    assert slot.periods == (3, 3, 3) + (8,) * (len(slot.search.scales) - 3)
+    assert all(slot.search._depths[k][1] < 28.3 for k in range(3, len(slot.search.scales)))
+    assert all(slot.search._depths[k][1] > 28.3 for k in range(3))
+
+
 def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
     # rain, seed 10: the third person crosses 40-10 m ahead while the ego drives at 55 km/h; in rain the far field
     # often gives one window, which grouping drops: before lone windows were verified by stereo the person was
