@@ -112,7 +112,8 @@ class PedestrianSlot:
         # every far_sweep_frames, the others every sweep_frames. Every crossing person of b02c612's strict
         # evaluations (90 runs) was first found 28.3 m away or farther, beyond the depths of the fourth level
         # (people of 41.5 px, feet at 28.1 m at most): the three smallest levels keep every third frame; the ones
-        # above them, which find again people whose track was lost, every eighth (a quarter of the slot's time)
+        # above them, which find again people whose track was lost, every eighth (a fifth to a quarter less of the
+        # slot's time; README, Speed)
         self.periods = tuple(far_sweep_frames if PERSON_PX * s <= far_person_px else sweep_frames
                              for s in self.search.scales)
         self.cam_x = float(rig.camera_position()[0])
