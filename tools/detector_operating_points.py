@@ -12,8 +12,8 @@ import cv2
 import numpy as np
 
 from percept.detection import ConstrainedSearch, LinearModel, SearchConfig, iou_matrix, window_of
-from percept.drive.samples import for_each_frame
-from percept.drive.train_people import truth_path
+from percept.training.samples import for_each_frame
+from percept.training.people import truth_path
 from percept.sensors import ObjectKind, StereoRig
 
 cv2.setNumThreads(1)

@@ -14,7 +14,7 @@ import time
 import cv2
 import numpy as np
 
-from percept.drive.samples import for_each_frame
+from percept.training.samples import for_each_frame
 from percept.sensors import ObjectKind
 
 cv2.setNumThreads(1)

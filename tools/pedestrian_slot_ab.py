@@ -1,5 +1,5 @@
 """Cost a frame of pedestrian slot variants on the same frames, alternated in one process (one thread), as
-``percept bench`` times a slot (``drive.bench.slot_ms``: the mean over consecutive frames from a reset): read the
+``percept bench`` times a slot (``bench.stages.slot_ms``: the mean over consecutive frames from a reset): read the
 ratios between variants; a busy machine moves every figure together.
 
     python tools/pedestrian_slot_ab.py [--frames 60] [--passes 3] [--by-level] VARIANT [VARIANT ...]
@@ -21,7 +21,7 @@ import numpy as np
 
 from percept.detection import LinearModel, PedestrianSlot
 from percept.detection.constrained import PERSON_PX, ConstrainedSearch
-from percept.drive.bench import slot_ms
+from percept.bench.stages import slot_ms
 from percept.drive.privileged import TruthFeed
 from percept.drive.tasks import TASKS, SlotContext
 from percept.sims import SimWorld, WorldConfig

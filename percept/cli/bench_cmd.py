@@ -37,7 +37,7 @@ def bench(
     from threadpoolctl import threadpool_limits
 
     from percept.drive import TASKS
-    from percept.drive.bench import bench_render, bench_task, bench_ticks
+    from percept.bench.stages import bench_render, bench_task, bench_ticks
 
     opt.check_number("--frames", frames, 1, 10000)
     opt.check_number("--seconds", seconds, 1, 600)
@@ -100,7 +100,7 @@ def _scenarios(names: list[str] | None) -> list[str]:
 
 def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: float) -> dict:
     """The whole stack per scenario, the render per condition and the soak, printed and as the JSON's groups."""
-    from percept.drive.bench_stack import CONDITIONS, PAIR_FRAMES, bench_stack, render_per_condition, soak
+    from percept.bench.stack import CONDITIONS, PAIR_FRAMES, bench_stack, render_per_condition, soak
     from percept.sims.env import SIMULATION_HZ
 
     loop_frames = int(round(seconds * SIMULATION_HZ))
@@ -146,7 +146,7 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
 
 def _stack_targets(stacks) -> str:
     """On how many scenarios each of the stack's targets was kept in this run, as one line."""
-    from percept.drive.bench_stack import TARGETS
+    from percept.bench.stack import TARGETS
 
     parts = []
     for key, name in TARGETS.items():

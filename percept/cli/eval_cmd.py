@@ -71,9 +71,9 @@ def eval_(
 
 def _plan(scenario, condition, seeds, workers, engine, duration, detector, out: Path, redo: bool, sources):
     """The checked options as (EvalPlan, Engine, the run files already in --out); one-line exit 2 otherwise."""
-    from percept.drive.batch import Engine, EvalPlan, parse_seeds
+    from percept.evaluate.batch import Engine, EvalPlan, parse_seeds
     from percept.drive.config import MAX_DURATION_S
-    from percept.drive.resume import refuse_other_settings, scan_runs
+    from percept.evaluate.resume import refuse_other_settings, scan_runs
     from percept.sims import SCENARIOS
 
     opt.check_number("--workers", workers, 1, 256)
@@ -122,9 +122,9 @@ def _report_failures(summary: dict, total: int, out: Path) -> None:
 
 def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict:
     """The batch under a progress bar; Ctrl-C says how many finished runs are kept."""
-    from percept.drive.batch import evaluate
+    from percept.evaluate.batch import evaluate
 
-    from percept.drive.resume import run_path
+    from percept.evaluate.resume import run_path
 
     failed = [0]
 

@@ -13,7 +13,7 @@ from percept.sensors.records import Source
 
 
 MAX_SEED = 2**31 - 1
-"""Largest --seed; the same as ``percept.drive.batch.MAX_SEED`` (not imported from there: --help stays fast)."""
+"""Largest --seed; the same as ``percept.evaluate.batch.MAX_SEED`` (not imported from there: --help stays fast)."""
 _SLOT = ("{task} slot: vision (its perception module; the default) or privileged (ground truth, the baseline; "
          "--privileged sets every slot).")
 

@@ -48,8 +48,8 @@ def train_detector(
     its second (at the default --second-threshold).
     """
     from percept.detection import LinearModel
-    from percept.drive.batch import parse_seeds
-    from percept.drive.train_people import TrainPlan, frames_to_sample, train_people_model
+    from percept.evaluate.batch import parse_seeds
+    from percept.training.people import TrainPlan, frames_to_sample, train_people_model
 
     opt.check_number("--every", every, 1, 100)
     opt.check_number("--c", c, 1e-5, 10.0)

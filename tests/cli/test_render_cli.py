@@ -102,7 +102,7 @@ def test_the_bench_table_says_how_many_times_faster_or_slower():
     from rich.console import Console
 
     from percept.cli.bench_cmd import _stage_table, ratio_text
-    from percept.drive.bench import StageCost
+    from percept.bench.stages import StageCost
 
     assert ratio_text(2.314 / 92.568) == "0.025 (40.0x faster)"
     assert ratio_text(6.461 / 1.778) == "3.63 (3.6x slower)"
@@ -117,7 +117,7 @@ def test_the_bench_table_says_how_many_times_faster_or_slower():
 
 
 def test_a_stage_meets_its_targets_only_when_it_keeps_every_one():
-    from percept.drive.bench import StageCost
+    from percept.bench.stages import StageCost
 
     assert StageCost("pedestrians", "slot", 2.3, "peer", 92.6, target_speedup=40.0).met is True  # 40.3x
     assert StageCost("pedestrians", "slot", 3.7, "peer", 110.0, target_speedup=40.0).met is False  # 29.7x

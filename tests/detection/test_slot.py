@@ -246,7 +246,7 @@ def test_the_request_closes_at_the_ego_speed_whatever_the_tracks_own_x_speed():
 WARM_CHECK = """
 from percept.compiled import dispatchers
 from percept.detection import blocks, hog, pyramid, stereo_range
-from percept.drive import bench as B
+from percept.bench import stages as B
 from percept.drive.tasks import TASKS
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose

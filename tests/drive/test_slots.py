@@ -110,7 +110,7 @@ def test_privileged_metrics_are_pinned(scenario, seed, group, key, value):
 
 
 def test_the_bench_times_a_slot_from_reset_as_the_median_of_its_passes_each_on_fresh_frames():
-    from percept.drive.bench import SLOT_PASSES, slot_ms
+    from percept.bench.stages import SLOT_PASSES, slot_ms
     from percept.sensors import Frame, ImuSample
 
     class Slot:

@@ -147,7 +147,7 @@ def test_mismatched_inputs_raise_instead_of_reading_past_the_arrays():
 
 WARM_CHECK = """
 from percept.compiled import dispatchers
-from percept.drive import bench as B
+from percept.bench import stages as B
 from percept.drive.tasks import TASKS
 from percept.lanes import evidence
 from percept.longitudinal import contact, flow, ground, groups, lift, refine

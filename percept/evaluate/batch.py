@@ -1,10 +1,10 @@
 """Batch evaluation: the closed loop over scenarios x conditions x seeds, one run JSON each, and a summary
-(``summary.json``; ``summary.csv``, ``summary.md`` and ``plots/`` from ``percept.drive.report``).
+(``summary.json``; ``summary.csv``, ``summary.md`` and ``plots/`` from ``percept.evaluate.report``).
 
 Runs go to worker processes (``workers``, one OpenCV thread each) or to a Ray cluster. Each finished run is
 written at once (atomically) to ``OUT/runs/<scenario>-<condition>-<seed>.json``, so an interrupted batch keeps
 what it finished and the same batch again reuses it. A failed run is reported in the summary (not written: the
-next batch drives it again); the others go on. Resume never mixes settings (``percept.drive.resume``): each run
+next batch drives it again); the others go on. Resume never mixes settings (``percept.evaluate.resume``): each run
 file and the summary carry ``settings``; damaged run files are redone, runs made with other settings refused
 before any work unless ``redo``.
 """
@@ -28,9 +28,9 @@ from threadpoolctl import threadpool_limits
 from percept.outputs import write_json_atomic
 from percept.sims import WorldConfig
 
-from .config import DriveConfig
+from percept.drive.config import DriveConfig
 from .environment import environments, numeric_environment
-from .loop import run_drive
+from percept.drive.loop import run_drive
 from .resume import (COUNTS, GROUPS, RunFiles, differences, refuse_other_settings, run_path, run_settings,
                      scan_runs)
 
@@ -211,7 +211,7 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
             if progress:
                 progress(r)
     from .report import reproduce_command, unsafe_runs, write_reports
-    from .tasks import TASKS
+    from percept.drive.tasks import TASKS
 
     summary = {"settings": settings, **summarize(plan, results),
                "unsafe": [{"scenario": r["scenario"], "condition": r["condition"], "seed": r["seed"], "what": what,

@@ -10,8 +10,8 @@ from typer.testing import CliRunner
 
 from percept.cli import app
 from percept.drive import TASKS
-from percept.drive import batch as ev
-from percept.drive.report import (metric_rows, needless_stop_runs, reproduce_command, summary_csv, unsafe_runs,
+from percept.evaluate import batch as ev
+from percept.evaluate.report import (metric_rows, needless_stop_runs, reproduce_command, summary_csv, unsafe_runs,
                                   write_reports)
 
 runner = CliRunner()

@@ -21,7 +21,8 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from .bench import cycle, median_ms, people_detector_full_frame, sgbm_full_frame, topdown_ready
+from .peers import topdown_ready
+from .stages import cycle, median_ms
 
 VISION = {"lateral": "vision", "longitudinal": "vision", "pedestrians": "vision", "odometry": "vision"}
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
@@ -41,28 +42,6 @@ TARGETS = {"perception_total": f"perception total <= {PERCEPTION_BUDGET_MS:g} ms
            "stereo_pair": f"stereo pair <= {STEREO_PAIR_BUDGET_MS:g} ms",
            "realtime_recorded": f"every recorded drive >= {REALTIME_RECORDED:g}x real time"}
 """The stack's targets, as ``StackCost.met`` names them, as a person reads them."""
-
-
-def lane_fit_full_frame(frames: list) -> tuple[str, Callable]:
-    """The stock lane fit: grey, Gaussian blur, Canny, a trapezoid mask below the horizon, ``HoughLinesP``, and a
-    least-squares line through each side's segments (left: negative slope)."""
-    h, w = frames[0].left.shape[:2]
-    mask = np.zeros((h, w), np.uint8)
-    cv2.fillPoly(mask, [np.array([[0, h], [int(0.45 * w), int(0.55 * h)], [int(0.55 * w), int(0.55 * h)], [w, h]],
-                                 np.int32)], 255)
-
-    def run(frame) -> None:
-        edges = cv2.Canny(cv2.GaussianBlur(cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY), (5, 5), 0), 50, 150)
-        segs = cv2.HoughLinesP(edges & mask, 2, np.pi / 180, 20, minLineLength=20, maxLineGap=60)
-        if segs is None:
-            return
-        s = segs.reshape(-1, 4).astype(np.float64)
-        slope = (s[:, 3] - s[:, 1]) / np.maximum(np.abs(s[:, 2] - s[:, 0]), 1e-6) * np.sign(s[:, 2] - s[:, 0])
-        for side in (slope < -0.3, slope > 0.3):
-            if side.sum() >= 1:
-                # u = a v + b through both ends of the side's segments
-                np.polyfit(np.r_[s[side, 1], s[side, 3]], np.r_[s[side, 0], s[side, 2]], 1)
-    return "Canny + HoughLinesP + a line per side, full frame", run
 
 
 def middle(values, key=None):
@@ -139,8 +118,8 @@ def _drive(scenario: str, seconds: float, record: Path | None = None, progress: 
     ``each_frame(frame_index)`` is called after each step is recorded)."""
     from percept.sims import WorldConfig
 
-    from .config import DriveConfig
-    from .loop import run_drive
+    from percept.drive.config import DriveConfig
+    from percept.drive.loop import run_drive
 
     cfg = DriveConfig(WorldConfig(scenario, seed=0), duration_s=seconds, sources=VISION)
     tick = (lambda i, n: progress()) if progress else None

@@ -8,8 +8,8 @@ from typer.testing import CliRunner
 
 from percept.cli import app
 from percept.cli import options as opt
-from percept.drive import batch as ev
-from percept.drive import EvalPlan, Job, parse_seeds
+from percept.evaluate import batch as ev
+from percept.evaluate import EvalPlan, Job, parse_seeds
 
 runner = CliRunner()
 
@@ -185,7 +185,7 @@ def test_jobs_cover_the_plan():
 
 
 def test_the_people_model_is_a_setting_only_where_the_pedestrian_slot_sees():
-    from percept.drive.resume import run_settings
+    from percept.evaluate.resume import run_settings
 
     sim = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"})
     inria = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="inria")

@@ -9,8 +9,8 @@ from typing import Callable
 
 from percept.sims import WorldConfig, check_condition
 
-from .config import DriveConfig
-from .loop import run_drive
+from percept.drive.config import DriveConfig
+from percept.drive.loop import run_drive
 
 FrameFn = Callable[[int, object, object], None]
 """fn(seed, frame, ground_truth): called with each sampled ``Frame`` and its ``GroundTruth``."""

@@ -14,8 +14,10 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from .privileged import TruthFeed
-from .tasks import SlotContext, Task
+from percept.drive.privileged import TruthFeed
+from percept.drive.tasks import SlotContext, Task
+
+from .peers import topdown_ready
 
 
 @dataclass(frozen=True)
@@ -110,13 +112,6 @@ def cycle(items: list, progress: Callable[[], None] | None) -> Callable[[], obje
     return nxt
 
 
-def topdown_ready(world):
-    """``world`` with highway-env's own top-down ``render()`` set to the camera's size (the render's peer)."""
-    world.env.render_mode = "rgb_array"
-    world.env.config.update(screen_width=world.cfg.rig.camera.width, screen_height=world.cfg.rig.camera.height)
-    return world
-
-
 def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] | None = None) -> StageCost:
     """One stereo pair of the ``highway`` scenario vs highway-env's top-down render of the same world."""
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -175,26 +170,3 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
         peer_ms = median_ms(lambda: run(shot()[0]), frames)
     return StageCost(task.timing_key, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms, peer,
                      peer_ms, task.budget_ms, task.bench_speedup if peer is not None else None)
-
-
-def sgbm_full_frame(frames: list) -> tuple[str, Callable]:
-    """The stock way to range what is ahead: OpenCV's StereoSGBM over the whole grey frame (96 disparities, 5x5
-    blocks, the usual P1 = 8 c b^2, P2 = 32 c b^2 smoothness penalties)."""
-    from percept.longitudinal.dense import sample_sgbm
-
-    sgbm = sample_sgbm(96, 5)
-
-    def run(frame) -> None:
-        sgbm.compute(cv2.cvtColor(frame.left, cv2.COLOR_BGR2GRAY), cv2.cvtColor(frame.right, cv2.COLOR_BGR2GRAY))
-    return "OpenCV StereoSGBM, full frame", run
-
-
-def people_detector_full_frame(frames: list) -> tuple[str, Callable]:
-    """The stock way to find people: OpenCV's HOG ``detectMultiScale`` with its default (INRIA) people detector
-    over the whole frame (8-pixel stride, 8-pixel padding, scale step 1.05)."""
-    hog = cv2.HOGDescriptor()
-    hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
-
-    def run(frame) -> None:
-        hog.detectMultiScale(frame.left, winStride=(8, 8), padding=(8, 8), scale=1.05)
-    return "OpenCV HOG detectMultiScale (default people detector), full frame", run
