@@ -21,10 +21,12 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from percept.drive.tasks import TASKS
+from percept.sensors import Source
+
 from .peers import topdown_ready
 from .stages import cycle, median_ms
 
-VISION = {"lateral": "vision", "longitudinal": "vision", "pedestrians": "vision", "odometry": "vision"}
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
 PAIR_FRAMES = 60
 """Frames whose stereo pair is timed alone on each scenario (the median: a few seconds' slowdown of the machine
@@ -57,7 +59,7 @@ class StackCost:
     of the loop's frames, each rendered after the slots have had the caches); stereo_pair_ms: the median cost of one
     stereo pair alone (``SimWorld.observe``: the render and the ground truth) on the scenario's first
     ``PAIR_FRAMES`` autopilot frames [ms]; peers_ms: the stock way to do each job on the first of those frames
-    (people, stereo, lanes) and highway-env's top-down render [ms/frame]; realtime_factors,
+    (each task's ``bench_peer``, by task name) and highway-env's top-down render (``render``) [ms/frame]; realtime_factors,
     realtime_factors_recording: each drive's, without / with recording (the drives alternate, so that a change in
     the machine's speed falls on both). The median of several is the middle one (``middle``), for the timings as
     for the realtime factors."""
@@ -82,8 +84,8 @@ class StackCost:
 
     @property
     def stock_ms(self) -> float:
-        """The stock composition: people + stereo + lane fit [ms/frame]."""
-        return sum(self.peers_ms[k] for k in ("people", "stereo", "lanes"))
+        """The stock composition: the sum of the tasks' peers [ms/frame]."""
+        return sum(ms for k, ms in self.peers_ms.items() if k != "render")
 
     @property
     def speedup(self) -> float | None:
@@ -121,7 +123,8 @@ def _drive(scenario: str, seconds: float, record: Path | None = None, progress: 
     from percept.drive.config import DriveConfig
     from percept.drive.loop import run_drive
 
-    cfg = DriveConfig(WorldConfig(scenario, seed=0), duration_s=seconds, sources=VISION)
+    cfg = DriveConfig(WorldConfig(scenario, seed=0), duration_s=seconds,
+                      sources={t.name: Source.VISION for t in TASKS})
     tick = (lambda i, n: progress()) if progress else None
     if record is None:
         return run_drive(cfg, progress=tick)
@@ -186,10 +189,9 @@ def bench_stack(scenario: str, seconds: float = 10.0, peer_frames: int = 20, rep
     typical = middle(runs, key=lambda r: r["timing_ms"]["perception_total"] or 0.0)
     shots, pair_ms, top_ms = _peer_frames(scenario, peer_frames)
     peers, shot = {}, cycle(shots, None)
-    for key, make in (("people", people_detector_full_frame), ("stereo", sgbm_full_frame),
-                      ("lanes", lane_fit_full_frame)):
-        _, fn = make(shots)
-        peers[key] = median_ms(lambda: fn(shot()), len(shots))
+    for task in (t for t in TASKS if t.bench_peer is not None):
+        _, fn = task.bench_peer(shots)
+        peers[task.name] = median_ms(lambda: fn(shot()), len(shots))
     peers["render"] = top_ms
     return StackCost(scenario, typical["frames"], typical["timing_ms"], pair_ms, peers,
                      tuple(r["realtime_factor"] for r in runs), tuple(r["realtime_factor"] for r in recorded))

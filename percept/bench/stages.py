@@ -155,12 +155,12 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     feed = TruthFeed()
     lm = world.landmark_map()
     ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, start_pose=hw_pose(world.ego))
-    by_name = {t.name: t for t in tasks}
-    upstream = {u: by_name[u].privileged(ctx) for u in task.upstream}
+    providers = {t.provides: t for t in tasks}
+    upstream = {rec: providers[rec].privileged(ctx) for rec in task.reads}
     shots = []
     for _ in range(frames):
         frame, feed.truth = world.observe()
-        shots.append((frame, {u: s.step(frame, {})[0] for u, s in upstream.items()}))
+        shots.append((frame, {rec: s.step(frame, {})[0] for rec, s in upstream.items()}))
         world.step()
     ms = slot_ms(task.vision(ctx), shots, progress=progress)
     shot = cycle(shots, progress)
@@ -168,5 +168,5 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     if task.bench_peer is not None:
         peer, run = task.bench_peer([f for f, _ in shots])
         peer_ms = median_ms(lambda: run(shot()[0]), frames)
-    return StageCost(task.timing_key, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms, peer,
+    return StageCost(task.name, f"{task.name} vision slot, 640x480 ({task.bench_scenario})", ms, peer,
                      peer_ms, task.budget_ms, task.bench_speedup if peer is not None else None)

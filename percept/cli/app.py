@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import typer
 
+from . import options as opt
 from . import (bench_cmd, calibrate_cmd, detect_cmd, drive_cmd, eval_cmd, lanes_cmd, odometry_cmd, render_cmd,
                scenarios_cmd, stereo_cmd, train_cmd, view_cmd)
 from .common import Command, Group, console, err, fail, progress_bar, run_cli, write_json
@@ -12,9 +13,9 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, cls=Group,
                   help="percept: a camera-only driving stack on highway-env, with a simulated stereo camera.")
 
 app.command("scenarios", cls=Command)(scenarios_cmd.scenarios)
-app.command("drive", cls=Command)(drive_cmd.drive)
+app.command("drive", cls=Command)(opt.with_task_options(drive_cmd.drive))
 app.command("render", cls=Command)(render_cmd.render)
-app.command("eval", cls=Command)(eval_cmd.eval_)
+app.command("eval", cls=Command)(opt.with_task_options(eval_cmd.eval_))
 app.command("bench", cls=Command)(bench_cmd.bench)
 app.command("stereo", cls=Command)(stereo_cmd.stereo)
 app.command("odometry", cls=Command)(odometry_cmd.odometry)

@@ -19,11 +19,8 @@ def drive(
     seed: opt.Seed = 0,
     condition: opt.Condition = "clear",
     duration: opt.Duration = None,
-    lateral: opt.Lateral = None,
-    longitudinal: opt.Longitudinal = None,
-    pedestrians: opt.Pedestrians = None,
+    sources: dict = None,
     detector: opt.Detector = "sim",
-    odometry: opt.Odometry = None,
     privileged: opt.Privileged = False,
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
@@ -47,7 +44,7 @@ def drive(
     opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
-                          opt.slot_sources(lateral, longitudinal, pedestrians, odometry, privileged), detector=detector)
+                          opt.slot_sources(sources, privileged), detector=detector)
     except ValueError as e:
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
@@ -118,7 +115,7 @@ def summary_table(cfg, result: dict) -> Table:
     for k in ("collisions", "pedestrian_collisions", "lane_departures"):
         t.add_row("run", k.replace("_", " "), fmt(result[k], "{}"))
     for task in cfg.tasks:
-        group = result[task.group]
+        group = result[task.name]
         name = f"{task.name} ({cfg.source(task.name).value})"
         for h in task.headline:
             t.add_row(escape(name), escape(h.label), fmt(group.get(h.key), h.fmt))

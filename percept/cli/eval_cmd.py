@@ -28,11 +28,8 @@ def eval_(
     address: Annotated[Optional[str], typer.Option("--address", help="Ray cluster address (default: start a "
                                                                      "local Ray).")] = None,
     duration: opt.Duration = None,
-    lateral: opt.Lateral = None,
-    longitudinal: opt.Longitudinal = None,
-    pedestrians: opt.Pedestrians = None,
+    sources: dict = None,
     detector: opt.Detector = "sim",
-    odometry: opt.Odometry = None,
     privileged: opt.Privileged = False,
     json_path: opt.JsonOut = None,
     redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
@@ -55,7 +52,7 @@ def eval_(
     from percept.drive import TASKS
 
     plan, eng, files = _plan(scenario, condition, seeds, workers, engine, duration, detector, out, redo,
-                             opt.slot_sources(lateral, longitudinal, pedestrians, odometry, privileged))
+                             opt.slot_sources(sources, privileged))
     check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
     for path, why in files.damaged:
         err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
@@ -154,7 +151,7 @@ def summary_table(summary: dict, tasks) -> Table:
     """Per scenario and condition: runs, summed safety counts, and each task's headline metrics (mean over seeds)
     for the metrics some run has."""
     cols = [(t, h) for t in tasks for h in t.headline
-            if any((g[t.group].get(h.key) or None) is not None for g in summary["groups"])]
+            if any((g[t.name].get(h.key) or None) is not None for g in summary["groups"])]
     t = Table(title=f"{sum(len(g['seeds']) for g in summary['groups'])} runs; slots: "
                     + ", ".join(f"{k} {v}" for k, v in summary["settings"]["slots"].items()),
               box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True, caption="means over seeds")
@@ -163,7 +160,7 @@ def summary_table(summary: dict, tasks) -> Table:
     for _, h in cols:
         t.add_column(escape(h.label), justify="right")
     for g in summary["groups"]:
-        cells = [fmt((g[task.group].get(h.key) or {}).get("mean"), h.fmt.replace("{}", "{:.1f}"))
+        cells = [fmt((g[task.name].get(h.key) or {}).get("mean"), h.fmt.replace("{}", "{:.1f}"))
                  for task, h in cols]
         t.add_row(g["scenario"], g["condition"], str(len(g["seeds"])), fmt(g["collisions"], "{}"),
                   fmt(g["pedestrian_collisions"], "{}"), fmt(g["lane_departures"], "{}"), *cells)

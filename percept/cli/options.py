@@ -3,9 +3,11 @@ lists them)."""
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Callable, Optional
 
 import typer
 
@@ -14,8 +16,8 @@ from percept.sensors.records import Source
 
 MAX_SEED = 2**31 - 1
 """Largest --seed; the same as ``percept.evaluate.batch.MAX_SEED`` (not imported from there: --help stays fast)."""
-_SLOT = ("{task} slot: vision (its perception module; the default) or privileged (ground truth, the baseline; "
-         "--privileged sets every slot).")
+_SLOT = ("The {task} slot, {help}: vision (its perception module; the default) or privileged (ground truth, the "
+         "baseline; --privileged sets every slot).")
 
 Scenario = Annotated[str, typer.Option("--scenario", help="Scenario name (see `percept scenarios`).")]
 Seed = Annotated[int, typer.Option("--seed", help="Random seed (0 to 2^31-1); the same seed and options give the "
@@ -23,13 +25,8 @@ Seed = Annotated[int, typer.Option("--seed", help="Random seed (0 to 2^31-1); th
 Condition = Annotated[str, typer.Option("--condition", help="clear | night | rain | glare | noise | dropout.")]
 Duration = Annotated[Optional[float], typer.Option("--duration", help="Simulated seconds (default: the "
                                                                       "scenario's own).")]
-Lateral = Annotated[Optional[Source], typer.Option("--lateral", help=_SLOT.format(task="Lateral (lanes, steering)"))]
-Longitudinal = Annotated[Optional[Source], typer.Option("--longitudinal", help=_SLOT.format(
-    task="Longitudinal (lead range, following, braking)"))]
-Pedestrians = Annotated[Optional[Source], typer.Option("--pedestrians", help=_SLOT.format(task="Pedestrian"))]
 Detector = Annotated[str, typer.Option("--detector", help="People model of the vision pedestrian slot: sim "
                                        "(trained on rendered people), inria (OpenCV's) or a model file.")]
-Odometry = Annotated[Optional[Source], typer.Option("--odometry", help=_SLOT.format(task="Odometry"))]
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",
                                                  dir_okay=False)]
 
@@ -63,10 +60,33 @@ def _bound(x: float) -> str:
     return str(int(x)) if float(x).is_integer() and abs(x) < 1e16 else f"{x:g}"
 
 
-def slot_sources(lateral: Source | None, longitudinal: Source | None, pedestrians: Source | None,
-                 odometry: Source | None, privileged: bool = False) -> dict:
-    """The slot options as the ``sources`` of a DriveConfig: a slot not given is on vision, or on ground truth with
-    ``--privileged``."""
+def with_task_options(command: Callable) -> Callable:
+    """``command`` with one ``--NAME vision|privileged`` option per task of the slot table in place of its
+    ``sources`` parameter, which receives them as a dict (task name -> Source, or None where not given): the CLI
+    offers whatever tasks the table holds."""
+    from percept.drive.tasks import TASKS
+
+    sig = inspect.signature(command, eval_str=True)
+    task_params = [inspect.Parameter(t.name, inspect.Parameter.KEYWORD_ONLY, default=None,
+                                     annotation=Annotated[Optional[Source], typer.Option(
+                                         f"--{t.name}", help=_SLOT.format(task=t.name, help=t.help))])
+                   for t in TASKS]
+    params = []
+    for p in sig.parameters.values():
+        params += task_params if p.name == "sources" else [p.replace(kind=inspect.Parameter.KEYWORD_ONLY)]
+
+    @functools.wraps(command)
+    def run(**kwargs):
+        return command(sources={t.name: kwargs.pop(t.name) for t in TASKS}, **kwargs)
+
+    run.__signature__ = sig.replace(parameters=params)
+    run.__annotations__ = {p.name: p.annotation for p in params}
+    del run.__wrapped__  # typer reads the signature above, not the wrapped one's
+    return run
+
+
+def slot_sources(given: dict, privileged: bool = False) -> dict:
+    """The task options (task name -> Source or None) as the ``sources`` of a DriveConfig: a slot not given is on
+    vision, or on ground truth with ``--privileged``."""
     default = Source.PRIVILEGED if privileged else Source.VISION
-    given = {"lateral": lateral, "longitudinal": longitudinal, "pedestrians": pedestrians, "odometry": odometry}
     return {task: default if src is None else src for task, src in given.items()}

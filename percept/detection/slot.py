@@ -95,7 +95,7 @@ def window_of(person: tuple[float, float, float, float]) -> tuple[float, float, 
 
 
 class PedestrianSlot:
-    """``step(frame, upstream)`` -> (BrakingRequest or None, PedestrianDebug); upstream["lateral"]: the ego path."""
+    """``step(frame, upstream)`` -> (BrakingRequest or None, PedestrianDebug); upstream[EgoPath]: the ego path."""
 
     def __init__(self, rig: StereoRig, dt_s: float, model: LinearModel | None = None,
                  search: SearchConfig = SearchConfig(), tracking: TrackConfig = TrackConfig(), sweep_frames: int = 8,
@@ -129,7 +129,7 @@ class PedestrianSlot:
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
         motion = self.motion.update(frame)
         speed, yaw_rate = motion.speed_mps, motion.yaw_rate_rps
-        path = upstream.get("lateral") or EgoPath.straight(speed)
+        path = upstream.get(EgoPath) or EgoPath.straight(speed)
         predicted = self.tracker.predict(speed, yaw_rate)
         if frame.left is None:
             tracks = self.tracker.update([], [], seen=False)

@@ -6,9 +6,9 @@ import time
 from dataclasses import dataclass
 
 from percept.control import EmergencyBraking, Following, LaneKeeping, nearest_target
-from percept.sensors import Frame, Source
+from percept.sensors import BrakingRequest, EgoPath, Frame, Lead, PoseEstimate, Source
 
-from .tasks import SlotContext, Task, task_order
+from .tasks import SlotContext, Task, task_order, upstream_of
 
 
 @dataclass(frozen=True)
@@ -26,12 +26,17 @@ class AgentStep:
 
 
 class Agent:
-    """Slots from the table (vision or privileged per task), and the shared laws: lane keeping on the lateral
-    task's ego path; following and emergency braking on the longitudinal lead and the pedestrians' braking
-    request, at the odometry task's speed."""
+    """Slots from the table (vision or privileged per task), and the shared laws, each fed by the record that plays
+    its role, whichever task provides it: lane keeping on the ego path (``EgoPath``); following and emergency
+    braking on the lead (``Lead``) and the braking request (``BrakingRequest``), at the speed of the pose estimate
+    (``PoseEstimate``). ValueError when no task provides the ego path or the pose."""
 
     def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float):
         self.order = task_order(tasks)
+        provided = {t.provides for t in self.order}
+        for role in (EgoPath, PoseEstimate):
+            if role not in provided:
+                raise ValueError(f"no task provides {role.__name__}, which the control laws need")
         self.slots = {t.name: (t.vision if sources[t.name] is Source.VISION else t.privileged)(ctx)
                       for t in self.order}
         self.dt_s = ctx.dt_s
@@ -46,17 +51,17 @@ class Agent:
             law.reset()
 
     def step(self, frame: Frame) -> AgentStep:
-        estimates, debug, timing = {}, {}, {}
+        estimates, debug, timing, by_record = {}, {}, {}, {}
         for task in self.order:
-            upstream = {u: estimates[u] for u in task.upstream}
             t0 = time.perf_counter()
-            estimates[task.name], debug[task.name] = self.slots[task.name].step(frame, upstream)
+            estimates[task.name], debug[task.name] = self.slots[task.name].step(frame, upstream_of(task, by_record))
             timing[task.name] = (time.perf_counter() - t0) * 1e3
-        steer, keeping = self.keeping.update(estimates["lateral"])
-        speed = estimates["odometry"].speed_mps
-        target = nearest_target(estimates["longitudinal"], estimates["pedestrians"])
+            by_record[task.provides] = estimates[task.name]
+        steer, keeping = self.keeping.update(by_record[EgoPath])
+        speed = by_record[PoseEstimate].speed_mps
+        request = by_record.get(BrakingRequest)
+        target = nearest_target(by_record.get(Lead), request)
         follow, following = self.following.update(target, speed)
-        request = estimates["pedestrians"]
         accel, braking = self.braking.update(target, speed, follow, self.dt_s,
                                              withdrawn=request is not None and request.withdrawn)
         return AgentStep(accel, steer, estimates, debug, timing,

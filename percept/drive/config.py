@@ -54,6 +54,11 @@ class DriveConfig:
         return self.sources[task]
 
     @property
+    def uses_detector(self) -> bool:
+        """Whether a vision slot reads the people model (``detector``), so that it changes the results."""
+        return any("detector" in t.slot_options and self.sources[t.name] is Source.VISION for t in self.tasks)
+
+    @property
     def needs_cameras(self) -> bool:
         """Whether any slot reads the camera images (every vision slot does)."""
         return any(s is Source.VISION for s in self.sources.values())

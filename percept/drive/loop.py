@@ -34,7 +34,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     rig = world.cfg.rig
     scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
                                              world.crossing_pedestrians, agent.following.time_gap,
-                                             rig.camera.fx * rig.baseline_m))
+                                             rig.camera.fx * rig.baseline_m, cfg.detector))
                for t in cfg.tasks}
     safety = SafetyScorer()
     recorder = recorder_factory(world) if recorder_factory else None
@@ -65,16 +65,14 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     result = {"scenario": cfg.world.scenario, "condition": cfg.world.condition.value, "seed": cfg.world.seed,
               "duration_s": round(sim_s, 4), "frames": frames, "realtime_factor": sim_s / wall if wall > 0 else None,
               "slots": {name: src.value for name, src in cfg.sources.items()}, **safety.result()}
-    result.update({t.group: scorers[t.name].result() for t in cfg.tasks})
-    if cfg.source("pedestrians") is Source.VISION:
-        result["pedestrians"]["detector"] = cfg.detector
+    result.update({t.name: scorers[t.name].result() for t in cfg.tasks})
     result["timing_ms"] = timing_json(cfg, slot_ms, render_ms if render else None, frames)
     return result
 
 
 def timing_json(cfg: DriveConfig, slot_ms: dict, render_ms: float | None, frames: int) -> dict:
     """Per-frame cost [ms] of rendering and of each vision slot (None for privileged ones), and their sum."""
-    per = {t.timing_key: slot_ms[t.name] / max(frames, 1) if cfg.source(t.name) is Source.VISION else None
+    per = {t.name: slot_ms[t.name] / max(frames, 1) if cfg.source(t.name) is Source.VISION else None
            for t in cfg.tasks}
     vision = [v for v in per.values() if v is not None]
     return {"render": None if render_ms is None else render_ms / max(frames, 1), **per,

@@ -122,7 +122,7 @@ class TruthSlot:
         """Nothing to forget."""
 
 
-class PrivilegedLateral(TruthSlot):
+class PrivilegedLanes(TruthSlot):
     """The true lane as the ego path, at the true speed."""
 
     def step(self, frame: Frame, upstream: dict) -> tuple[EgoPath, None]:

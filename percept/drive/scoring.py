@@ -40,13 +40,14 @@ class ScoreContext:
     """vision: the task's slot is a vision one (its estimates are scored); pedestrians, crossing_pedestrians: how
     many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting;
     stereo_fb_px_m: the rig's focal length times its baseline [px m] (one disparity pixel is Z^2 / (f b) of range
-    at range Z), or None without a stereo rig."""
+    at range Z), or None without a stereo rig; detector: the people model of the vision pedestrian slot."""
 
     vision: bool
     pedestrians: int
     crossing_pedestrians: int
     time_gap_setting_s: float
     stereo_fb_px_m: float | None = None
+    detector: str = "sim"
 
 
 @dataclass(frozen=True)
@@ -268,13 +269,15 @@ class PedestrianScorer:
     def result(self) -> dict:
         stops = [bool(self.crossing_stopped.get(k, False)) for k in sorted(self.crossing_seen)]
         det = self.tally.result() if self.tally is not None else {}
-        return {"recall": det.get("recall"), "precision": det.get("precision"), "fppi": det.get("fppi"),
-                "recall_by_height": det.get("recall_by_height"),
-                # the counts behind the rates, so that a batch can pool its runs' frames
-                "counts": {k: det[k] for k in ("tp", "fp", "fn", "frames")} | {"by_height": det["matched_by_height"]}
-                if det else None,
-                "first_detection_range_m": det.get("first_detection_range_m"),
-                "stops": stops if self.ctx.crossing_pedestrians else None,
-                "false_stops": self.false_stops,
-                "verge_brakes": self.verge_brakes if self.ctx.pedestrians else None,
-                "brakes_for_no_one": self.brakes_for_no_one}
+        out = {"recall": det.get("recall"), "precision": det.get("precision"), "fppi": det.get("fppi"),
+               "recall_by_height": det.get("recall_by_height"),
+               # the counts behind the rates, so that a batch can pool its runs' frames
+               "counts": {k: det[k] for k in ("tp", "fp", "fn", "frames")} | {"by_height": det["matched_by_height"]}
+               if det else None,
+               "first_detection_range_m": det.get("first_detection_range_m"),
+               "stops": stops if self.ctx.crossing_pedestrians else None,
+               "false_stops": self.false_stops,
+               "verge_brakes": self.verge_brakes if self.ctx.pedestrians else None,
+               "brakes_for_no_one": self.brakes_for_no_one}
+        # the people model, where a vision slot used one
+        return out | ({"detector": self.ctx.detector} if self.ctx.vision else {})

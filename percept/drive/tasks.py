@@ -1,22 +1,40 @@
-"""The slot table: one entry per driving task. The loop, scoring, recording, the CLI and the benchmark read it;
-adding a task is a package (its vision slot) plus one entry here.
+"""The slot table: one entry per driving task. The loop, the agent, scoring, recording, the CLI's per-task options,
+evaluation's resume keys and reports and the benchmark all read it; adding a task is a package (its vision slot) plus
+one entry here.
 
-A slot is anything with ``reset()`` and ``step(frame, upstream) -> (estimate, debug)``; ``upstream`` holds the
-estimates of the tasks named in the entry's ``upstream``. Perception packages implement it structurally and never
-import ``drive``.
+A task has one name wherever a user meets it: its CLI option (``--lanes vision``), its JSON group, its
+``timing_ms`` key, its recording part and its ``percept bench`` stage. Task names appear as string literals only in
+this module. A slot is anything with ``reset()`` and ``step(frame, upstream) -> (estimate, debug)``; ``upstream``
+maps each record type the entry ``reads`` to the estimate of the task that ``provides`` it, so a slot asks for
+``upstream[EgoPath]`` and never for another task by name, and the agent finds what steers, what brakes and what
+measures speed by the record each task provides (docs/design.md, "Agent and slots").
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from importlib import import_module
+from typing import TYPE_CHECKING, Callable, Protocol
 
-from percept.sensors import Frame, LandmarkMap, Pose2D, StereoRig
+from percept.sensors.poses import Pose2D
+from percept.sensors.records import BrakingRequest, EgoPath, LandmarkMap, Lead, PoseEstimate
 
-from . import privileged as priv
-from .privileged import TruthFeed
-from .odometry_scoring import OdometryScorer
-from .scoring import LaneScorer, LongitudinalScorer, PedestrianScorer, ScoreContext
+if TYPE_CHECKING:
+    from percept.sensors import Frame, StereoRig
+
+    from .privileged import TruthFeed
+    from .scoring import ScoreContext
+
+
+def lazy(ref: str) -> Callable:
+    """A callable that imports ``"module:attribute"`` when first called and calls it: the table names its slots and
+    scorers without importing them, so that reading it (``--help`` does) stays cheap."""
+    module, attr = ref.split(":")
+
+    def call(*args, **kwargs):
+        return getattr(import_module(module), attr)(*args, **kwargs)
+    call.__qualname__ = call.__name__ = attr
+    return call
 
 
 class Slot(Protocol):
@@ -27,51 +45,43 @@ class Slot(Protocol):
 
 @dataclass(frozen=True)
 class SlotContext:
-    """What a slot factory may use: the rig, the frame period [s], the landmark map (None without signs), the
-    people model of the vision pedestrian slot ('sim', 'inria' or a file), the known start pose (where odometry
-    starts; None = the origin); truth is for privileged slots only."""
+    """What a slot factory may use; truth is for privileged slots only."""
 
-    rig: StereoRig
-    dt_s: float
-    landmarks: LandmarkMap | None
-    truth: TruthFeed
-    detector: str = "sim"
-    start_pose: Pose2D | None = None
+    rig: StereoRig  # the forward stereo rig
+    dt_s: float  # frame period [s]
+    landmarks: LandmarkMap | None  # the mapped landmarks (None: a road without signs)
+    truth: "TruthFeed"  # this frame's ground truth, for privileged slots
+    detector: str = "sim"  # people model of the vision pedestrian slot: "sim", "inria" or a model file
+    start_pose: Pose2D | None = None  # the known start pose, where odometry starts (None: the origin)
 
 
 @dataclass(frozen=True)
 class Headline:
-    """One metric the drive and eval tables show: a label with units, its key in the task's JSON group, a format."""
+    """One metric the drive and eval tables show."""
 
-    label: str
-    key: str
-    fmt: str = "{:.3f}"
+    label: str  # what the tables print, with units
+    key: str  # its key in the task's JSON group
+    fmt: str = "{:.3f}"  # how the tables format it
 
 
 @dataclass(frozen=True)
 class Task:
-    """name: the CLI flag (--name) and the key of ``slots``; group: its JSON group; timing_key: its key in
-    ``timing_ms`` and in ``percept bench``; privileged / vision: slot factories (vision None = not built yet);
-    scorer: ScoreContext -> scorer; recorder: "module:function" of its part in ``percept.review`` (None = none);
-    upstream: tasks whose estimates it reads; headline: metrics the tables show; help: one line for --help;
-    bench_scenario: where ``percept bench`` times its vision slot; budget_ms: its per-frame budget [ms];
-    bench_peer: frames -> (name, run(frame)), the stock way to do the same job, timed in the same run;
-    bench_speedup: how many times faster than that peer the slot must be."""
+    """One driving task: its name, where its estimate comes from, how it is scored, recorded and benchmarked."""
 
-    name: str
-    group: str
-    timing_key: str
-    privileged: Callable[[SlotContext], Slot]
-    scorer: Callable[[ScoreContext], object]
-    vision: Callable[[SlotContext], Slot] | None = None
-    recorder: str | Callable | None = None
-    upstream: tuple[str, ...] = ()
-    headline: tuple[Headline, ...] = ()
-    help: str = ""
-    bench_scenario: str = "highway"
-    budget_ms: float | None = None
-    bench_peer: Callable | None = None
-    bench_speedup: float | None = None
+    name: str  # the one name: --NAME, the JSON group, the timing_ms key, the recording part, the bench stage
+    provides: type  # the record its slots return (or None in its place); the agent and readers find it by this type
+    privileged: Callable[[SlotContext], Slot]  # the slot on ground truth, the baseline
+    scorer: Callable[[ScoreContext], object]  # ScoreContext -> scorer with update(...) and result() -> JSON group
+    vision: Callable[[SlotContext], Slot] | None = None  # the slot on the cameras (None: not built yet)
+    recorder: str | Callable | None = None  # "module:attribute" of its recording part in percept.review (None: none)
+    reads: tuple[type, ...] = ()  # record types of other tasks its slot reads, as upstream[type]
+    headline: tuple[Headline, ...] = ()  # metrics the drive and eval tables show
+    help: str = ""  # what it computes, one line for --help
+    bench_scenario: str = "highway"  # where percept bench times its vision slot
+    budget_ms: float | None = None  # its per-frame budget in percept bench [ms] (None: none of its own)
+    bench_peer: Callable | None = None  # frames -> (name, run(frame)): the stock way to do its job, timed beside it
+    bench_speedup: float | None = None  # how many times faster than that peer the slot must be (None: no target)
+    slot_options: tuple[str, ...] = ()  # DriveConfig fields its vision slot reads (they change its results)
 
 
 def _longitudinal_slot(ctx: SlotContext) -> Slot:
@@ -80,22 +90,10 @@ def _longitudinal_slot(ctx: SlotContext) -> Slot:
     return LongitudinalSlot(ctx.rig, ctx.dt_s)
 
 
-def _sgbm_peer(frames: list):
-    from .bench import sgbm_full_frame
-
-    return sgbm_full_frame(frames)
-
-
 def _pedestrian_slot(ctx: SlotContext) -> Slot:
     from percept.detection import LinearModel, PedestrianSlot
 
     return PedestrianSlot(ctx.rig, ctx.dt_s, LinearModel.named(ctx.detector))
-
-
-def _people_peer(frames: list):
-    from .bench import people_detector_full_frame
-
-    return people_detector_full_frame(frames)
 
 
 def _odometry_slot(ctx: SlotContext) -> Slot:
@@ -111,31 +109,36 @@ def _lane_slot(ctx: SlotContext) -> Slot:
 
 
 TASKS: tuple[Task, ...] = (
-    Task("lateral", "lane", "lanes", priv.PrivilegedLateral, LaneScorer, vision=_lane_slot,
-         recorder="percept.review.parts:lateral",
+    Task("lanes", EgoPath, lazy("percept.drive.privileged:PrivilegedLanes"),
+         lazy("percept.drive.scoring:LaneScorer"), vision=_lane_slot,
+         recorder="percept.review.parts:lanes",
          headline=(Headline("lane offset RMSE [m]", "offset_rmse_m", "{:.4f}"),
                    Headline("lane heading RMSE [rad]", "heading_rmse_rad", "{:.4f}"),
                    Headline("lane curvature RMSE [1/m]", "curvature_rmse_1pm", "{:.5f}"),
                    Headline("centering RMS [m]", "centering_rms_m"), Headline("centering max [m]", "centering_max_m")),
-         help="lane markings -> the ego path (steering)", bench_scenario="curves", budget_ms=3.0),
-    Task("longitudinal", "longitudinal", "longitudinal", priv.PrivilegedLongitudinal,
-         LongitudinalScorer, vision=_longitudinal_slot, recorder="percept.review.parts:longitudinal",
-         upstream=("lateral",),
+         help="lane markings -> the ego path (steering)", bench_scenario="curves", budget_ms=3.0,
+         bench_peer=lazy("percept.bench.peers:lane_fit_full_frame")),
+    Task("longitudinal", Lead, lazy("percept.drive.privileged:PrivilegedLongitudinal"),
+         lazy("percept.drive.scoring:LongitudinalScorer"), vision=_longitudinal_slot,
+         recorder="percept.review.parts:longitudinal", reads=(EgoPath,),
          headline=(Headline("range error (median)", "range_abs_rel_err", "{:.3f}"),
                    Headline("time gap mean [s]", "time_gap_mean_s", "{:.2f}"),
                    Headline("time gap min [s]", "time_gap_min_s", "{:.2f}"),
                    Headline("phantom brakes", "phantom_brakes", "{}")),
-         help="the lead ahead (following, emergency braking)", budget_ms=3.0, bench_peer=_sgbm_peer,
-         bench_speedup=15.0),
-    Task("pedestrians", "pedestrians", "pedestrians", priv.PrivilegedPedestrians,
-         PedestrianScorer, vision=_pedestrian_slot, recorder="percept.review.parts:pedestrians", upstream=("lateral",),
+         help="the lead ahead (following, emergency braking)", budget_ms=3.0,
+         bench_peer=lazy("percept.bench.peers:sgbm_full_frame"), bench_speedup=15.0),
+    Task("pedestrians", BrakingRequest, lazy("percept.drive.privileged:PrivilegedPedestrians"),
+         lazy("percept.drive.scoring:PedestrianScorer"), vision=_pedestrian_slot,
+         recorder="percept.review.parts:pedestrians", reads=(EgoPath,),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}"),
                    Headline("verge brakes", "verge_brakes", "{}"),
                    Headline("brakes for no one", "brakes_for_no_one", "{}")),
          help="people in or stepping into the path (braking requests)", bench_scenario="crossing",
-         bench_peer=_people_peer, bench_speedup=40.0),
-    Task("odometry", "odometry", "odometry", priv.PrivilegedOdometry, OdometryScorer, vision=_odometry_slot,
-         recorder="percept.review.parts:odometry", upstream=("longitudinal",),
+         bench_peer=lazy("percept.bench.peers:people_detector_full_frame"), bench_speedup=40.0,
+         slot_options=("detector",)),
+    Task("odometry", PoseEstimate, lazy("percept.drive.privileged:PrivilegedOdometry"),
+         lazy("percept.drive.odometry_scoring:OdometryScorer"), vision=_odometry_slot,
+         recorder="percept.review.parts:odometry", reads=(Lead,),
          headline=(Headline("drift VO [%]", "drift_pct_vo", "{:.2f}"),
                    Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),
                    Headline("ATE with landmarks [m]", "ate_rmse_landmarks_m", "{:.2f}"),
@@ -145,18 +148,31 @@ TASKS: tuple[Task, ...] = (
 
 
 def task_order(tasks: tuple[Task, ...]) -> list[Task]:
-    """The tasks in dependency order (upstream first, otherwise as listed); ValueError on a cycle or unknown name."""
-    names = {t.name for t in tasks}
+    """The tasks in dependency order (a task after those providing what it reads, otherwise as listed); ValueError
+    on a repeated name or record, a record no task provides, or a cycle."""
+    providers = {}
     for t in tasks:
-        for u in t.upstream:
-            if u not in names:
-                raise ValueError(f"task {t.name} reads unknown task {u}")
+        if t.name in {p.name for p in providers.values()}:
+            raise ValueError(f"two tasks are named {t.name}")
+        if t.provides in providers:
+            raise ValueError(f"tasks {providers[t.provides].name} and {t.name} both provide {t.provides.__name__}")
+        providers[t.provides] = t
+    for t in tasks:
+        for rec in t.reads:
+            if rec not in providers:
+                raise ValueError(f"task {t.name} reads {rec.__name__}, which no task provides")
     done: list[Task] = []
     pending = list(tasks)
     while pending:
-        ready = [t for t in pending if all(u in {d.name for d in done} for u in t.upstream)]
+        ready = [t for t in pending if all(providers[r] in done for r in t.reads)]
         if not ready:
             raise ValueError(f"the tasks {[t.name for t in pending]} depend on each other in a cycle")
         done.append(ready[0])
         pending.remove(ready[0])
     return done
+
+
+def upstream_of(task: Task, estimates: dict) -> dict:
+    """What ``task``'s slot reads: each record type in ``task.reads`` -> its estimate, from ``estimates`` (record
+    type -> this frame's estimate of the task that provides it)."""
+    return {rec: estimates[rec] for rec in task.reads}

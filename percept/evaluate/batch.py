@@ -31,7 +31,7 @@ from percept.sims import WorldConfig
 from percept.drive.config import DriveConfig
 from .environment import environments, numeric_environment
 from percept.drive.loop import run_drive
-from .resume import (COUNTS, GROUPS, RunFiles, differences, refuse_other_settings, run_path, run_settings,
+from .resume import (COUNTS, groups, RunFiles, differences, refuse_other_settings, run_path, run_settings,
                      scan_runs)
 
 __all__ = ["MAX_SEED", "MAX_SEEDS", "Engine", "EvalPlan", "Job", "RunFiles", "differences", "evaluate",
@@ -241,7 +241,7 @@ def summarize(plan: EvalPlan, results: list[dict]) -> dict:
                  "failed": [{"seed": r["seed"], "error": r["error"]} for r in rs if "error" in r]}
             for k in COUNTS:
                 g[k] = int(sum(r[k] for r in ok)) if ok else None
-            for grp in GROUPS:
+            for grp in groups():
                 keys = sorted({k for r in ok for k in r.get(grp, {})})
                 g[grp] = {k: _stats([r[grp].get(k) for r in ok]) for k in keys}
             g["realtime_factor"] = _stats([r.get("realtime_factor") for r in ok])

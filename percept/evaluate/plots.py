@@ -122,7 +122,7 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
     metrics = {(sc, c): [run_metrics(r) for r in _runs(results, sc, c)] for sc, c in cells}
     for t in tasks:
         for h in t.headline:
-            key = f"{t.group}.{h.key}"
+            key = f"{t.name}.{h.key}"
             groups = [(f"{sc} / {c}", [m[key] for m in metrics[(sc, c)] if key in m]) for sc, c in cells]
             groups = [g for g in groups if g[1]]
             if groups:

@@ -17,7 +17,7 @@ import numpy as np
 from percept.outputs import write_text_atomic
 
 from .environment import environments
-from .resume import COUNTS, GROUPS
+from .resume import COUNTS, groups
 
 HIGHER_IS_BETTER = frozenset({
     "realtime_factor", "pedestrians.recall", "pedestrians.precision", "pedestrians.first_detection_range_m",
@@ -41,7 +41,7 @@ def run_metrics(run: dict) -> dict[str, float]:
     out["missed_stops"] = float(sum(1 for s in stops if not s)) if stops else 0.0
     for k in NEEDLESS:
         out[k] = float(run.get("pedestrians", {}).get(k) or 0)
-    for g in GROUPS:
+    for g in groups():
         for k, v in (run.get(g) or {}).items():
             if isinstance(v, (int, float)) and not isinstance(v, bool):
                 out[f"{g}.{k}"] = float(v)
@@ -160,7 +160,7 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
             cells = [_fmt((rows.get((sc, c, k)) or {}).get("total"), "{:.0f}") for k in SAFETY]
             lines.append(f"| {sc} | {c} | {n} | {failed} | " + " | ".join(cells) + " |")
     lines += ["", "## Headline metrics (mean / p95 / worst over the seeds)", ""]
-    heads = [(f"{t.group}.{h.key}", f"{t.name}: {h.label}") for t in tasks for h in t.headline]
+    heads = [(f"{t.name}.{h.key}", f"{t.name}: {h.label}") for t in tasks for h in t.headline]
     heads = [(k, label) for k, label in heads if any(key[2] == k for key in rows)]
     if heads:
         lines += ["| scenario | condition | " + " | ".join(label for _, label in heads) + " |",

@@ -20,8 +20,11 @@ if TYPE_CHECKING:
 
 COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
 """Safety counts every run JSON has (integers)."""
-GROUPS = ("lane", "longitudinal", "pedestrians", "odometry", "timing_ms")
-"""Metric groups every run JSON has (objects)."""
+def groups() -> tuple[str, ...]:
+    """Metric groups every run JSON has (objects): one per task of the slot table, and ``timing_ms``."""
+    from percept.drive.tasks import TASKS
+
+    return tuple(t.name for t in TASKS) + ("timing_ms",)
 
 
 def run_settings(plan: EvalPlan) -> dict:
@@ -32,13 +35,13 @@ def run_settings(plan: EvalPlan) -> dict:
     cfg = plan.config(plan.jobs[0])
     return {"percept": version("percept"), "duration_s": plan.duration_s,
             "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
-            "detector": cfg.detector if cfg.source("pedestrians") is Source.VISION else None,
+            "detector": cfg.detector if cfg.uses_detector else None,
             "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
                       "autopilot": cfg.world.autopilot}}
 
 
 def differences(now: dict, then) -> list[str]:
-    """How the settings ``then`` of a stored run differ from ``now``: 'slots lateral=vision (now privileged)'."""
+    """How the settings ``then`` of a stored run differ from ``now``: 'slots lanes=vision (now privileged)'."""
     if not isinstance(then, dict):
         return ["no settings recorded (made by an older percept)"]
     diff = []
@@ -70,7 +73,7 @@ def _not_a_run(data) -> str | None:
     """Why ``data`` is not a finished percept run (a key missing or of the wrong type), or None."""
     if not isinstance(data, dict) or "error" in data or not isinstance(data.get("frames"), int):
         return "not a percept run"
-    bad = [k for k in COUNTS if not isinstance(data.get(k), int)] + [g for g in GROUPS
+    bad = [k for k in COUNTS if not isinstance(data.get(k), int)] + [g for g in groups()
                                                                     if not isinstance(data.get(g), dict)]
     return f"not a percept run (no valid {', '.join(bad)})" if bad else None
 

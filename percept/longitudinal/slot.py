@@ -86,7 +86,7 @@ class LeadDebug:
 
 class LongitudinalSlot:
     """Slot interface: ``reset()``, ``step(frame, upstream) -> (Lead | None, LeadDebug)``; reads the ego path
-    (``upstream["lateral"]``, a straight corridor without it)."""
+    (``upstream[EgoPath]``, a straight corridor without it)."""
 
     def __init__(self, rig: StereoRig, dt_s: float, cfg: LeadConfig = LeadConfig()):
         self.rig, self.dt, self.cfg = rig, dt_s, cfg
@@ -113,7 +113,7 @@ class LongitudinalSlot:
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
         motion = self.motion.update(frame)
-        path = upstream.get("lateral") or EgoPath.straight(motion.speed_mps)
+        path = upstream.get(EgoPath) or EgoPath.straight(motion.speed_mps)
         # nothing in the path comes towards the ego faster than it drives: range rate >= -(v_ego + reverse_mps)
         self._rate_floor_mps = -(motion.speed_mps + self.cfg.reverse_mps) if motion.speed_ok else -np.inf
         self._predict()

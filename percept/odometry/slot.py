@@ -12,8 +12,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from percept.sensors import (Frame, LandmarkMap, Pose2D, PoseEstimate, Side, StereoRig, as_sample, plausible_speed,
-                             plausible_yaw_rate)
+from percept.sensors import (Frame, LandmarkMap, Lead, Pose2D, PoseEstimate, Side, StereoRig, as_sample,
+                             plausible_speed, plausible_yaw_rate)
 
 from .fusion import FusionNoise, PoseFilter
 from .landmarks import LandmarkFinder, LandmarkSighting
@@ -121,7 +121,7 @@ class OdometrySlot:
         """VO on this frame's pair guided by ``prior`` (``_prior``; the lead's box, from the longitudinal slot, left
         out: it moves); the VO-only chain takes every step, the filters the pose against the last keyframe when the
         keyframe changes (one independent measurement per keyframe span)."""
-        lead = upstream.get("longitudinal")
+        lead = upstream.get(Lead)
         step = self.vo.process(left, frame.right_gray_or_bgr(), prior, [getattr(lead, "box_px", None)])
         if left is None or frame.right is None:
             self._since_image += 1

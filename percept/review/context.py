@@ -40,7 +40,7 @@ class RecordOptions:
     """camera_hz: how often the left image (and what the parts draw on it) is stored [Hz]; the frame rate or more
     stores every frame; jpeg_quality: JPEG quality of the stored image, 1..100; image_scale: stored image size
     relative to the camera's, 0.1..1 (0.5 = half width and height). Validated on construction (ValueError naming
-    the bad value). The defaults keep a highway run with the vision lateral slot near 7 MB per simulated minute
+    the bad value). The defaults keep a highway run with the vision lanes slot near 7 MB per simulated minute
     (every frame at full size and quality 70: about 26 MB)."""
 
     camera_hz: float = 5.0

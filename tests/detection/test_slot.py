@@ -44,16 +44,16 @@ def test_dropped_and_black_frames_and_nan_wheel_speed_or_yaw_rate_degrade_gracef
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(10.0)
     black = np.zeros((480, 640, 3), np.uint8)
-    request, debug = slot.step(frame(0, black), {"lateral": path})
+    request, debug = slot.step(frame(0, black), {EgoPath: path})
     assert request is None and debug.detections == () and debug.stats.windows > 0
-    request, debug = slot.step(frame(1, None), {"lateral": path})  # dropped: nothing searched
+    request, debug = slot.step(frame(1, None), {EgoPath: path})  # dropped: nothing searched
     assert request is None and debug.stats is None and debug.levels == ()
     request, debug = slot.step(frame(2, black, speed=math.nan), {})  # no path: a straight corridor
     assert request is None and slot.motion.last.speed_mps == 10.0  # the last good wheel speed is kept
     turning = Frame(3, 3 / 15, black, black, ImuSample(np.zeros(3), np.array([0.0, 0.0, 0.1])), 10.0)
-    slot.step(turning, {"lateral": path})
+    slot.step(turning, {EgoPath: path})
     broken = Frame(4, 4 / 15, black, black, ImuSample(np.zeros(3), np.array([0.0, 0.0, np.nan])), 10.0)
-    request, _ = slot.step(broken, {"lateral": path})
+    request, _ = slot.step(broken, {EgoPath: path})
     assert request is None and slot.motion.last.yaw_rate_rps == 0.1  # and the last good yaw rate
     with pytest.raises(ValueError, match="sweep_frames"):
         PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=0)
@@ -66,7 +66,7 @@ def test_the_far_fields_levels_are_searched_more_often_than_the_near_ones():
     the others in sweep_frames."""
     slot = PedestrianSlot(StereoRig(), 1 / 15, sweep_frames=6, far_sweep_frames=3, far_person_px=50.0)
     black = np.zeros((480, 640, 3), np.uint8)
-    seen = [slot.step(frame(i, black), {"lateral": EgoPath.straight(10.0)})[1].levels for i in range(12)]
+    seen = [slot.step(frame(i, black), {EgoPath: EgoPath.straight(10.0)})[1].levels for i in range(12)]
     heights = 96 * slot.search.scales
     for k, h in enumerate(heights):
         frames = [i for i, levels in enumerate(seen) if k in levels]
@@ -248,6 +248,7 @@ from percept.compiled import dispatchers
 from percept.detection import blocks, hog, pyramid, stereo_range
 from percept.bench import stages as B
 from percept.drive.tasks import TASKS
+from percept.sensors import EgoPath
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose
 kernels = dispatchers(blocks, hog, pyramid, stereo_range)
@@ -255,12 +256,12 @@ world = SimWorld(WorldConfig("crossing", seed=1, autopilot=True))
 feed = B.TruthFeed()
 ctx = B.SlotContext(world.cfg.rig, world.dt, None, feed, start_pose=hw_pose(world.ego))
 tasks = {t.name: t for t in TASKS}
-lateral, slot = tasks["lateral"].privileged(ctx), tasks["pedestrians"].vision(ctx)
+lateral, slot = tasks["lanes"].privileged(ctx), tasks["pedestrians"].vision(ctx)
 before = [len(k.signatures) for k in kernels]
 grouped = lone = stereo = 0
 for _ in range(60):
     frame, feed.truth = world.observe()
-    request, debug = slot.step(frame, {"lateral": lateral.step(frame, {})[0]})
+    request, debug = slot.step(frame, {EgoPath: lateral.step(frame, {})[0]})
     grouped += sum(d.windows > 1 for d in debug.detections)
     lone += sum(d.windows == 1 for d in debug.detections)
     stereo = max([stereo] + [t.stereo_hits for t in debug.tracks])

@@ -55,7 +55,7 @@ def test_privileged_puts_every_slot_on_ground_truth_and_a_slot_option_still_wins
     r = runner.invoke(app, ["drive", "--duration", "0.5", "--privileged", "--lateral", "vision", "--no-record",
                             "--json", str(js)])
     assert r.exit_code == 0, r.output
-    assert json.loads(js.read_text())["slots"] == {"lateral": "vision", "longitudinal": "privileged",
+    assert json.loads(js.read_text())["slots"] == {"lanes": "vision", "longitudinal": "privileged",
                                                    "pedestrians": "privileged", "odometry": "privileged"}
 
 

@@ -83,7 +83,7 @@ def test_drive_config_names_the_bad_task_or_source():
         DriveConfig(sources={"steering": "vision"})
     with pytest.raises(ValueError, match="--odometry must be vision or privileged"):
         DriveConfig(sources={"odometry": "magic"})
-    assert DriveConfig(sources={"lateral": "vision"}).source("lateral") is Source.VISION
+    assert DriveConfig(sources={"lanes": "vision"}).source("lateral") is Source.VISION
     unbuilt = Task("counter", "counter", "counter_ms", CountingSlot, CountingScorer)
     with pytest.raises(ValueError, match="the counter slot has no vision implementation yet; use --counter privileged"):
         DriveConfig(sources={"counter": "vision"}, tasks=TASKS + (unbuilt,))

@@ -16,7 +16,7 @@ from percept.evaluate.report import (metric_rows, needless_stop_runs, reproduce_
 
 runner = CliRunner()
 SETTINGS = {"percept": "0.1.0", "duration_s": 12.0, "detector": None,
-            "slots": {"lateral": "vision", "longitudinal": "privileged", "pedestrians": "privileged",
+            "slots": {"lanes": "vision", "longitudinal": "privileged", "pedestrians": "privileged",
                       "odometry": "privileged"}}
 
 

@@ -97,12 +97,12 @@ def test_standing_behind_a_stopped_lead_in_rain_keeps_the_lane_and_the_lead():
             pass
 
         def log_step(self, frame, truth, step):
-            lane, gt = step.estimates["lateral"].lane, truth.truth
+            lane, gt = step.estimates["lanes"].lane, truth.truth
             rows.append((gt.speed_mps, lane.offset_m - gt.lane.offset_m, step.steering_rad,
                          step.estimates["longitudinal"] is not None))
 
     r = run_drive(DriveConfig(WorldConfig("lead-brake", 0, Condition.RAIN), duration_s=30.0,
-                              sources={t: "vision" for t in ("lateral", "longitudinal", "pedestrians", "odometry")}),
+                              sources={t: "vision" for t in ("lanes", "longitudinal", "pedestrians", "odometry")}),
                   recorder_factory=Probe)
     a = np.array(rows, dtype=float)
     standing = a[a[:, 0] < 0.05]

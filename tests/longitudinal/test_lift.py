@@ -150,6 +150,7 @@ from percept.compiled import dispatchers
 from percept.bench import stages as B
 from percept.drive.tasks import TASKS
 from percept.lanes import evidence
+from percept.sensors import EgoPath, Lead
 from percept.longitudinal import contact, flow, ground, groups, lift, refine
 from percept.odometry import features
 from percept.sims import SimWorld, WorldConfig
@@ -158,15 +159,15 @@ modules = (evidence, contact, flow, ground, groups, lift, refine, features)
 kernels = dispatchers(*modules)
 world = SimWorld(WorldConfig("lead-brake", seed=1, autopilot=True))
 ctx = B.SlotContext(world.cfg.rig, world.dt, None, B.TruthFeed(), start_pose=hw_pose(world.ego))
-slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lateral", "longitudinal", "odometry")}
+slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lanes", "longitudinal", "odometry")}
 before = [len(k.signatures) for k in kernels]
 refined = 0
 for _ in range(45):
     frame, _ = world.observe()
-    path = slots["lateral"].step(frame, {})[0]
-    lead = slots["longitudinal"].step(frame, {"lateral": path})
+    path = slots["lanes"].step(frame, {})[0]
+    lead = slots["longitudinal"].step(frame, {EgoPath: path})
     refined += lead[1].refined is not None
-    slots["odometry"].step(frame, {"longitudinal": lead[0]})
+    slots["odometry"].step(frame, {Lead: lead[0]})
     world.step()
 print(len(kernels), min(before), refined, [len(k.signatures) for k in kernels] == before)
 """

@@ -28,7 +28,7 @@ def frame(left, right, i=0, speed=20.0):
 
 def test_dropped_and_featureless_frames_give_no_lead_and_no_error():
     slot = LongitudinalSlot(StereoRig(), 1 / 15)
-    path = {"lateral": EgoPath.straight(20.0)}
+    path = {EgoPath: EgoPath.straight(20.0)}
     lead, dbg = slot.step(frame(None, None), path)
     assert lead is None and dbg.obstacle is None and dbg.measured_m is None
     black = np.zeros((480, 640, 3), np.uint8)
@@ -50,7 +50,7 @@ def test_stereo_contact_and_flow_all_reach_the_filter():
     used, errors = set(), []
     for _ in range(30):
         frame, gt = w.observe()
-        lead, dbg = slot.step(frame, {"lateral": EgoPath.straight(frame.wheel_speed_mps)})
+        lead, dbg = slot.step(frame, {EgoPath: EgoPath.straight(frame.wheel_speed_mps)})
         used.update(dbg.used)
         true = min((o.distance_m for o in gt.objects if o.kind.value == "vehicle" and abs(o.position_m[1]) < 1.5))
         if dbg.contact is not None:
@@ -108,7 +108,7 @@ def run_script(script, speed_mps=10.0):
     out = []
     for i in range(len(script)):
         f = Frame(i, i / 15, grey, grey, ImuSample(np.zeros(3), np.zeros(3)), speed_mps)
-        out.append(slot.step(f, {"lateral": EgoPath.straight(speed_mps)}))
+        out.append(slot.step(f, {EgoPath: EgoPath.straight(speed_mps)}))
     return slot, out
 
 

@@ -81,7 +81,7 @@ def privileged(tmp_path_factory):
 @pytest.fixture(scope="module")
 def vision(tmp_path_factory):
     path = tmp_path_factory.mktemp("vision") / "run.rrd"
-    return path, record(path, {"lateral": "vision", "longitudinal": "vision"}, duration_s=2.0)
+    return path, record(path, {"lanes": "vision", "longitudinal": "vision"}, duration_s=2.0)
 
 
 def images(cols: dict) -> int:

@@ -2,9 +2,9 @@
 and the control part every recording has. See ``percept.review.context`` for the part interface."""
 
 from .control import PART as control
-from .lateral import PART as lateral
+from .lanes import PART as lanes
 from .longitudinal import PART as longitudinal
 from .odometry import PART as odometry
 from .pedestrians import PART as pedestrians
 
-__all__ = ["control", "lateral", "longitudinal", "odometry", "pedestrians"]
+__all__ = ["control", "lanes", "longitudinal", "odometry", "pedestrians"]

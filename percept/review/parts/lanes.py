@@ -1,4 +1,4 @@
-"""Lateral part: the ego path. Offset, heading and curvature of the estimate beside the true lane; the path
+"""Lanes part: the ego path. Offset, heading and curvature of the estimate beside the true lane; the path
 around the car; its boundaries on the left image and, from the vision slot's ``LaneDebug``, the marking
 evidence (coloured by the side the fit gave it)."""
 
