@@ -5,6 +5,8 @@ from __future__ import annotations
 from typing import Annotated, List, Optional
 
 import typer
+from rich import box
+from rich.console import Group
 from rich.table import Table
 
 from . import options as opt
@@ -36,8 +38,8 @@ def bench(
     measured in the same run (ratio = ours / peer)."""
     from threadpoolctl import threadpool_limits
 
-    from percept.drive import TASKS
     from percept.bench.stages import bench_render, bench_task, bench_ticks
+    from percept.drive.tasks import TASKS
 
     opt.check_number("--frames", frames, 1, 10000)
     opt.check_number("--seconds", seconds, 1, 600)
@@ -54,6 +56,7 @@ def bench(
         results = [bench_render(frames, progress=tick)] + [bench_task(t, TASKS, frames, progress=tick)
                                                            for t in tasks]
     console.print(_stage_table(results))
+    console.print(_stage_legend(results), highlight=False)
     out = {"stages": [r.to_dict() for r in results]}
     if stack or soak_minutes:
         out.update(_stack(scenarios, seconds, repeats, soak_minutes))
@@ -61,30 +64,35 @@ def bench(
 
 
 def _stage_table(results) -> Table:
-    t = Table(title="percept bench (one thread, ms per call: slots the median of 3 passes' means over consecutive "
-                    "frames, the rest the median)")
-    for col in ("stage", "what", "ms", "peer", "peer ms", "ratio (ours / peer)", "target", "met"):
-        t.add_column(col, justify="left" if col in ("stage", "what", "peer", "target") else "right")
+    """One row per stage, narrow enough for an 80-column terminal: what each stage and peer is follows below it
+    (``_stage_legend``)."""
+    t = Table(title="percept bench: one thread, ms per call (slots: median of 3 passes' means over consecutive "
+                    "frames; the rest: median)", box=box.SIMPLE_HEAD, title_justify="left")
+    for col in ("stage", "ms", "peer ms", "against the peer", "target", "met"):
+        t.add_column(col, justify="left" if col in ("stage", "target") else "right", no_wrap=True)
     for r in results:
-        t.add_row(r.stage, r.what, f"{r.ms:.2f}", r.peer or "-", fmt(r.peer_ms), ratio_text(r.ratio),
-                  target_text(r), "-" if r.met is None else ("yes" if r.met else "NO"))
+        t.add_row(r.stage, f"{r.ms:.2f}", fmt(r.peer_ms), speed_text(r.ratio), target_text(r),
+                  "-" if r.met is None else ("yes" if r.met else "NO"))
     return t
 
 
+def _stage_legend(results) -> str:
+    """Each stage's work and its peer, a line each."""
+    return "\n".join(f"  {r.stage}: {r.what}" + (f"; peer: {r.peer}" if r.peer else "") for r in results)
+
+
 def target_text(r) -> str:
-    """A stage's targets as a person reads them: '<= 3.00 ms, >= 15x faster', or '-'."""
-    parts = ([] if r.target_ms is None else [f"<= {r.target_ms:.2f} ms"]) + (
-        [] if r.target_speedup is None else [f">= {r.target_speedup:g}x faster"])
+    """A stage's targets as a person reads them: '<= 3 ms, >= 15x', or '-'."""
+    parts = ([] if r.target_ms is None else [f"<= {r.target_ms:g} ms"]) + (
+        [] if r.target_speedup is None else [f">= {r.target_speedup:g}x"])
     return ", ".join(parts) or "-"
 
 
-def ratio_text(ratio: float | None) -> str:
-    """The JSON's ratio (ours / peer) as a person reads it: '0.025 (40.0x faster)', '3.63 (3.6x slower)', 'n/a'."""
+def speed_text(ratio: float | None) -> str:
+    """The JSON's ratio (ours / peer) as a person reads it: '40.0x faster', '3.6x slower', 'n/a'."""
     if ratio is None or not ratio > 0:
         return "n/a"
-    if ratio < 1:
-        return f"{ratio:.3f} ({1 / ratio:.1f}x faster)"
-    return f"{ratio:.2f} ({ratio:.1f}x slower)"
+    return f"{1 / ratio:.1f}x faster" if ratio < 1 else f"{ratio:.1f}x slower"
 
 
 def _scenarios(names: list[str] | None) -> list[str]:
@@ -113,20 +121,7 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
         soaked = soak(soak_minutes, progress=tick) if soak_minutes else None
     out = {}
     if stacks:
-        t = Table(title=f"the whole stack, every slot on vision, in the closed loop (one thread, ms per frame: the "
-                        f"median of {repeats} drives; realtime: the median [min-max]); the stock composition = "
-                        f"detectMultiScale + StereoSGBM + a Hough lane fit on the same scenario")
-        for col in ("scenario", "render", "lanes", "longitudinal", "pedestrians", "odometry", "perception total",
-                    "stock", "faster", "top-down render", "realtime", "realtime recorded"):
-            t.add_column(col, justify="left" if col == "scenario" else "right")
-        for c in stacks:
-            tm = c.timing_ms
-            t.add_row(c.scenario, *(fmt(tm.get(k)) for k in ("render", "lanes", "longitudinal", "pedestrians",
-                                                             "odometry", "perception_total")),
-                      fmt(c.stock_ms), fmt(c.speedup), fmt(c.peers_ms["render"]),
-                      _spread(c.realtime_factor, c.realtime_factors),
-                      _spread(c.realtime_factor_recording, c.realtime_factors_recording))
-        console.print(t)
+        console.print(_stack_tables(stacks, repeats))
         console.print(f"stereo pair alone on each scenario (clear, ms, the median of {PAIR_FRAMES} frames; \"render\" "
                       "above is the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}"
                                                                      for c in stacks))
@@ -142,6 +137,31 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
                       f"{soaked['realtime_factor']}")
         out["soak"] = soaked
     return out
+
+
+def _stack_tables(stacks, repeats: int) -> Group:
+    """The whole stack per scenario, in two tables that each fit 80 columns: each stage's cost; then the stock
+    composition, the speed-up and the realtime factors."""
+    from percept.drive.tasks import TASKS
+
+    keys = ["render"] + [t.name for t in TASKS if t.vision is not None] + ["perception_total"]
+    cost = Table(title=f"the whole stack on vision in the closed loop: ms per frame, one thread, the median of "
+                       f"{repeats} drives", box=box.SIMPLE_HEAD, title_justify="left")
+    cost.add_column("scenario", no_wrap=True)
+    for k in keys:
+        cost.add_column(k.replace("_", " ").replace("perception total", "total"), justify="right", no_wrap=True)
+    for c in stacks:
+        cost.add_row(c.scenario, *(fmt(c.timing_ms.get(k)) for k in keys))
+    peers = " + ".join(t.name for t in TASKS if t.bench_peer is not None)
+    speed = Table(title=f"against the stock composition (the peers of {peers}, ms per frame); realtime: median "
+                        "[min-max]", box=box.SIMPLE_HEAD, title_justify="left")
+    for col in ("scenario", "stock", "faster", "top-down", "realtime", "recorded"):
+        speed.add_column(col, justify="left" if col == "scenario" else "right", no_wrap=True)
+    for c in stacks:
+        speed.add_row(c.scenario, fmt(c.stock_ms), fmt(c.speedup), fmt(c.peers_ms["render"]),
+                      _spread(c.realtime_factor, c.realtime_factors),
+                      _spread(c.realtime_factor_recording, c.realtime_factors_recording))
+    return Group(cost, speed)
 
 
 def _stack_targets(stacks) -> str:

@@ -120,8 +120,8 @@ def summary_table(cfg, result: dict) -> Table:
         for h in task.headline:
             t.add_row(escape(name), escape(h.label), fmt(group.get(h.key), h.fmt))
             name = ""
-    if task_stops := result.get("pedestrians", {}).get("stops"):
-        t.add_row("pedestrians", "stopped for crossings", f"{sum(task_stops)} of {len(task_stops)}")
+        if task.outcome is not None and (events := group.get(task.outcome.key)):
+            t.add_row(escape(name), escape(task.outcome.label), f"{sum(events)} of {len(events)}")
     timing = result["timing_ms"]
     t.add_row("timing", escape("render [ms/frame]"), fmt(timing["render"]))
     t.add_row("", escape("perception [ms/frame]"), fmt(timing["perception_total"]))

@@ -49,15 +49,13 @@ def eval_(
     version); a damaged run file is listed and driven again. A run that fails is listed with its error, the others
     go on, and the exit code is 1.
     """
-    from percept.drive import TASKS
-
     plan, eng, files = _plan(scenario, condition, seeds, workers, engine, duration, detector, out, redo,
                              opt.slot_sources(sources, privileged))
     check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
     for path, why in files.damaged:
         err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
     summary = _run(plan, out, workers, eng, address, redo, files)
-    console.print(summary_table(summary, TASKS))
+    console.print(summary_table(summary, plan.tasks))
     console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
                   f"{out / 'summary.md'}; plots in {out / 'plots'}")
     write_json(json_path, summary)

@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 from percept.sensors import Source
 from percept.sims import WorldConfig
 
-from .tasks import TASKS, Task
+from . import tasks as tasks_module
+from .tasks import Task
 
 MAX_DURATION_S = 24 * 3600.0
 """Longest run a configuration accepts [s] (a day of simulated driving)."""
@@ -24,7 +25,7 @@ class DriveConfig:
     world: WorldConfig = field(default_factory=WorldConfig)
     duration_s: float | None = None
     sources: dict = field(default_factory=dict)
-    tasks: tuple[Task, ...] = TASKS
+    tasks: tuple[Task, ...] = field(default_factory=lambda: tasks_module.TASKS)
     detector: str = "sim"
 
     def __post_init__(self) -> None:

@@ -26,15 +26,16 @@ if TYPE_CHECKING:
     from .scoring import ScoreContext
 
 
-def lazy(ref: str) -> Callable:
-    """A callable that imports ``"module:attribute"`` when first called and calls it: the table names its slots and
-    scorers without importing them, so that reading it (``--help`` does) stays cheap."""
-    module, attr = ref.split(":")
+@dataclass(frozen=True)
+class lazy:  # noqa: N801 - used like a function in the table
+    """A callable that imports ``"module:attribute"`` when called and calls it: the table names its slots and
+    scorers without importing them, so that reading it (``--help`` does) stays cheap; it pickles (Ray, workers)."""
 
-    def call(*args, **kwargs):
+    ref: str  # "module:attribute"
+
+    def __call__(self, *args, **kwargs):
+        module, attr = self.ref.split(":")
         return getattr(import_module(module), attr)(*args, **kwargs)
-    call.__qualname__ = call.__name__ = attr
-    return call
 
 
 class Slot(Protocol):
@@ -65,6 +66,24 @@ class Headline:
 
 
 @dataclass(frozen=True)
+class Count:
+    """A count of events in the task's JSON group that evaluation sums per scenario and condition."""
+
+    key: str  # its key in the task's JSON group (an integer per run)
+    label: str  # what the reports print
+    listed: bool = False  # list the runs that have any under "Runs to look at" (worth a look, not failing)
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """Events that each end well or not, as a list of booleans in the task's JSON group (one per event)."""
+
+    key: str  # its key in the task's JSON group
+    label: str  # what the tables print beside "N of M"
+    missed: str  # the name of the count of those that did not end well (summed like a Count)
+
+
+@dataclass(frozen=True)
 class Task:
     """One driving task: its name, where its estimate comes from, how it is scored, recorded and benchmarked."""
 
@@ -82,6 +101,10 @@ class Task:
     bench_peer: Callable | None = None  # frames -> (name, run(frame)): the stock way to do its job, timed beside it
     bench_speedup: float | None = None  # how many times faster than that peer the slot must be (None: no target)
     slot_options: tuple[str, ...] = ()  # DriveConfig fields its vision slot reads (they change its results)
+    counts: tuple[Count, ...] = ()  # safety-relevant counts that evaluation sums
+    outcome: Outcome | None = None  # events that end well or not (evaluation tallies them)
+    higher_is_better: tuple[str, ...] = ()  # keys of its group where more is better (reports' p95 and worst)
+    eval_plots: Callable | None = None  # (task name, plan, results) -> {file name: BGR image}: its own plots
 
 
 def _longitudinal_slot(ctx: SlotContext) -> Slot:
@@ -126,7 +149,10 @@ TASKS: tuple[Task, ...] = (
                    Headline("time gap min [s]", "time_gap_min_s", "{:.2f}"),
                    Headline("phantom brakes", "phantom_brakes", "{}")),
          help="the lead ahead (following, emergency braking)", budget_ms=3.0,
-         bench_peer=lazy("percept.bench.peers:sgbm_full_frame"), bench_speedup=15.0),
+         bench_peer=lazy("percept.bench.peers:sgbm_full_frame"), bench_speedup=15.0,
+         counts=(Count("phantom_brakes", "phantom brakes"),),
+         higher_is_better=("time_gap_mean_s", "time_gap_min_s", "time_gap_steady_s"),
+         eval_plots=lazy("percept.evaluate.plots:range_error_by_range")),
     Task("pedestrians", BrakingRequest, lazy("percept.drive.privileged:PrivilegedPedestrians"),
          lazy("percept.drive.scoring:PedestrianScorer"), vision=_pedestrian_slot,
          recorder="percept.review.parts:pedestrians", reads=(EgoPath,),
@@ -135,7 +161,10 @@ TASKS: tuple[Task, ...] = (
                    Headline("brakes for no one", "brakes_for_no_one", "{}")),
          help="people in or stepping into the path (braking requests)", bench_scenario="crossing",
          bench_peer=lazy("percept.bench.peers:people_detector_full_frame"), bench_speedup=40.0,
-         slot_options=("detector",)),
+         slot_options=("detector",), outcome=Outcome("stops", "crossings stopped for", "missed_stops"),
+         counts=(Count("false_stops", "false stops", listed=True),
+                 Count("brakes_for_no_one", "brakes for no one", listed=True)),
+         higher_is_better=("recall", "precision", "first_detection_range_m")),
     Task("odometry", PoseEstimate, lazy("percept.drive.privileged:PrivilegedOdometry"),
          lazy("percept.drive.odometry_scoring:OdometryScorer"), vision=_odometry_slot,
          recorder="percept.review.parts:odometry", reads=(Lead,),
@@ -143,7 +172,10 @@ TASKS: tuple[Task, ...] = (
                    Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),
                    Headline("ATE with landmarks [m]", "ate_rmse_landmarks_m", "{:.2f}"),
                    Headline("inside 3 sigma", "consistency_3sigma", "{:.3f}")),
-         help="where the car is, and its speed", bench_scenario="loop", budget_ms=5.0),
+         help="where the car is, and its speed", bench_scenario="loop", budget_ms=5.0,
+         higher_is_better=("consistency_3sigma", "consistency_3sigma_fused", "landmark_fixes", "landmark_sightings",
+                           "path_length_m"),
+         eval_plots=lazy("percept.evaluate.plots:worst_trajectories")),
 )
 
 

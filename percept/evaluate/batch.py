@@ -112,6 +112,11 @@ class EvalPlan:
                            dict(self.slots), detector=self.detector)
 
     @property
+    def tasks(self) -> tuple:
+        """The slot table the runs are driven with."""
+        return self.config(self.jobs[0]).tasks
+
+    @property
     def jobs(self) -> list[Job]:
         return [Job(sc, c, s) for sc in self.scenarios for c in self.conditions for s in self.seeds]
 
@@ -211,13 +216,12 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
             if progress:
                 progress(r)
     from .report import reproduce_command, unsafe_runs, write_reports
-    from percept.drive.tasks import TASKS
 
     summary = {"settings": settings, **summarize(plan, results),
                "unsafe": [{"scenario": r["scenario"], "condition": r["condition"], "seed": r["seed"], "what": what,
                            "reproduce": reproduce_command(r, settings)} for r, what in unsafe_runs(results)]}
     write_json_atomic(out_dir / "summary.json", summary)
-    write_reports(plan, results, settings, out_dir, TASKS)
+    write_reports(plan, results, settings, out_dir, plan.tasks)
     return summary
 
 
@@ -232,7 +236,7 @@ def _stats(values: list) -> dict | None:
 def summarize(plan: EvalPlan, results: list[dict]) -> dict:
     """Per (scenario, condition): runs, failures, summed counts, and mean / max / min of every numeric metric
     (null where no run has it)."""
-    groups = []
+    cells = []
     for sc in plan.scenarios:
         for c in plan.conditions:
             rs = [r for r in results if r.get("scenario") == sc and r.get("condition") == c]
@@ -241,13 +245,14 @@ def summarize(plan: EvalPlan, results: list[dict]) -> dict:
                  "failed": [{"seed": r["seed"], "error": r["error"]} for r in rs if "error" in r]}
             for k in COUNTS:
                 g[k] = int(sum(r[k] for r in ok)) if ok else None
-            for grp in groups():
+            for grp in groups(plan.tasks):
                 keys = sorted({k for r in ok for k in r.get(grp, {})})
                 g[grp] = {k: _stats([r[grp].get(k) for r in ok]) for k in keys}
             g["realtime_factor"] = _stats([r.get("realtime_factor") for r in ok])
-            stops = [s for r in ok for s in (r["pedestrians"].get("stops") or [])]
-            # pedestrian stops: how many crossings the car stopped for, of all crossings in these runs
-            g["pedestrian_stops"] = {"stopped": int(sum(stops)), "crossings": len(stops)} if stops else None
-            groups.append(g)
+            for t in (t for t in plan.tasks if t.outcome is not None):
+                # how many of these runs' events ended well, of all of them (e.g. crossings stopped for)
+                events = [e for r in ok for e in (r[t.name].get(t.outcome.key) or [])]
+                g[t.name][t.outcome.key] = {"met": int(sum(events)), "of": len(events)} if events else None
+            cells.append(g)
     # the slots and the duration are in the summary's ``settings`` (what the runs were made with)
-    return {"seeds": list(plan.seeds), "groups": groups, "environments": environments(results)}
+    return {"seeds": list(plan.seeds), "groups": cells, "environments": environments(results)}

@@ -116,10 +116,11 @@ def _runs(results, sc, c):
 
 
 def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
-    """Every plot the results allow, into ``folder``; the paths written."""
+    """Every plot the results allow, into ``folder``: each task's headline metrics, then each task's own plots
+    (``Task.eval_plots``); the paths written."""
     images: dict[str, np.ndarray] = {}
     cells = [(sc, c) for sc in plan.scenarios for c in plan.conditions]
-    metrics = {(sc, c): [run_metrics(r) for r in _runs(results, sc, c)] for sc, c in cells}
+    metrics = {(sc, c): [run_metrics(r, tasks) for r in _runs(results, sc, c)] for sc, c in cells}
     for t in tasks:
         for h in t.headline:
             key = f"{t.name}.{h.key}"
@@ -127,10 +128,25 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
             groups = [g for g in groups if g[1]]
             if groups:
                 images[f"{key}.png"] = distribution_png(f"{t.name}: {h.label}", groups)
+    for t in tasks:
+        if t.eval_plots is not None:
+            images.update(t.eval_plots(t.name, plan, results))
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for name, img in images.items():
+        write_bytes_atomic(folder / name, png_bytes(img))
+        out.append(folder / name)
+    return out
+
+
+def range_error_by_range(task: str, plan, results: list[dict]) -> dict[str, np.ndarray]:
+    """Per scenario, the in-path range error against range, one line per condition (the median over runs of each
+    range bin's error, from the group's ``range_abs_rel_err_by_bin``)."""
+    images = {}
     for sc in plan.scenarios:
         series = []
         for c in plan.conditions:
-            per = [r["longitudinal"].get("range_abs_rel_err_by_bin") or {} for r in _runs(results, sc, c)]
+            per = [r[task].get("range_abs_rel_err_by_bin") or {} for r in _runs(results, sc, c)]
             names = sorted({b for p in per for b, v in p.items() if v is not None}, key=lambda b: int(b.split("-")[0]))
             # (bin centre [m], median relative error over the runs [%])
             pts = [(sum(map(float, b.split("-"))) / 2,
@@ -138,22 +154,23 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
             if len(pts) >= 2:
                 series.append((c, np.array(pts)))
         if series:
-            images[f"longitudinal.range_error_by_range.{sc}.png"] = lines_png(
+            images[f"{task}.range_error_by_range.{sc}.png"] = lines_png(
                 f"{sc}: in-path range error against range (median over runs)", "range [m]", "|dZ|/Z [%]", series)
-    for sc, c in cells:
-        # one trajectory per scenario x condition, the run whose estimate strayed furthest (landmark-fix ATE):
-        # a batch of hundreds of runs gets a plot a reader can look through
-        runs = [r for r in _runs(results, sc, c) if (r.get("odometry") or {}).get("trajectory")]
-        if runs:
-            r = max(runs, key=lambda r: r["odometry"].get("ate_rmse_landmarks_m") or 0.0)
-            traj = r["odometry"]["trajectory"]
-            series = [(name, np.asarray(traj[name], float)) for name in TRAJECTORY_SERIES if traj.get(name)]
-            images[f"odometry.trajectory.{sc}-{c}-{r['seed']}.png"] = lines_png(
-                f"odometry {sc} / {c} / seed {r['seed']} (worst ATE of {len(runs)})", "x [m]", "y [m]", series,
-                equal=True)
-    folder.mkdir(parents=True, exist_ok=True)
-    out = []
-    for name, img in images.items():
-        write_bytes_atomic(folder / name, png_bytes(img))
-        out.append(folder / name)
-    return out
+    return images
+
+
+def worst_trajectories(task: str, plan, results: list[dict]) -> dict[str, np.ndarray]:
+    """Per scenario x condition, the trajectories of the run whose estimate strayed furthest (landmark-fix ATE),
+    so that a batch of hundreds of runs gets plots a reader can look through."""
+    images = {}
+    for sc in plan.scenarios:
+        for c in plan.conditions:
+            runs = [r for r in _runs(results, sc, c) if (r.get(task) or {}).get("trajectory")]
+            if runs:
+                r = max(runs, key=lambda r: r[task].get("ate_rmse_landmarks_m") or 0.0)
+                traj = r[task]["trajectory"]
+                series = [(name, np.asarray(traj[name], float)) for name in TRAJECTORY_SERIES if traj.get(name)]
+                images[f"{task}.trajectory.{sc}-{c}-{r['seed']}.png"] = lines_png(
+                    f"{task} {sc} / {c} / seed {r['seed']} (worst ATE of {len(runs)})", "x [m]", "y [m]", series,
+                    equal=True)
+    return images

@@ -3,7 +3,7 @@ worst), ``summary.md`` (safety counts, the headline metrics, the runs that faile
 that reproduces each) and the list ``--strict`` acts on.
 
 "Worst" is the maximum of a metric where lower is better (errors, counts, times) and the minimum where higher is
-better (``HIGHER_IS_BETTER``); p95 is the 95th percentile towards the worse side (the 5th where higher is better).
+better (``higher_is_better``); p95 is the 95th percentile towards the worse side (the 5th where higher is better).
 """
 
 from __future__ import annotations
@@ -19,29 +19,38 @@ from percept.outputs import write_text_atomic
 from .environment import environments
 from .resume import COUNTS, groups
 
-HIGHER_IS_BETTER = frozenset({
-    "realtime_factor", "pedestrians.recall", "pedestrians.precision", "pedestrians.first_detection_range_m",
-    "longitudinal.time_gap_mean_s", "longitudinal.time_gap_min_s", "longitudinal.time_gap_steady_s",
-    "odometry.consistency_3sigma", "odometry.consistency_3sigma_fused", "odometry.landmark_fixes",
-    "odometry.landmark_sightings", "odometry.path_length_m"})
-NEEDLESS = ("false_stops", "brakes_for_no_one")
-"""The pedestrians group's counts of stops nothing called for and hard brakings for no one: listed, not failing."""
-SAFETY = ("collisions", "pedestrian_collisions", "lane_departures", "phantom_brakes", "missed_stops") + NEEDLESS
-"""Counts summed per scenario x condition: the three of every run, the longitudinal phantom brakes, the crossing
-pedestrians the car did not stop for, its stops that nothing called for and its hard brakings for no one."""
 UNSAFE = ("collisions", "pedestrian_collisions", "lane_departures")
 """What makes a run fail ``--strict``."""
 
 
-def run_metrics(run: dict) -> dict[str, float]:
-    """The numeric metrics of one run JSON, flat: the safety counts, ``<group>.<key>`` and ``realtime_factor``."""
+def safety_counts(tasks) -> list[tuple[str, str]]:
+    """(metric, label) of every count summed per scenario x condition: the unsafe counts of every run, then each
+    task's counts and the events of its outcome that did not end well."""
+    out = [(k, k.replace("_", " ")) for k in UNSAFE]
+    for t in tasks:
+        if t.outcome is not None:
+            out.append((t.outcome.missed, t.outcome.missed.replace("_", " ")))
+        out += [(c.key, c.label) for c in t.counts]
+    return out
+
+
+def higher_is_better(tasks) -> frozenset[str]:
+    """The metrics (``<group>.<key>``) where more is better: the realtime factor and those the tasks name."""
+    return frozenset({"realtime_factor"} | {f"{t.name}.{k}" for t in tasks for k in t.higher_is_better})
+
+
+def run_metrics(run: dict, tasks) -> dict[str, float]:
+    """The numeric metrics of one run JSON, flat: the safety counts (``safety_counts``), ``<group>.<key>`` and
+    ``realtime_factor``."""
     out: dict[str, float] = {k: float(run[k]) for k in COUNTS}
-    stops = run.get("pedestrians", {}).get("stops")
-    out["phantom_brakes"] = float(run.get("longitudinal", {}).get("phantom_brakes") or 0)
-    out["missed_stops"] = float(sum(1 for s in stops if not s)) if stops else 0.0
-    for k in NEEDLESS:
-        out[k] = float(run.get("pedestrians", {}).get(k) or 0)
-    for g in groups():
+    for t in tasks:
+        group = run.get(t.name) or {}
+        if t.outcome is not None:
+            events = group.get(t.outcome.key)
+            out[t.outcome.missed] = float(sum(1 for e in events if not e)) if events else 0.0
+        for c in t.counts:
+            out[c.key] = float(group.get(c.key) or 0)
+    for g in groups(tasks):
         for k, v in (run.get(g) or {}).items():
             if isinstance(v, (int, float)) and not isinstance(v, bool):
                 out[f"{g}.{k}"] = float(v)
@@ -50,25 +59,24 @@ def run_metrics(run: dict) -> dict[str, float]:
     return out
 
 
-def _stat_row(name: str, values: list[float]) -> dict:
+def _stat_row(name: str, values: list[float], up: bool, total: bool) -> dict:
     a = np.asarray(values, dtype=float)
-    up = name in HIGHER_IS_BETTER
     return {"metric": name, "runs": len(a), "mean": float(a.mean()),
             "p95": float(np.percentile(a, 5 if up else 95)), "worst": float(a.min() if up else a.max()),
-            "total": float(a.sum()) if name in SAFETY else None, "better": "higher" if up else "lower"}
+            "total": float(a.sum()) if total else None, "better": "higher" if up else "lower"}
 
 
-def metric_rows(plan, results: list[dict]) -> list[dict]:
+def metric_rows(plan, results: list[dict], tasks) -> list[dict]:
     """Long table: one row per scenario x condition x metric some run has (runs, mean, p95, worst, total)."""
-    rows = []
+    rows, safety, up = [], {k for k, _ in safety_counts(tasks)}, higher_is_better(tasks)
     for sc in plan.scenarios:
         for c in plan.conditions:
-            ok = [run_metrics(r) for r in results
+            ok = [run_metrics(r, tasks) for r in results
                   if r.get("scenario") == sc and r.get("condition") == c and "error" not in r]
-            names = sorted({k for m in ok for k in m}, key=lambda k: (k not in SAFETY, k))
+            names = sorted({k for m in ok for k in m}, key=lambda k: (k not in safety, k))
             for name in names:
                 vals = [m[name] for m in ok if name in m]
-                rows.append({"scenario": sc, "condition": c, **_stat_row(name, vals)})
+                rows.append({"scenario": sc, "condition": c, **_stat_row(name, vals, name in up, name in safety)})
     return rows
 
 
@@ -105,10 +113,11 @@ def unsafe_runs(results: list[dict]) -> list[tuple[dict, str]]:
     return _runs_with(results, lambda r: {k: r.get(k) for k in UNSAFE})
 
 
-def needless_stop_runs(results: list[dict]) -> list[tuple[dict, str]]:
-    """Runs that stopped when nothing called for it, or braked hard for no one (``pedestrians.false_stops``,
-    ``pedestrians.brakes_for_no_one``): (run, what happened). Not unsafe by ``--strict``'s rule, but worth a look."""
-    return _runs_with(results, lambda r: {k: (r.get("pedestrians") or {}).get(k) for k in NEEDLESS})
+def listed_runs(results: list[dict], tasks) -> list[tuple[dict, str]]:
+    """Runs with any of the tasks' listed counts (``Count.listed``: a stop nothing called for, a hard braking for no
+    one): (run, what happened). Not unsafe by ``--strict``'s rule, but worth a look."""
+    return _runs_with(results, lambda r: {c.label: (r.get(t.name) or {}).get(c.key)
+                                          for t in tasks for c in t.counts if c.listed})
 
 
 def summary_csv(rows: list[dict]) -> str:
@@ -143,21 +152,20 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
     """The evaluation as Markdown: settings, safety, headline metrics (``rows`` from ``metric_rows``), failures
     with reproduction commands."""
     rows = {(r["scenario"], r["condition"], r["metric"]): r for r in rows}
-    ok = [r for r in results if "error" not in r]
+    ok, safety = [r for r in results if "error" not in r], safety_counts(tasks)
     slots = ", ".join(f"{k} {v}" for k, v in settings.get("slots", {}).items())
     lines = [f"# Evaluation: {len(ok)} runs", "",
              f"Scenarios {', '.join(plan.scenarios)}; conditions {', '.join(plan.conditions)}; seeds "
              f"{_seed_text(plan.seeds)}; slots: {slots}; percept {settings.get('percept')}.", "",
              *_environment_lines(results),
              "## Safety (totals over the seeds)", "",
-             "| scenario | condition | runs | failed | collisions | pedestrian collisions | lane departures | "
-             "phantom brakes | missed stops | false stops | brakes for no one |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| scenario | condition | runs | failed | " + " | ".join(label for _, label in safety) + " |",
+             "|---|---|---|---|" + "---|" * len(safety)]
     for sc in plan.scenarios:
         for c in plan.conditions:
             n = sum(1 for r in ok if r["scenario"] == sc and r["condition"] == c)
             failed = sum(1 for r in results if "error" in r and r.get("scenario") == sc and r.get("condition") == c)
-            cells = [_fmt((rows.get((sc, c, k)) or {}).get("total"), "{:.0f}") for k in SAFETY]
+            cells = [_fmt((rows.get((sc, c, k)) or {}).get("total"), "{:.0f}") for k, _ in safety]
             lines.append(f"| {sc} | {c} | {n} | {failed} | " + " | ".join(cells) + " |")
     lines += ["", "## Headline metrics (mean / p95 / worst over the seeds)", ""]
     heads = [(f"{t.name}.{h.key}", f"{t.name}: {h.label}") for t in tasks for h in t.headline]
@@ -171,18 +179,18 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
                          if (sc, c, k) in rows else "—" for k, _ in heads]
                 lines.append(f"| {sc} | {c} | " + " | ".join(cells) + " |")
     lines += ["", "Every metric, with p95 and worst: `summary.csv`.", ""]
-    lines += _problems_md(results, settings)
+    lines += _problems_md(results, settings, tasks)
     if plots:
         lines += ["## Plots", ""] + [f"![{Path(p).stem}]({p})" for p in plots] + [""]
     return "\n".join(lines)
 
 
-def _problems_md(results: list[dict], settings: dict) -> list[str]:
-    bad = unsafe_runs(results) + needless_stop_runs(results)
+def _problems_md(results: list[dict], settings: dict, tasks) -> list[str]:
+    bad = unsafe_runs(results) + listed_runs(results, tasks)
     errors = [r for r in results if "error" in r]
     if not bad and not errors:
-        return ["No run had a collision, a pedestrian collision, a lane departure, a false stop or a hard braking "
-                "for no one, and none failed.", ""]
+        looked = [k.replace("_", " ") for k in UNSAFE] + [c.label for t in tasks for c in t.counts if c.listed]
+        return [f"No run had any {', '.join(looked)}, and none failed.", ""]
     lines = ["## Runs to look at", ""]
     lines += [f"- {r['scenario']} / {r['condition']} / seed {r['seed']}: {what} — `{reproduce_command(r, settings)}`"
               for r, what in bad]
@@ -202,7 +210,7 @@ def write_reports(plan, results: list[dict], settings: dict, out_dir: Path, task
 
     out_dir = Path(out_dir)
     plots = write_plots(plan, results, out_dir / "plots", tasks)
-    rows = metric_rows(plan, results)
+    rows = metric_rows(plan, results, tasks)
     write_text_atomic(out_dir / "summary.csv", summary_csv(rows))
     rel = [str(p.relative_to(out_dir)) for p in plots]
     write_text_atomic(out_dir / "summary.md", summary_md(plan, results, rows, settings, tasks, rel))

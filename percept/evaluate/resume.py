@@ -13,18 +13,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from percept.sensors import Source
+from percept.drive import tasks as tasks_module
 
 if TYPE_CHECKING:
     from .batch import EvalPlan, Job
 
 COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
 """Safety counts every run JSON has (integers)."""
-def groups() -> tuple[str, ...]:
-    """Metric groups every run JSON has (objects): one per task of the slot table, and ``timing_ms``."""
-    from percept.drive.tasks import TASKS
-
-    return tuple(t.name for t in TASKS) + ("timing_ms",)
+def groups(tasks=None) -> tuple[str, ...]:
+    """Metric groups every run JSON has (objects): one per task (of the slot table unless given), and
+    ``timing_ms``."""
+    return tuple(t.name for t in (tasks or tasks_module.TASKS)) + ("timing_ms",)
 
 
 def run_settings(plan: EvalPlan) -> dict:

@@ -19,7 +19,7 @@ def percept(*args: str, cwd=None) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize("args, message", [
     (["drive", "--record", "."], "Invalid value for '--record'"),
-    (["drive", "--lateral", "magic"], "Invalid value for '--lateral'"),
+    (["drive", "--lanes", "magic"], "Invalid value for '--lanes'"),
     (["render", "--frames", "x", "--out", "o"], "Invalid value for '--frames'"),
     (["eval", "--scenario", "highway"], "Missing option '--out'"),
     (["lanes"], "Missing argument"),

@@ -17,7 +17,7 @@ def test_highway_follows_at_the_set_time_gap(seed):
     assert r["collisions"] == 0 and r["lane_departures"] == 0
     lon = r["longitudinal"]
     assert lon["time_gap_steady_s"] == pytest.approx(lon["time_gap_setting_s"], abs=0.2)
-    assert r["lane"]["centering_max_m"] < 0.1
+    assert r["lanes"]["centering_max_m"] < 0.1
 
 
 @pytest.mark.parametrize("scenario", ["lead-brake", "cut-in"])
@@ -42,7 +42,7 @@ def test_curves_centering_with_privileged_lateral():
     # the clothoid transitions leave no curvature step to overshoot (0.109 m worst over seeds 0-9)
     r = drive("curves", 0, duration=30.0)
     assert r["lane_departures"] == 0
-    assert r["lane"]["centering_max_m"] < 0.15
+    assert r["lanes"]["centering_max_m"] < 0.15
     assert r["collisions"] == 0
 
 
@@ -59,5 +59,5 @@ def test_metrics_that_do_not_apply_are_null():
     assert r["pedestrians"]["stops"] is None and r["pedestrians"]["verge_brakes"] is None  # no pedestrians
     # but a stop for no one can happen on any road: counted everywhere
     assert r["pedestrians"]["false_stops"] == 0 and r["pedestrians"]["brakes_for_no_one"] == 0
-    assert r["lane"]["offset_rmse_m"] is None  # privileged lateral: no estimate to score
+    assert r["lanes"]["offset_rmse_m"] is None  # privileged lanes: no estimate to score
     assert r["odometry"]["ate_rmse_fused_m"] is None

@@ -11,7 +11,7 @@ from percept.cli.view_cmd import rerun_executable
 
 runner = CliRunner()
 KEYS = ["scenario", "condition", "seed", "duration_s", "frames", "realtime_factor", "collisions",
-        "pedestrian_collisions", "lane_departures", "lane", "longitudinal", "pedestrians", "odometry", "timing_ms"]
+        "pedestrian_collisions", "lane_departures", "lanes", "longitudinal", "pedestrians", "odometry", "timing_ms"]
 
 
 def rerun_bin() -> str:
@@ -28,7 +28,7 @@ def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
     assert d["scenario"] == "highway" and d["frames"] == 15
     assert d["timing_ms"]["render"] > 0
     # every slot sees by default, and each one's stage is timed
-    assert d["slots"] == {t: "vision" for t in ("lateral", "longitudinal", "pedestrians", "odometry")}
+    assert d["slots"] == {t: "vision" for t in ("lanes", "longitudinal", "pedestrians", "odometry")}
     assert all(d["timing_ms"][k] > 0 for k in ("lanes", "longitudinal", "pedestrians", "odometry"))
     assert rrd.exists() and not (tmp_path / "run.rrd.part").exists()
     # the recorder writes no footer (percept.review.recorder)
@@ -39,20 +39,20 @@ def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
 
 def test_vision_lateral_recording_shows_what_the_lanes_module_saw(tmp_path):
     rrd = tmp_path / "v.rrd"
-    r = runner.invoke(app, ["drive", "--scenario", "curves", "--duration", "1", "--lateral", "vision",
+    r = runner.invoke(app, ["drive", "--scenario", "curves", "--duration", "1", "--lanes", "vision",
                             "--record", str(rrd), "--json", str(tmp_path / "v.json")])
     assert r.exit_code == 0, r.output
     p = subprocess.run([rerun_bin(), "rrd", "print", str(rrd)], capture_output=True, text=True,
                        env={"RERUN_ANALYTICS": "0", "PATH": ""})
     assert p.returncode == 0, p.stderr
-    for entity in ("world/ego/camera/left/lateral/boundaries", "world/ego/camera/left/lateral/evidence",
-                   "world/ego/lateral/path", "lateral/offset_m/estimate", "lateral/curvature_1pm/truth"):
+    for entity in ("world/ego/camera/left/lanes/boundaries", "world/ego/camera/left/lanes/evidence",
+                   "world/ego/lanes/path", "lanes/offset_m/estimate", "lanes/curvature_1pm/truth"):
         assert entity in p.stdout, entity
 
 
 def test_privileged_puts_every_slot_on_ground_truth_and_a_slot_option_still_wins(tmp_path):
     js = tmp_path / "p.json"
-    r = runner.invoke(app, ["drive", "--duration", "0.5", "--privileged", "--lateral", "vision", "--no-record",
+    r = runner.invoke(app, ["drive", "--duration", "0.5", "--privileged", "--lanes", "vision", "--no-record",
                             "--json", str(js)])
     assert r.exit_code == 0, r.output
     assert json.loads(js.read_text())["slots"] == {"lanes": "vision", "longitudinal": "privileged",
@@ -69,7 +69,7 @@ def test_drive_default_recording_path(tmp_path, monkeypatch):
 @pytest.mark.parametrize("args, message", [
     (["--scenario", "motorway"], "unknown scenario 'motorway'"),
     (["--condition", "snow"], "unknown condition 'snow'"),
-    (["--lateral", "magic"], "Invalid value for '--lateral'"),
+    (["--lanes", "magic"], "Invalid value for '--lanes'"),
     (["--pedestrians", "vision", "--detector", "nope.npz"], "--detector must be sim, inria or a model file"),
     (["--duration", "-3"], "--duration must be a finite number"),
     (["--duration", "inf"], "--duration must be a finite number"),

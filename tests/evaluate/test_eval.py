@@ -51,8 +51,8 @@ def test_eval_writes_runs_and_a_summary_and_resumes(tmp_path):
     gaps = [x["longitudinal"]["time_gap_min_s"] for x in one]
     assert lb["longitudinal"]["time_gap_min_s"] == pytest.approx({"mean": sum(gaps) / 2, "max": max(gaps),
                                                                   "min": min(gaps)})
-    # a metric no run has stays null; privileged lateral has no estimate to score
-    assert lb["lane"]["offset_rmse_m"] is None and lb["pedestrian_stops"] is None
+    # a metric no run has stays null; privileged lanes has no estimate to score
+    assert lb["lanes"]["offset_rmse_m"] is None and lb["pedestrians"]["stops"] is None
     # each run records what its numbers depend on besides the code, and the summary lists where the runs came from
     import numpy as np
 
@@ -207,10 +207,10 @@ def test_resume_never_mixes_runs_made_with_other_settings(tmp_path):
     run = json.loads((tmp_path / "runs" / "lead-brake-clear-0.json").read_text())
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert run["settings"] == summary["settings"] and run["settings"]["duration_s"] == 2.0
-    assert run["settings"]["slots"]["lateral"] == "vision" and run["settings"]["percept"]
+    assert run["settings"]["slots"]["lanes"] == "vision" and run["settings"]["percept"]
     before = _files(tmp_path)
     for args, diff in ((["--duration", "1"], "duration_s 2.0 (now 1.0)"),
-                       (["--duration", "2", "--lateral", "privileged"], "slots lateral=vision (now privileged)")):
+                       (["--duration", "2", "--lanes", "privileged"], "slots lanes=vision (now privileged)")):
         r = runner.invoke(app, [*base, *args])
         assert r.exit_code == 2 and "Traceback" not in r.output
         assert "made with other settings" in r.output and diff in r.output and "--redo" in r.output

@@ -9,9 +9,9 @@ import numpy as np
 from typer.testing import CliRunner
 
 from percept.cli import app
-from percept.drive import TASKS
+from percept.drive.tasks import TASKS
 from percept.evaluate import batch as ev
-from percept.evaluate.report import (metric_rows, needless_stop_runs, reproduce_command, summary_csv, unsafe_runs,
+from percept.evaluate.report import (listed_runs, metric_rows, reproduce_command, summary_csv, unsafe_runs,
                                   write_reports)
 
 runner = CliRunner()
@@ -28,7 +28,7 @@ def run(seed, collisions=0, recall=None, offset=0.01, stops=None, phantom=0, tra
                               "estimate": [[0, 0], [10, 0.1], [20, 1.2]]}}
     return {"scenario": "highway", "condition": "clear", "seed": seed, "frames": 10, "collisions": collisions,
             "pedestrian_collisions": 0, "lane_departures": 0, "realtime_factor": 2.0 + seed,
-            "lane": {"offset_rmse_m": offset, "centering_rms_m": 0.05},
+            "lanes": {"offset_rmse_m": offset, "centering_rms_m": 0.05},
             "longitudinal": {"phantom_brakes": phantom, "range_abs_rel_err_by_bin": {"0-20": 0.01, "20-40": 0.02}},
             "pedestrians": {"recall": recall, "stops": stops}, "odometry": odo, "timing_ms": {"lanes": 1.0}}
 
@@ -40,13 +40,13 @@ def test_rows_have_mean_p95_and_the_worst_on_the_right_side():
     runs = [run(k, recall=r, offset=o, stops=s, phantom=k % 2)
             for k, (r, o, s) in enumerate([(0.9, 0.01, [True]), (0.5, 0.02, [False]), (0.8, 0.04, [True]),
                                            (0.7, 0.03, [True, False])])]
-    rows = {r["metric"]: r for r in metric_rows(PLAN, runs)}
-    assert rows["lane.offset_rmse_m"]["worst"] == 0.04 and rows["lane.offset_rmse_m"]["better"] == "lower"
+    rows = {r["metric"]: r for r in metric_rows(PLAN, runs, TASKS)}
+    assert rows["lanes.offset_rmse_m"]["worst"] == 0.04 and rows["lanes.offset_rmse_m"]["better"] == "lower"
     assert rows["pedestrians.recall"]["worst"] == 0.5 and rows["pedestrians.recall"]["better"] == "higher"
     assert rows["pedestrians.recall"]["p95"] == np.percentile([0.9, 0.5, 0.8, 0.7], 5)
     assert rows["realtime_factor"]["worst"] == 2.0  # slowest run
     assert rows["missed_stops"]["total"] == 2 and rows["phantom_brakes"]["total"] == 2
-    assert rows["lane.offset_rmse_m"]["total"] is None  # only counts are summed
+    assert rows["lanes.offset_rmse_m"]["total"] is None  # only counts are summed
     back = list(csv.DictReader(io.StringIO(summary_csv(list(rows.values())))))
     assert {r["metric"] for r in back} == set(rows) and back[0]["scenario"] == "highway"
 
@@ -69,8 +69,8 @@ def test_stops_for_no_one_are_listed_and_summed_but_do_not_fail_strict(tmp_path)
     ghost["pedestrians"].update(false_stops=1, brakes_for_no_one=2)
     runs = [run(0), ghost]
     assert unsafe_runs(runs) == []
-    assert [(r["seed"], what) for r, what in needless_stop_runs(runs)] == [(1, "1 false stops, 2 brakes for no one")]
-    rows = {r["metric"]: r for r in metric_rows(PLAN, runs)}
+    assert [(r["seed"], what) for r, what in listed_runs(runs, TASKS)] == [(1, "1 false stops, 2 brakes for no one")]
+    rows = {r["metric"]: r for r in metric_rows(PLAN, runs, TASKS)}
     assert rows["false_stops"]["total"] == 1 and rows["brakes_for_no_one"]["total"] == 2
     write_reports(PLAN, runs, SETTINGS, tmp_path, TASKS)
     md = (tmp_path / "summary.md").read_text()
@@ -88,7 +88,7 @@ def test_reports_are_written_and_readable(tmp_path):
     assert "seed 4: 1 collisions" in md and "`percept drive --scenario highway --seed 4" in md
     pngs = [p for p in written if p.suffix == ".png"]
     names = {p.name for p in pngs}
-    assert {"lane.centering_rms_m.png", "longitudinal.range_error_by_range.highway.png",
+    assert {"lanes.centering_rms_m.png", "longitudinal.range_error_by_range.highway.png",
             "odometry.trajectory.highway-clear-1.png"} <= names
     # one trajectory per scenario and condition: the run with the worst ATE
     assert not any(n.startswith("odometry.trajectory.highway-clear-0") for n in names)
