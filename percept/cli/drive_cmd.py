@@ -36,12 +36,11 @@ def drive(
 ):
     """Drive a scenario in closed loop from the cameras, score it against ground truth and record it to Rerun."""
     from percept.drive import DriveConfig, run_drive
-    from percept.drive.config import MAX_DURATION_S
     from percept.review import partial_path
     from percept.sims import WorldConfig
 
     opt.check_number("--seed", seed, 0, opt.MAX_SEED)
-    opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
+    opt.check_number("--duration", duration, 1e-3, opt.MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
                           opt.slot_sources(sources, privileged), detector=detector)

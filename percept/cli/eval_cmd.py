@@ -66,13 +66,12 @@ def eval_(
 
 def _plan(scenario, condition, seeds, workers, engine, duration, detector, out: Path, redo: bool, sources):
     """The checked options as (EvalPlan, Engine, the run files already in --out); one-line exit 2 otherwise."""
-    from percept.evaluate.batch import Engine, EvalPlan, parse_seeds
-    from percept.drive.config import MAX_DURATION_S
+    from percept.evaluate.plan import Engine, EvalPlan, parse_seeds
     from percept.evaluate.resume import refuse_other_settings, scan_runs
     from percept.sims import SCENARIOS
 
     opt.check_number("--workers", workers, 1, 256)
-    opt.check_number("--duration", duration, 1e-3, MAX_DURATION_S)
+    opt.check_number("--duration", duration, 1e-3, opt.MAX_DURATION_S)
     if "all" in scenario and len(set(scenario)) > 1:
         fail("--scenario all already means every scenario; give either all or scenario names, not both")
     names = list(SCENARIOS) if "all" in scenario else scenario

@@ -8,6 +8,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
+from enum import Enum
 from pathlib import Path
 from typing import Optional
 
@@ -15,6 +16,13 @@ import numpy as np
 import typer
 
 from .common import Command
+
+
+class LanesFormat(str, Enum):
+    """The JSON layout of ``percept lanes``."""
+
+    PERCEPT = "percept"  # every estimate
+    TUSIMPLE = "tusimple"  # the TuSimple benchmark's prediction lines
 
 CALIBRATION_IMAGES = 30
 """At most this many images of a folder (evenly spread) measure the camera height."""
@@ -44,47 +52,53 @@ def register(app: typer.Typer) -> None:
                                                          "video (0: no motion model)."),
         max_frames: Optional[int] = typer.Option(None, "--max-frames", help="Process at most this many video frames "
                                                                           "(at least 1)."),
-        fmt: str = typer.Option("percept", "--format", help="JSON layout: percept (the default: every estimate) or "
-                                                           "tusimple (the benchmark's prediction lines: each "
-                                                           "boundary's x at its h_samples rows, -2 where none; "
-                                                           "images only)."),
+        fmt: LanesFormat = typer.Option(LanesFormat.PERCEPT, "--format", help="JSON layout: percept (every "
+                                        "estimate) or tusimple (the benchmark's prediction lines: each boundary's x "
+                                        "at its h_samples rows, -2 where none; images only)."),
     ):
         """Fit the ego lane on recorded footage; pitch and horizon come from the lane lines' vanishing point.
 
         The JSON and every overlay are written complete or not at all: an error, a full disk or Ctrl-C leaves the
         files that were there untouched. Overlays of a folder are written one by one as each image is done.
         """
-        from percept.cli.common import check_outputs, fail
-        from percept.cli.footage_out import overlay_path
-        from percept.lanes.realworld import FootageLanes, RealLaneConfig
-        from percept.sensors import CameraCalibration, FootageKind, list_footage
-
-        _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt, json_path)
-        try:
-            cfg = RealLaneConfig(hfov_rad=math.radians(hfov), mount_height_m=mount_height, lane_width_m=lane_width,
-                                 speed_mps=speed)
-            cal = CameraCalibration.load(calib) if calib is not None else None
-            kind, files = list_footage(source)
-        except ValueError as e:
-            fail(str(e))
-        video = kind is FootageKind.VIDEO
-        if video and fmt == "tusimple":
-            fail("--format tusimple is for images (TuSimple scores stills); extract the video's frames into a folder")
-        overlays = [] if out is None else [overlay_path(out, p, "lanes", video) for p in files]
-        if out is not None and out.exists() and not out.is_dir():
-            fail(f"--out {out} is a file; give a folder for the overlays")
-        check_outputs([json_path, *overlays], [*files, calib])
-        runner = FootageLanes(cfg, cal)
-        header = {"source": str(source), "kind": kind.value, "calibration": None if calib is None else str(calib),
-                  "hfov_deg": None if cal is not None else hfov, "lane_width_m": lane_width,
-                  "assumed_speed_mps": speed}
-        if video:
-            _run_video(runner, files[0], out, json_path, max_frames, header)
-        else:
-            _run_images(runner, files, out, json_path, header, single=source.is_file(), tusimple=fmt == "tusimple")
+        _lanes(source, json_path, out, calib, mount_height, lane_width, hfov, speed, max_frames, fmt)
 
 
-def _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt: str, json_path) -> None:
+def _lanes(source: Path, json_path, out, calib, mount_height, lane_width: float, hfov: float, speed: float,
+           max_frames, fmt: LanesFormat) -> None:
+    """``percept lanes`` once its options are parsed: check them, list the footage, fit and write."""
+    from percept.cli.common import check_outputs, fail
+    from percept.cli.footage_out import overlay_path
+    from percept.lanes.realworld import FootageLanes, RealLaneConfig
+    from percept.sensors import CameraCalibration, FootageKind, list_footage
+
+    _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt, json_path)
+    try:
+        cfg = RealLaneConfig(hfov_rad=math.radians(hfov), mount_height_m=mount_height, lane_width_m=lane_width,
+                             speed_mps=speed)
+        cal = CameraCalibration.load(calib) if calib is not None else None
+        kind, files = list_footage(source)
+    except ValueError as e:
+        fail(str(e))
+    video = kind is FootageKind.VIDEO
+    if video and fmt is LanesFormat.TUSIMPLE:
+        fail("--format tusimple is for images (TuSimple scores stills); extract the video's frames into a folder")
+    overlays = [] if out is None else [overlay_path(out, p, "lanes", video) for p in files]
+    if out is not None and out.exists() and not out.is_dir():
+        fail(f"--out {out} is a file; give a folder for the overlays")
+    check_outputs([json_path, *overlays], [*files, calib])
+    runner = FootageLanes(cfg, cal)
+    header = {"source": str(source), "kind": kind.value, "calibration": None if calib is None else str(calib),
+              "hfov_deg": None if cal is not None else hfov, "lane_width_m": lane_width,
+              "assumed_speed_mps": speed}
+    if video:
+        _run_video(runner, files[0], out, json_path, max_frames, header)
+    else:
+        _run_images(runner, files, out, json_path, header, single=source.is_file(),
+                    tusimple=fmt is LanesFormat.TUSIMPLE)
+
+
+def _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt: LanesFormat, json_path) -> None:
     """One-line errors (exit 2) for option values out of range or that do not go together."""
     from percept.cli.common import fail
     from percept.cli.options import check_number
@@ -94,9 +108,7 @@ def _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt: str, 
     check_number("--hfov", hfov, 3.0, 177.0)
     check_number("--speed", speed, 0.0, 100.0)
     check_number("--max-frames", max_frames, 1, 10**7)
-    if fmt not in ("percept", "tusimple"):
-        fail(f"--format must be percept or tusimple, got {fmt!r}")
-    if fmt == "tusimple" and json_path is None:
+    if fmt is LanesFormat.TUSIMPLE and json_path is None:
         fail("--format tusimple describes the --json file; give --json OUT")
 
 

@@ -11,11 +11,10 @@ from typing import Annotated, Callable, Optional
 
 import typer
 
+from percept.drive.limits import MAX_DURATION_S, MAX_SEED
 from percept.sensors.records import Source
 
 
-MAX_SEED = 2**31 - 1
-"""Largest --seed; the same as ``percept.evaluate.batch.MAX_SEED`` (not imported from there: --help stays fast)."""
 _SLOT = ("The {task} slot, {help}: vision (its perception module; the default) or privileged (ground truth, the "
          "baseline; --privileged sets every slot).")
 

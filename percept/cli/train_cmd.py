@@ -41,26 +41,19 @@ def train_detector(
 
     The conditions rotate over the seeds (by default clear, night, rain). The model is selected with `--model FILE` in
     `percept detect` and `--detector FILE` in `percept drive` and `percept eval`. With `--first-stage MODEL` the model
-    trained here becomes the second stage of a cascade: MODEL finds the people, this one confirms them. The one
-    shipped in the package (`sim`) is such a cascade: this command's defaults made its first stage at commit 2932bd1
-    (the renderer has changed a little since: the same plan now gives 5 556 positives where it gave 5 552), and
-    `--negatives-from highway --negatives-from curves --negatives-from cut-in --negatives-from loop --first-stage sim`
-    its second (at the default --second-threshold).
+    trained here becomes the second stage of a cascade: MODEL finds the people, this one confirms them. The model
+    shipped in the package (`sim`) is such a cascade: its first stage is this command's defaults, its second
+    `--negatives-from highway --negatives-from curves --negatives-from cut-in --negatives-from loop --first-stage sim`.
     """
     from percept.detection import LinearModel
-    from percept.evaluate.batch import parse_seeds
-    from percept.training.people import TrainPlan, frames_to_sample, train_people_model
+    from percept.training.people import frames_to_sample, train_people_model
 
     opt.check_number("--every", every, 1, 100)
     opt.check_number("--c", c, 1e-5, 10.0)
     opt.check_number("--second-threshold", second_threshold, -5.0, 5.0)
     try:
         first = None if first_stage is None else replace(LinearModel.named(first_stage), second=None)
-        conditions = {"conditions": tuple(condition)} if condition else {}
-        if negatives_from:
-            conditions["negative_scenarios"] = tuple(negatives_from)
-        plan = TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c,
-                         negative_seeds=tuple(parse_seeds(negative_seeds, "--negative-seeds")), **conditions)
+        plan = _plan(seeds, every, duration, c, condition, negatives_from, negative_seeds)
     except ValueError as e:
         fail(str(e))
     record_path = out.with_suffix(".json")
@@ -72,6 +65,25 @@ def train_detector(
             model, record = train_people_model(plan, tick=lambda: bar.advance(task))
         except ValueError as e:
             fail(str(e))
+    _save(model, record, plan, out, record_path, seeds, negative_seeds, first, first_stage, second_threshold)
+
+
+def _plan(seeds: str, every: int, duration, c: float, condition, negatives_from, negative_seeds: str):
+    """The TrainPlan the options describe; ValueError naming the bad one."""
+    from percept.evaluate.plan import parse_seeds
+    from percept.training.people import TrainPlan
+
+    conditions = {"conditions": tuple(condition)} if condition else {}
+    if negatives_from:
+        conditions["negative_scenarios"] = tuple(negatives_from)
+    return TrainPlan(seeds=tuple(parse_seeds(seeds)), every=every, duration_s=duration, c=c,
+                     negative_seeds=tuple(parse_seeds(negative_seeds, "--negative-seeds")), **conditions)
+
+
+def _save(model, record: dict, plan, out: Path, record_path: Path, seeds: str, negative_seeds: str, first,
+          first_stage: str | None, second_threshold: float) -> None:
+    """Write the model (as a cascade's second stage behind ``first`` when given) and its training record; say
+    what was trained."""
     traffic = (f"; hard negatives also from {', '.join(plan.negative_scenarios)} seeds {negative_seeds}"
                if plan.negative_scenarios else "")
     meta = {"trained_on": f"{plan.scenario} seeds {seeds}, conditions {', '.join(plan.conditions)}, every "

@@ -19,6 +19,7 @@ from percept.sensors.vehicle import MAX_BRAKE_MPS2
 
 from .base import Controller, limiting
 from .target import Target
+from .tuning import STANDING_MPS, STANDSTILL_GAP_M, STOP_GAIN
 
 MAX_ACCEL_MPS2 = 2.5
 """Comfort limit on the commanded acceleration [m/s²]."""
@@ -40,8 +41,8 @@ class EmergencyBraking(Controller):
     """standstill_m: margin kept to a vehicle [m]; ped_margin_m: margin kept to a pedestrian [m];
     trigger_mps2: required deceleration that triggers an emergency brake; gain: braking / required."""
 
-    def __init__(self, standstill_m: float = 4.0, ped_margin_m: float = PERSON_STOP_MARGIN_M,
-                 trigger_mps2: float = 2.0, gain: float = 1.3):
+    def __init__(self, standstill_m: float = STANDSTILL_GAP_M, ped_margin_m: float = PERSON_STOP_MARGIN_M,
+                 trigger_mps2: float = 2.0, gain: float = STOP_GAIN):
         self.d0, self.ped_margin, self.trigger, self.gain = standstill_m, ped_margin_m, trigger_mps2, gain
         self.reset()
 
@@ -69,7 +70,7 @@ class EmergencyBraking(Controller):
                 a_req = target.closing_mps * target.closing_mps / (2 * max(room, 0.1))
                 if a_req > self.trigger:
                     terms["emergency"] = -self.gain * a_req
-            if room < 0.5 and v < 1.0:
+            if room < 0.5 and v < STANDING_MPS:
                 terms["hold"] = -MAX_BRAKE_MPS2  # hold the car at a standstill
         stop_in = None if self.stop_at_m is None else self.stop_at_m - self.travelled_m
         if stop_in is not None:

@@ -19,6 +19,7 @@ from percept.sensors import ObjectKind
 
 from .base import Controller, limiting
 from .target import Target
+from .tuning import STANDING_MPS, STANDSTILL_GAP_M, STOP_GAIN
 
 
 @dataclass(frozen=True)
@@ -36,9 +37,9 @@ class FollowingDebug:
 class Following(Controller):
     """Acceleration [m/s²] from the set speed and the in-path target; gains as time constants [s]."""
 
-    def __init__(self, set_speed_mps: float, time_gap_s: float = 1.8, standstill_m: float = 4.0,
-                 gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5, stop_gain: float = 1.3,
-                 standing_mps: float = 1.0):
+    def __init__(self, set_speed_mps: float, time_gap_s: float = 1.8, standstill_m: float = STANDSTILL_GAP_M,
+                 gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5, stop_gain: float = STOP_GAIN,
+                 standing_mps: float = STANDING_MPS):
         for name, v in (("time_gap_s", time_gap_s), ("gap_time_constant_s", gap_time_constant_s),
                         ("speed_time_constant_s", speed_time_constant_s)):
             if not v > 0:

@@ -9,11 +9,8 @@ from percept.sensors import Source
 from percept.sims import WorldConfig
 
 from . import tasks as tasks_module
+from .limits import MAX_DURATION_S
 from .tasks import Task
-
-MAX_DURATION_S = 24 * 3600.0
-"""Longest run a configuration accepts [s] (a day of simulated driving)."""
-
 
 
 @dataclass(frozen=True)
@@ -45,11 +42,11 @@ class DriveConfig:
             if clean[name] is Source.VISION and names[name].vision is None:
                 raise ValueError(f"the {name} slot has no vision implementation yet; use --{name} privileged")
         object.__setattr__(self, "sources", {t.name: clean.get(t.name, Source.PRIVILEGED) for t in self.tasks})
-        if self.detector not in ("sim", "inria"):
-            from pathlib import Path
+        from percept.detection import LinearModel
 
-            if not Path(self.detector).is_file():
-                raise ValueError(f"--detector must be sim, inria or a model file, got '{self.detector}'")
+        path = LinearModel.file_of(self.detector)
+        if path is not None and not path.is_file():
+            raise ValueError(f"--detector must be sim, inria or a model file, got '{self.detector}'")
 
     def source(self, task: str) -> Source:
         return self.sources[task]

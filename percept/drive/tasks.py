@@ -4,7 +4,8 @@ one entry here.
 
 A task has one name wherever a user meets it: its CLI option (``--lanes vision``), its JSON group, its
 ``timing_ms`` key, its recording part and its ``percept bench`` stage. Task names appear as string literals only in
-this module. A slot is anything with ``reset()`` and ``step(frame, upstream) -> (estimate, debug)``; ``upstream``
+this module; the same words elsewhere name other things: the footage commands ``percept lanes`` and ``percept
+odometry`` (and their overlay files' suffix), and the TuSimple format's ``"lanes"`` key. A slot is anything with ``reset()`` and ``step(frame, upstream) -> (estimate, debug)``; ``upstream``
 maps each record type the entry ``reads`` to the estimate of the task that ``provides`` it, so a slot asks for
 ``upstream[EgoPath]`` and never for another task by name, and the agent finds what steers, what brakes and what
 measures speed by the record each task provides (docs/design.md, "Agent and slots").
@@ -134,7 +135,7 @@ def _lane_slot(ctx: SlotContext) -> Slot:
 TASKS: tuple[Task, ...] = (
     Task("lanes", EgoPath, lazy("percept.drive.privileged:PrivilegedLanes"),
          lazy("percept.drive.scoring:LaneScorer"), vision=_lane_slot,
-         recorder="percept.review.parts:lanes",
+         recorder="percept.review.parts.lanes:PART",
          headline=(Headline("lane offset RMSE [m]", "offset_rmse_m", "{:.4f}"),
                    Headline("lane heading RMSE [rad]", "heading_rmse_rad", "{:.4f}"),
                    Headline("lane curvature RMSE [1/m]", "curvature_rmse_1pm", "{:.5f}"),
@@ -143,7 +144,7 @@ TASKS: tuple[Task, ...] = (
          bench_peer=lazy("percept.bench.peers:lane_fit_full_frame")),
     Task("longitudinal", Lead, lazy("percept.drive.privileged:PrivilegedLongitudinal"),
          lazy("percept.drive.scoring:LongitudinalScorer"), vision=_longitudinal_slot,
-         recorder="percept.review.parts:longitudinal", reads=(EgoPath,),
+         recorder="percept.review.parts.longitudinal:PART", reads=(EgoPath,),
          headline=(Headline("range error (median)", "range_abs_rel_err", "{:.3f}"),
                    Headline("time gap mean [s]", "time_gap_mean_s", "{:.2f}"),
                    Headline("time gap min [s]", "time_gap_min_s", "{:.2f}"),
@@ -155,7 +156,7 @@ TASKS: tuple[Task, ...] = (
          eval_plots=lazy("percept.evaluate.plots:range_error_by_range")),
     Task("pedestrians", BrakingRequest, lazy("percept.drive.privileged:PrivilegedPedestrians"),
          lazy("percept.drive.scoring:PedestrianScorer"), vision=_pedestrian_slot,
-         recorder="percept.review.parts:pedestrians", reads=(EgoPath,),
+         recorder="percept.review.parts.pedestrians:PART", reads=(EgoPath,),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}"),
                    Headline("verge brakes", "verge_brakes", "{}"),
                    Headline("brakes for no one", "brakes_for_no_one", "{}")),
@@ -167,7 +168,7 @@ TASKS: tuple[Task, ...] = (
          higher_is_better=("recall", "precision", "first_detection_range_m")),
     Task("odometry", PoseEstimate, lazy("percept.drive.privileged:PrivilegedOdometry"),
          lazy("percept.drive.odometry_scoring:OdometryScorer"), vision=_odometry_slot,
-         recorder="percept.review.parts:odometry", reads=(Lead,),
+         recorder="percept.review.parts.odometry:PART", reads=(Lead,),
          headline=(Headline("drift VO [%]", "drift_pct_vo", "{:.2f}"),
                    Headline("drift fused [%]", "drift_pct_fused", "{:.2f}"),
                    Headline("ATE with landmarks [m]", "ate_rmse_landmarks_m", "{:.2f}"),

@@ -11,7 +11,7 @@ import numpy as np
 
 from percept.outputs import png_bytes, write_bytes_atomic
 
-from .report import run_metrics
+from .metrics import run_metrics
 
 FONT = cv2.FONT_HERSHEY_SIMPLEX
 INK, GRID, DOT, MEAN = (40, 40, 40), (225, 225, 225), (200, 120, 30), (30, 30, 220)

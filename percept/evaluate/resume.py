@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from percept.drive import tasks as tasks_module
 
 if TYPE_CHECKING:
-    from .batch import EvalPlan, Job
+    from .plan import EvalPlan, Job
 
 COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
 """Safety counts every run JSON has (integers)."""

@@ -1,10 +1,6 @@
-"""The review parts, one per driving task (what ``percept.drive.tasks`` names as "percept.review.parts:<task>"),
+"""The review parts: one module per driving task, named in the slot table as "percept.review.parts.<module>:PART",
 and the control part every recording has. See ``percept.review.context`` for the part interface."""
 
 from .control import PART as control
-from .lanes import PART as lanes
-from .longitudinal import PART as longitudinal
-from .odometry import PART as odometry
-from .pedestrians import PART as pedestrians
 
-__all__ = ["control", "lanes", "longitudinal", "odometry", "pedestrians"]
+__all__ = ["control"]

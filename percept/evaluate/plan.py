@@ -1,0 +1,91 @@
+"""What a batch is: its scenarios, conditions and seeds (``parse_seeds``), the slots and options every run shares, and
+the jobs it expands to; validated before any run starts."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+
+from percept.drive.config import DriveConfig
+from percept.drive.limits import MAX_SEED
+from percept.sims import WorldConfig
+
+MAX_SEEDS = 10_000
+"""Most seeds one batch takes; a range is counted before it is expanded, so '0-99999999999' is refused at once."""
+
+
+class Engine(str, Enum):
+    LOCAL = "local"
+    RAY = "ray"
+
+
+def parse_seeds(text: str, option: str = "--seeds") -> list[int]:
+    """"A-B" (inclusive), "A,B,C" or "N" -> sorted unique seeds, each 0 to MAX_SEED and at most MAX_SEEDS of
+    them; ValueError with the expected forms otherwise (naming ``option``)."""
+    spans = []
+    try:
+        for part in text.split(","):
+            a, sep, b = part.strip().partition("-")
+            lo, hi = int(a), int(b) if sep else int(a)
+            if lo < 0 or hi < lo:
+                raise ValueError
+            spans.append((lo, hi))
+    except ValueError:
+        raise ValueError(f"{option} must look like 0-9, 3 or 1,4,7 (non-negative, A <= B), got '{text}'") from None
+    if (top := max(hi for _, hi in spans)) > MAX_SEED:
+        raise ValueError(f"{option} go from 0 to {MAX_SEED}, got {top}")
+    count, end = 0, -1  # seeds covered by the spans, overlaps counted once
+    for lo, hi in sorted(spans):
+        count += max(0, hi - max(lo, end + 1) + 1)
+        end = max(end, hi)
+    if count > MAX_SEEDS:
+        raise ValueError(f"{option} '{text}' names {count} seeds; a batch takes at most {MAX_SEEDS} (split it)")
+    return sorted({s for lo, hi in spans for s in range(lo, hi + 1)})
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of the batch."""
+
+    scenario: str
+    condition: str
+    seed: int
+
+    @property
+    def name(self) -> str:
+        return f"{self.scenario}-{self.condition}-{self.seed}"
+
+
+@dataclass(frozen=True)
+class EvalPlan:
+    """scenarios, conditions: names; seeds: the seeds of every (scenario, condition); slots: Source per task name
+    (missing ones privileged); duration_s: None = each scenario's own. Validated here: a bad name, condition or
+    slot raises ValueError before any run starts. detector: the vision pedestrian slot's people model."""
+
+    scenarios: tuple[str, ...]
+    conditions: tuple[str, ...]
+    seeds: tuple[int, ...]
+    slots: dict = field(default_factory=dict)
+    duration_s: float | None = None
+    detector: str = "sim"
+
+    def __post_init__(self) -> None:
+        if not self.scenarios or not self.conditions or not self.seeds:
+            raise ValueError("a batch needs at least one scenario, one condition and one seed")
+        for sc in self.scenarios:
+            for c in self.conditions:
+                # builds and validates the whole configuration of one run (names, condition, slots, duration)
+                self.config(Job(sc, c, self.seeds[0]))
+
+    def config(self, job: Job) -> DriveConfig:
+        return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
+                           dict(self.slots), detector=self.detector)
+
+    @property
+    def tasks(self) -> tuple:
+        """The slot table the runs are driven with."""
+        return self.config(self.jobs[0]).tasks
+
+    @property
+    def jobs(self) -> list[Job]:
+        return [Job(sc, c, s) for sc in self.scenarios for c in self.conditions for s in self.seeds]
