@@ -1,4 +1,4 @@
-"""The records task slots exchange (DESIGN.md, "Agent and slots"): frozen, in SI units, vehicle frame unless named.
+"""The records task slots exchange (docs/design.md, "Agent and slots"): frozen, SI units, vehicle frame unless named.
 
 A vision slot and its privileged twin return the same record, so either can feed the control laws and the
 slots downstream. Vehicle frame: ISO 8855 (x forward, y left, z up); ranges are measured from the left camera.
@@ -31,22 +31,16 @@ class ObjectKind(str, Enum):
 
 @dataclass(frozen=True)
 class LaneEstimate:
-    """The ego lane in the vehicle frame (x forward, y left), as the lateral controller needs it.
+    """The ego lane in the vehicle frame (x forward, y left), as lane keeping needs it; its centre is
+    y_c(x) = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6."""
 
-    offset_m: vehicle centre's lateral offset from the lane centre (+ left); heading_rad: vehicle heading relative
-    to the lane (+ CCW); curvature_1pm: lane curvature (+ turning left); width_m; confidence: 0..1 (0 = no
-    evidence, the values are a prediction); valid: False before the first fit; curvature_rate_1pm2: change of
-    the curvature per metre ahead (a clothoid). The lane centre in the vehicle frame is
-    y_c(x) = -offset - tan(heading) x + curvature x^2 / 2 + curvature_rate x^3 / 6.
-    """
-
-    offset_m: float
-    heading_rad: float
-    curvature_1pm: float
-    width_m: float
-    confidence: float
-    valid: bool = True
-    curvature_rate_1pm2: float = 0.0
+    offset_m: float  # the vehicle centre's lateral offset from the lane centre [m] (+ left)
+    heading_rad: float  # the vehicle's heading relative to the lane [rad] (+ counter-clockwise)
+    curvature_1pm: float  # the lane's curvature [1/m] (+ turning left)
+    width_m: float  # the lane's width [m]
+    confidence: float  # 0..1; 0: no evidence, the values are a prediction
+    valid: bool = True  # False before the first fit
+    curvature_rate_1pm2: float = 0.0  # change of the curvature per metre ahead [1/m^2] (a clothoid)
 
     def centre_y(self, x_m: np.ndarray) -> np.ndarray:
         """Lateral position of the lane centre at distances x_m ahead [m]."""
@@ -71,15 +65,11 @@ class LaneEstimate:
 
 @dataclass(frozen=True)
 class EgoPath:
-    """Where the ego is going: the lane it keeps (or, without one, a straight corridor along its x axis) and the
-    speed it goes at [m/s] (the speed the estimate was made with: wheel speed for vision, true for privileged).
+    """Where the ego is going, as the lanes task provides it: lane keeping steers along it, and the tasks that look
+    for obstacles look for them in it."""
 
-    What the lateral slot returns; lane keeping steers along it and the longitudinal and pedestrian slots look
-    for obstacles in it.
-    """
-
-    lane: LaneEstimate | None
-    speed_mps: float
+    lane: LaneEstimate | None  # the lane it keeps (None: a straight corridor along the vehicle's x axis)
+    speed_mps: float  # the speed the estimate was made with [m/s] (wheel speed for vision, true for privileged)
 
     @classmethod
     def straight(cls, speed_mps: float) -> "EgoPath":
@@ -96,20 +86,15 @@ class EgoPath:
 
 @dataclass(frozen=True)
 class Lead:
-    """The nearest thing standing in the ego path (a vehicle, a person, anything else that stands up).
+    """The nearest thing standing in the ego path (a vehicle, a person, anything else that stands up)."""
 
-    range_m: left-camera depth of its nearest point [m]; range_rate_mps: d(range)/dt [m/s], negative when closing;
-    kind: what it is; confidence: 0..1; ttc_s: time to contact [s] (None when not closing); box_px: (u0, v0, u1,
-    v1) in the left image, or None; obj_id: the tracker's (or the simulator's) id.
-    """
-
-    range_m: float
-    range_rate_mps: float
-    kind: ObjectKind = ObjectKind.VEHICLE
-    confidence: float = 1.0
-    ttc_s: float | None = None
-    box_px: tuple | None = None
-    obj_id: int | None = None
+    range_m: float  # left-camera depth of its nearest point [m]
+    range_rate_mps: float  # d(range)/dt [m/s], negative when closing
+    kind: ObjectKind = ObjectKind.VEHICLE  # what it is
+    confidence: float = 1.0  # 0..1
+    ttc_s: float | None = None  # time to contact [s] (None when not closing)
+    box_px: tuple | None = None  # (u0, v0, u1, v1) in the left image [px], or None
+    obj_id: int | None = None  # the tracker's (or the simulator's) id
 
     @staticmethod
     def time_to_contact(range_m: float, range_rate_mps: float) -> float | None:
@@ -119,17 +104,14 @@ class Lead:
 
 @dataclass(frozen=True)
 class BrakingRequest:
-    """Stop before ``stop_before_m`` (left-camera range of the conflict point, e.g. a person stepping into the
-    path) [m]; range_rate_mps: its d(range)/dt [m/s]; reason: why, for review; kind: what is there; obj_id;
-    withdrawn: True withdraws what was asked for ``obj_id`` (it has turned out to be no person): brake for nothing,
-    and drop a stop committed to for it."""
+    """A request to stop before a conflict point (a person stepping into the path), or to withdraw one."""
 
-    stop_before_m: float
-    range_rate_mps: float
-    reason: str
-    kind: ObjectKind = ObjectKind.PEDESTRIAN
-    obj_id: int | None = None
-    withdrawn: bool = False
+    stop_before_m: float  # left-camera range of the conflict point [m]
+    range_rate_mps: float  # its d(range)/dt [m/s]
+    reason: str  # why, for review
+    kind: ObjectKind = ObjectKind.PEDESTRIAN  # what is there
+    obj_id: int | None = None  # the tracker's (or the simulator's) id of what is there
+    withdrawn: bool = False  # withdraws what was asked for obj_id (no person after all): drop a stop committed to
 
     @staticmethod
     def asking(request: "BrakingRequest | None") -> "BrakingRequest | None":
@@ -139,21 +121,20 @@ class BrakingRequest:
 
 @dataclass(frozen=True)
 class PoseEstimate:
-    """Planar pose of the vehicle in the world frame, its speed [m/s] and the (3, 3) covariance of (x_m, y_m,
-    yaw_rad) [m², m·rad, rad²]; valid: False while the estimator has nothing to go on."""
+    """Where the vehicle is in the world frame, and its speed."""
 
-    pose: Pose2D
-    speed_mps: float
-    covariance: np.ndarray
-    valid: bool = True
+    pose: Pose2D  # planar pose (x_m, y_m, yaw_rad)
+    speed_mps: float  # speed along the vehicle's x axis [m/s]
+    covariance: np.ndarray  # (3, 3) of (x_m, y_m, yaw_rad) [m², m·rad, rad²]
+    valid: bool = True  # False while the estimator has nothing to go on
 
 
 @dataclass(frozen=True)
 class LandmarkMap:
-    """Surveyed landmark signs: marker ids (N,) and their panel centres (N, 3) in the world frame [m]."""
+    """Surveyed landmark signs."""
 
-    ids: tuple[int, ...]
-    positions_m: np.ndarray
+    ids: tuple[int, ...]  # marker ids (N,)
+    positions_m: np.ndarray  # their panel centres (N, 3) in the world frame [m]
 
     def __post_init__(self) -> None:
         p = np.asarray(self.positions_m, dtype=float).reshape(-1, 3)
