@@ -1,9 +1,9 @@
 """Compiled per-patch loops of ``raster.prepare`` (numba, cached on disk): culling and projecting each patch into
 one camera, and the affine rows of its inverse homography.
 
-Float64 throughout, with the operations in the order of the vectorised numpy version they replace (cross and dot
-products are ``vec3``'s; rows of four summed left to right, as numpy sums them), so the prepared patches
-are the same bit for bit.
+Float64 throughout, with the operations in the order of the vectorised numpy formulas (cross and dot products are
+``vec3``'s; rows of four summed left to right, as numpy sums them), so the prepared patches are those formulas' to
+the bit.
 """
 
 from __future__ import annotations

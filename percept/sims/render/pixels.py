@@ -1,10 +1,9 @@
 """Compiled per-pixel loops of the rasteriser (numba, cached on disk): the large patches one by one over their
 boxes, the small ones as one fragment per inside pixel, and the shading of the small ones' winners.
 
-The arithmetic is the vectorised numpy version's, operation for operation and in its precision (float32 for
-1/Z and texture coordinates, float64 where numpy promoted), so the images are the same bit for bit: every
-float32 value is cast explicitly, because numba (unlike numpy) widens float32 with a float64 literal to
-float64. ``fragments.py`` holds what OpenCV does (texture warps and samples) and the order of the passes.
+The arithmetic is that of the vectorised numpy formulas, operation for operation and in their precision (float32 for
+1/Z and texture coordinates, float64 where numpy promotes), so the images are theirs to the bit: every float32
+value is cast explicitly, because numba (unlike numpy) widens float32 with a float64 literal to float64. ``fragments.py`` holds what OpenCV does (texture warps and samples) and the order of the passes.
 """
 
 from __future__ import annotations
@@ -68,8 +67,8 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
     held = np.zeros(len(order), np.int64)
     ends = np.zeros(len(order), np.int64)
     # every inside pixel of a patch lies in its box, so the boxes of the patches with an id bound the silhouettes: the
-    # buffers are allocated once, never grown in the loop (an array reassigned in the pixel loop kept LLVM from
-    # optimising it: the kernel ran 4-5x slower, with the same output)
+    # buffers are allocated once, never grown in the loop (an array reassigned in the pixel loop keeps LLVM from
+    # optimising the loop)
     bound = 0
     if want_sil:
         for k in range(len(order)):
