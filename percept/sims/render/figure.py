@@ -1,8 +1,8 @@
 """The primitives a pedestrian's figure is built from, compiled (numba): view-facing tapered limbs, view-facing
 discs and boxes, collected as rows of a buffer, then lowered onto the ground and packed as the renderer's patches.
 
-A figure is some fifty thousand tuple operations, too many for the interpreter in every frame. These functions are
-compiled, with the float64 operations of their Python reading in the same order:
+A figure is some fifty thousand tuple operations, too many for the interpreter in every frame. These functions run
+compiled, and do the float64 operations the interpreter would do, in the same order:
 ``vec3``'s tuple functions, Python's ``min``/``max`` (which keep the first of equal arguments; ``pymin``,
 ``pymax``), and no ``math.hypot`` of two non-zero numbers (the C library's, which numba calls, differs from
 CPython's in the last bit for about 0.6% of arguments; see ``pedestrian._body``). So a figure is the same to the
