@@ -92,8 +92,8 @@ def _pairwise_leaf(a, lo, n):  # pragma: no cover - compiled
 def pairwise_sum(a, lo, n):  # pragma: no cover - compiled
     """``np.sum`` of ``a[lo:lo + n]`` (1-D, contiguous) bit for bit: numpy's pairwise summation in the array's own
     type (numpy/_core/src/umath/loops_utils.h.src, ``pairwise_sum``): a run longer than 128 is the sum of its two
-    halves, split at a multiple of 8. numpy recurses; this walks the same tree with a stack (numba does not cache
-    recursive functions safely: loaded from its cache, one crashed)."""
+    halves, split at a multiple of 8. numpy recurses; this walks the same tree with a stack (numba's disk cache is
+    not safe for recursive functions)."""
     # tasks (start, length, halves done?) and the partial sums, post-order: left half, right half, then their sum
     starts, lengths, combine = np.empty(128, np.int64), np.empty(128, np.int64), np.empty(128, np.bool_)
     sums = np.empty(64, a.dtype)
@@ -139,7 +139,7 @@ def floor_quotient(a, b):  # pragma: no cover - compiled
     """floor(a / b) of float32 a and b > 0 as an int64, exactly numpy's ``a // b`` (``floor_divide``) wherever the
     multiple of b below a is a float32, as for a corner's grid cell (tests/odometry/test_features_reference.py): the
     quotient in float64, then moved to the multiple q with q b <= a < (q + 1) b, the products exact in float64 for
-    whole q under 2^29. No ``fmod``, which cost most of the corner selection's pass."""
+    whole q under 2^29. No ``fmod``: it would cost more than the rest of the corner selection's pass."""
     a64, b64 = np.float64(a), np.float64(b)
     q = np.floor(a64 / b64)
     if q * b64 > a64:

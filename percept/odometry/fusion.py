@@ -33,44 +33,30 @@ GATE_CHI2 = {2: 9.21, 3: 11.34}
 
 @dataclass(frozen=True)
 class FusionNoise:
-    """gyro_sigma_rps, accel_sigma_mps2: white noise of one IMU sample; gyro_bias_walk [rad/s/sqrt(s)];
-    wheel_sigma_mps: of one wheel-speed sample; wheel_scale_sigma: prior std of the wheel scale error;
-    init_bias_sigma_rps: prior std of the gyro bias; accel_bias_walk [m/s²/sqrt(s)], init_accel_bias_mps2: the
-    accelerometer bias's random walk and prior std; vo_scale_sigma, vo_yaw_drift_sigma_rad_per_m: prior std of
-    visual odometry's systematic errors (translation scale, yaw per metre travelled), with vo_bias_walk their
-    relative random walk per sqrt(s): without landmarks they are unobservable and the estimate's covariance grows
-    with the distance as it should (a NaN or implausible IMU or wheel sample, by ``percept.sensors``' one rule, is
-    rejected); vo_scale_translation, vo_scale_rotation: multiply the visual odometry's
-    own variances of translation and of yaw (its covariance comes from the reprojection residuals alone and leaves
-    out the keyframe points' depth error; these factors were measured from its innovations on `loop`);
-    vo_step_floor: standard deviations (along [m], across [m], yaw [rad]) added to every keyframe span's relative
-    motion, whatever its residuals say, below the spans' errors as measured against the truth (2026-11-28,
-    ``tools/vo_span_errors.py``, 2 362 spans of `loop` and `lead-brake` in clear, `lead-brake` and `highway` in
-    rain: standard deviations of 4.0-5.5 cm along, 1.2-2.8 cm across and 1.7-2.5e-4 rad in yaw, by day over spans
-    of 5 frames as in rain over 2), while the residuals' covariance varied far more from span to span (a span's
-    squared error over its own variance had a median of 2.6-3.0 and a 90th percentile of 20-27 before the
-    scale factors). Without the floor, on `lead-brake` seed 2 (odometry alone on vision) the second span, 7.5 cm
-    (1.5 %) short, set the filter's speed 0.6 m/s low with a standard deviation of 6 cm/s, the gate refused three of
-    the next five spans, and the estimate stayed outside its 3-sigma bound to the end;
-    lockout_sightings, lockout_widen: after this many landmark sightings refused in a row, the pose variances are
-    multiplied by lockout_widen."""
+    """Noise model of ``PoseFilter``: the sensors' white noise, the random walks and priors of their biases, and the
+    scaling of visual odometry's own covariance."""
 
-    gyro_sigma_rps: float = 0.003
-    accel_sigma_mps2: float = 0.08
-    gyro_bias_walk: float = 0.0003
-    wheel_sigma_mps: float = 0.07
-    wheel_scale_sigma: float = 0.015
-    init_bias_sigma_rps: float = 0.002
-    accel_bias_walk: float = 0.003
-    init_accel_bias_mps2: float = 0.02
-    vo_scale_sigma: float = 0.003
-    vo_yaw_drift_sigma_rad_per_m: float = 2e-5
-    vo_bias_walk: float = 0.2
-    vo_scale_translation: float = 9.0
-    vo_scale_rotation: float = 4.0
-    vo_step_floor: tuple[float, float, float] = (0.03, 0.015, 1.5e-4)
-    lockout_sightings: int = 3
-    lockout_widen: float = 4.0
+    gyro_sigma_rps: float = 0.003  # white noise of one gyro sample [rad/s]
+    accel_sigma_mps2: float = 0.08  # white noise of one accelerometer sample [m/s²]
+    gyro_bias_walk: float = 0.0003  # random walk of the gyro bias [rad/s/sqrt(s)]
+    wheel_sigma_mps: float = 0.07  # white noise of one wheel-speed sample [m/s]
+    wheel_scale_sigma: float = 0.015  # prior std of the wheel scale error [1]
+    init_bias_sigma_rps: float = 0.002  # prior std of the gyro bias [rad/s]
+    accel_bias_walk: float = 0.003  # random walk of the accelerometer bias [m/s²/sqrt(s)]
+    init_accel_bias_mps2: float = 0.02  # prior std of the accelerometer bias [m/s²]
+    vo_scale_sigma: float = 0.003  # prior std of visual odometry's translation scale error [1]
+    vo_yaw_drift_sigma_rad_per_m: float = 2e-5  # prior std of visual odometry's yaw drift [rad/m travelled]
+    # without landmarks the VO errors are unobservable: their covariance grows with the distance, as it should
+    vo_bias_walk: float = 0.2  # random walk of both VO errors, relative to their prior std [1/sqrt(s)]
+    # VO's covariance comes from the reprojection residuals alone and leaves out the keyframe points' depth error
+    vo_scale_translation: float = 9.0  # factor on VO's translation variances
+    vo_scale_rotation: float = 4.0  # factor on VO's yaw variance
+    # added to every keyframe span's motion whatever its residuals say: their covariance varies far more from span
+    # to span than the spans' true errors, and one over-confident span would set the speed wrong and make the gate
+    # refuse the spans after it
+    vo_step_floor: tuple[float, float, float] = (0.03, 0.015, 1.5e-4)  # span std: along, across [m], yaw [rad]
+    lockout_sightings: int = 3  # landmark sightings refused in a row before the pose variances are widened
+    lockout_widen: float = 4.0  # factor on the pose variances after such a lock-out
 
 
 class _Ekf(ExtendedKalmanFilter):

@@ -40,22 +40,18 @@ class LandmarkSighting:
 
 @dataclass(frozen=True)
 class SightingConfig:
-    """min_range_m, max_range_m: camera depths at which a sign is looked for; corner_sigma_px: a refined marker
-    corner's error at the least (a sighting whose corners disagree between the images gets more); face_sigma_m:
-    how far the face centre may lie from the mapped point (face offset, survey); margin_px: added around a
-    predicted window; sigma_window: pose-uncertainty sigmas the window covers; marker_side_m: the side of a sign's
-    marker, its black square [m] (0.7 of the simulator's 0.9 m panel); min_perimeter_share: ArUco skips candidates
-    whose perimeter is under this share of the marker's expected one (at its predicted range, face on): most of its
-    cost is in the small ones."""
+    """Settings of ``LandmarkFinder``: where signs are looked for, the search windows and the sightings' errors."""
 
-    min_range_m: float = 4.0
-    max_range_m: float = 32.0
-    corner_sigma_px: float = 0.3
-    face_sigma_m: float = 0.06
-    margin_px: int = 12
-    sigma_window: float = 3.0
-    marker_side_m: float = 0.63
-    min_perimeter_share: float = 0.25
+    min_range_m: float = 4.0  # least camera depth at which a sign is looked for [m]
+    max_range_m: float = 32.0  # largest camera depth at which a sign is looked for [m]
+    # a sighting whose corners disagree between the images gets more
+    corner_sigma_px: float = 0.3  # a refined marker corner's least error [px]
+    face_sigma_m: float = 0.06  # how far the face centre may lie from the mapped point (face offset, survey) [m]
+    margin_px: int = 12  # added around a predicted window [px]
+    sigma_window: float = 3.0  # pose-uncertainty sigmas a window covers
+    marker_side_m: float = 0.63  # side of a sign's marker, its black square: 0.7 of the simulator's 0.9 m panel [m]
+    # ArUco skips the smaller candidates, where most of its cost is
+    min_perimeter_share: float = 0.25  # least share of the marker's expected perimeter (predicted range, face on)
 
 
 class LandmarkFinder:

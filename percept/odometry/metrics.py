@@ -6,7 +6,7 @@ vehicle transforms ((N, 3, 4) KITTI rows are accepted too). Estimate and truth a
 
 References: Geiger, Lenz & Urtasun 2012, "Are we ready for autonomous driving? The KITTI vision
 benchmark suite" (CVPR), odometry protocol of its devkit; Sturm et al. 2012, "A benchmark for the
-evaluation of RGB-D SLAM systems" (IROS), absolute trajectory error. DESIGN, "Scoring definitions":
+evaluation of RGB-D SLAM systems" (IROS), absolute trajectory error. docs/design.md, "Scoring definitions":
 KITTI's protocol with segment lengths scaled to the run's length; ATE RMSE from the known start
 pose, no alignment.
 """

@@ -14,10 +14,8 @@ none; the plane m is then read from H given R and t (linear least squares), and 
 (as in e.g. Song & Chandraker 2014, "Robust scale estimation in real-time monocular SFM for autonomous driving").
 The scale in use is the median of the recent estimates; when the road cannot be aligned it is the last good one.
 
-Why direct alignment, not triangulated road corners: on the KITTI frames in ../shared/data the corners' RANSAC
-plane gave scales 8-13 % too small (median; 19-26 % rms): asphalt has few corners, the fit took the pavement
-beside the road, and KLT's translational model is biased by the road's perspective change. The aligned road
-homography gave -0.8 % (2.5 % rms).
+The road is aligned directly, not fitted through triangulated corners: asphalt has few corners, a corner fit takes
+the pavement beside the road, and KLT's translational model is biased by the road's perspective change.
 
 The first frame has no motion to measure: it returns ``VOStep.failed("first frame")`` (identity motion), so a
 trajectory built from the steps starts at the first camera. Dark or featureless frames, too few inliers, near-zero
@@ -39,40 +37,29 @@ from .types import VOStep
 
 @dataclass(frozen=True)
 class MonoVOConfig:
-    """Settings of ``MonoVO`` (pixels at the input resolution).
+    """Settings of ``MonoVO``: corners, KLT, the essential matrix, the road alignment and the scale's history
+    (pixels at the input resolution)."""
 
-    max_features: corners detected (cv2.goodFeaturesToTrack, quality ``quality``, ``min_distance_px`` apart);
-    min_tracked: fewer tracked points than this -> new corners are added (a keyframe); klt_window_px, klt_levels:
-    pyramidal Lucas-Kanade; fb_max_px: largest forward-backward tracking error kept; ransac_px: epipolar distance
-    of an essential-matrix inlier; min_inliers: fewer -> failed step; min_flow_px: median track motion below this
-    -> "no motion" (failed); road_range_m, road_half_width_m: the road region is the level road nearer than this
-    and within this of the camera's axis; max_tilt_rad: largest angle between the road's normal and the camera's
-    down axis; min_road_ncc: smallest correlation of an accepted road alignment; ecc_iterations: of the
-    alignment; sweep_steps, sweep_step_m: the sweep of the first alignment tries steps of sweep_step_m[0] ..
-    sweep_step_m[1] metres per frame; scale_window: estimates in the median; max_scale_jump: an estimate more
-    than this factor from the median is refused; min_intensity_std: frames flatter than this fail.
-    """
-
-    max_features: int = 1500
-    min_tracked: int = 600
-    quality: float = 0.01
-    min_distance_px: float = 8.0
-    klt_window_px: int = 21
-    klt_levels: int = 3
-    fb_max_px: float = 1.0
-    ransac_px: float = 1.0
-    min_inliers: int = 30
-    min_flow_px: float = 0.5
-    road_range_m: float = 20.0
-    road_half_width_m: float = 2.0
-    max_tilt_rad: float = 0.2
-    min_road_ncc: float = 0.8
-    ecc_iterations: int = 50
-    sweep_steps: int = 40
-    sweep_step_m: tuple[float, float] = (0.1, 5.0)
-    scale_window: int = 5
-    max_scale_jump: float = 1.5
-    min_intensity_std: float = 2.0
+    max_features: int = 1500  # corners detected (cv2.goodFeaturesToTrack)
+    min_tracked: int = 600  # fewer tracked points and new corners are added (a keyframe)
+    quality: float = 0.01  # goodFeaturesToTrack's quality level (share of the strongest corner's response)
+    min_distance_px: float = 8.0  # least distance between two corners [px]
+    klt_window_px: int = 21  # pyramidal Lucas-Kanade's window side [px]
+    klt_levels: int = 3  # pyramidal Lucas-Kanade's pyramid levels
+    fb_max_px: float = 1.0  # largest forward-backward tracking error kept [px]
+    ransac_px: float = 1.0  # epipolar distance of an essential-matrix inlier [px]
+    min_inliers: int = 30  # fewer inliers and the step fails
+    min_flow_px: float = 0.5  # a median track motion below this is no motion (a failed step) [px]
+    road_range_m: float = 20.0  # the road region is the level road nearer than this [m]
+    road_half_width_m: float = 2.0  # ... and within this of the camera's axis [m]
+    max_tilt_rad: float = 0.2  # largest angle between the road's normal and the camera's down axis [rad]
+    min_road_ncc: float = 0.8  # least correlation of an accepted road alignment
+    ecc_iterations: int = 50  # iterations of the ECC road alignment
+    sweep_steps: int = 40  # steps the first alignment's sweep tries
+    sweep_step_m: tuple[float, float] = (0.1, 5.0)  # the sweep's least and largest motion per frame [m]
+    scale_window: int = 5  # scale estimates in the median
+    max_scale_jump: float = 1.5  # an estimate more than this factor from the median is refused
+    min_intensity_std: float = 2.0  # frames whose grey-level std is below this fail (dark or featureless)
 
     def __post_init__(self) -> None:
         for name in ("max_features", "min_tracked", "klt_levels", "min_inliers", "scale_window", "sweep_steps",

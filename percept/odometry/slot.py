@@ -26,9 +26,8 @@ GOOD_SHARE = 0.5
 CLEAN_NOISE_GREY = 1.0
 """A keyframe pose measured from n < FEW_INLIERS PnP inliers, or whose inliers are a share q < GOOD_SHARE of the
 points tracked, or in images noisier than CLEAN_NOISE_GREY (sigma s, grey levels), has its standard deviations
-widened by FEW_INLIERS / n, GOOD_SHARE / q and s / CLEAN_NOISE_GREY. Measured on `loop` at night when these were
-set: keyframe poses about 2 % short of the truth, a bias their reprojection residuals do not show (about 0.5 % since
-the dark keyframes' 11 px KLT windows; README, Odometry)."""
+widened by FEW_INLIERS / n, GOOD_SHARE / q and s / CLEAN_NOISE_GREY: such poses are biased (short of the truth at
+night) beyond what their reprojection residuals show."""
 
 
 @dataclass(frozen=True)
@@ -57,7 +56,8 @@ def _planar(T: np.ndarray) -> tuple[float, float, float]:
 
 
 class OdometrySlot:
-    """rig; dt_s: frame period [s]; landmarks: the map (None: no fixes); start: the known start pose."""
+    """The odometry slot of one run. rig: the stereo rig; dt_s: frame period [s]; landmarks: the map (None: no
+    fixes); start: the known start pose; noise: the filters' noise model."""
 
     def __init__(self, rig: StereoRig, dt_s: float, landmarks: LandmarkMap | None, start: Pose2D,
                  noise: FusionNoise = FusionNoise()):
@@ -75,7 +75,7 @@ class OdometrySlot:
     def reset(self) -> None:
         self.vo.reset()
         # without landmarks, VO's systematic errors cannot be told from the gyro bias and the wheel scale: the
-        # fused filter leaves them out (best accuracy, an over-confident heading on long runs, measured); the
+        # fused filter leaves them out (the better accuracy, for an over-confident heading on long runs); the
         # estimate, whose landmark fixes make them observable, carries them
         plain = replace(self.noise, vo_scale_sigma=0.0, vo_yaw_drift_sigma_rad_per_m=0.0)
         self.dead_reckoning = PoseFilter(self.start, plain)

@@ -5,9 +5,9 @@ At a keyframe, corners (FAST, strongest per grid cell) in the left image get the
 pose relative to the keyframe comes from PnP with RANSAC (points on moving vehicles and pedestrians disagree
 with the static world's motion and fall out as outliers) refined by Levenberg-Marquardt on the inliers; with a
 motion prior (wheel speed and gyro) that most points agree with, Levenberg-Marquardt starts from the prior and
-drops the points it cannot fit, without RANSAC. A new
-keyframe starts when too few inliers are left. References: Nistér, Naroditsky & Bergen 2004, "Visual
-odometry" (CVPR); Geiger, Ziegler & Stiller 2011, "StereoScan" (IV); Hartley & Zisserman, ch. 6-7 (PnP).
+drops the points it cannot fit, without RANSAC. A new keyframe starts when too few inliers are left.
+References: Nistér, Naroditsky & Bergen 2004, "Visual odometry" (CVPR); Geiger, Ziegler & Stiller 2011,
+"StereoScan" (IV); Hartley & Zisserman, ch. 6-7 (PnP).
 """
 
 from __future__ import annotations
@@ -27,43 +27,33 @@ from .types import VOStep
 
 @dataclass(frozen=True)
 class StereoVOConfig:
-    """max_features: corners per keyframe; grid: cells (columns, rows) the corners are spread over;
-    fast_threshold: FAST's intensity threshold; levels: KLT pyramid levels without a motion prior; win_px and
-    prior_levels: KLT's window and, when a motion prior says where to start, its pyramid levels (a shallow pyramid
-    suffices and costs less) from a keyframe of low contrast, whose grey levels' standard deviation is below
-    low_contrast_grey (the simulator's rain: 25.5-32.2 on 2 700 frames; a large window holds enough texture through
-    the streaks); lit_win_px and lit_prior_levels: the same from a keyframe in daylight with contrast (glare's frames:
-    40.2-48.4 on 1 080; the KITTI frames in ../shared/data 51.5-66.6): small windows on one level, about
-    1 ms a frame less, VO as accurate by day and better in glare (README, Odometry); there, tracking without a prior
-    keeps win_px windows on levels (a motion nothing predicts needs the larger window); dark_grey, dark_win_px: from
-    a keyframe whose mean grey level is below dark_grey (night: a scene lit by the car's own lamps) KLT tracks with
-    dark_win_px windows and prior_levels (the beam's light stays put in the image while the road moves through it, a
-    brightness change KLT's constancy assumption cannot explain; a smaller window holds less of it; the simulator's
-    night frames have a mean grey level of 53-56, every other condition's 129 or more, the KITTI frames 85-107);
-    max_row_err_px: a stereo match must stay on its row (rectified pair); min_disparity_px: farthest usable
-    point (f b / d); min_inliers: fewer and the step fails; keyframe_inliers: fewer starts a new keyframe;
-    ransac_px: PnP RANSAC reprojection threshold; prior_gate_px, prior_gate_frac: with a motion prior, a point whose
-    image lies further than prior_gate_px + prior_gate_frac x (its image motion since the keyframe) from where the
-    prior puts it is left out of PnP (it moves: a vehicle, a pedestrian; or it was tracked wrongly)."""
+    """Settings of ``StereoVO``: corners, KLT windows by the keyframe's light, stereo matches, PnP and the prior's
+    gate (pixels at the input resolution)."""
 
-    max_features: int = 400
-    grid: tuple[int, int] = (10, 6)
-    fast_threshold: int = 5
-    win_px: int = 15
-    levels: int = 3
-    dark_grey: float = 70.0
-    dark_win_px: int = 11
-    prior_levels: int = 1
-    low_contrast_grey: float = 36.0
-    lit_win_px: int = 11
-    lit_prior_levels: int = 0
-    max_row_err_px: float = 0.7
-    min_disparity_px: float = 0.5
-    min_inliers: int = 12
-    keyframe_inliers: int = 60
-    ransac_px: float = 0.7
-    prior_gate_px: float = 3.0
-    prior_gate_frac: float = 0.15
+    max_features: int = 400  # corners per keyframe
+    grid: tuple[int, int] = (10, 6)  # cells (columns, rows) the corners are spread over
+    fast_threshold: int = 5  # FAST's least intensity threshold [grey levels]
+    # a large window holds enough texture through rain's streaks; a motion nothing predicts needs it too
+    win_px: int = 15  # KLT window side without a motion prior, and with one from a low-contrast keyframe [px]
+    levels: int = 3  # KLT pyramid levels without a motion prior
+    # at night the beam's light stays put in the image while the road moves through it, a brightness change KLT's
+    # constancy assumption cannot explain: a smaller window holds less of it
+    dark_grey: float = 70.0  # below this mean grey level a keyframe is dark (simulated night 53-56, daylight 85+)
+    dark_win_px: int = 11  # KLT window side from a dark keyframe, with a motion prior or without [px]
+    prior_levels: int = 1  # KLT pyramid levels with a motion prior from a dark or low-contrast keyframe
+    low_contrast_grey: float = 36.0  # below this grey-level std a keyframe has low contrast (rain 25-33, day 40+)
+    # small windows on one level by day with contrast: a motion prior says where to start
+    lit_win_px: int = 11  # KLT window side with a motion prior from a lit keyframe with contrast [px]
+    lit_prior_levels: int = 0  # KLT pyramid levels with a motion prior from a lit keyframe with contrast
+    max_row_err_px: float = 0.7  # a stereo match must stay this close to its row (rectified pair) [px]
+    min_disparity_px: float = 0.5  # the farthest usable point's disparity, f b / Z [px]
+    min_inliers: int = 12  # fewer PnP inliers and the step fails
+    keyframe_inliers: int = 60  # fewer PnP inliers and this frame starts a new keyframe
+    ransac_px: float = 0.7  # PnP's reprojection threshold of an inlier [px]
+    # with a motion prior, a point further than prior_gate_px + prior_gate_frac x (its image motion since the
+    # keyframe) from where the prior puts it is left out of PnP: it moves (a vehicle, a person) or was tracked wrongly
+    prior_gate_px: float = 3.0  # the gate's constant part [px]
+    prior_gate_frac: float = 0.15  # the gate's share of the point's image motion since the keyframe
 
     def __post_init__(self) -> None:
         if self.max_features < 20 or self.min_inliers < 6 or self.keyframe_inliers < self.min_inliers:

@@ -44,8 +44,8 @@ def iou_matrix(a_boxes: np.ndarray, b_boxes: np.ndarray) -> np.ndarray:
 
 def iou(a, b) -> float:
     """Intersection over union of two boxes (u0, v0, u1, v1) [px]: ``iou_matrix``'s arithmetic for one pair, in Python
-    floats (the same IEEE doubles, so the same value) rather than (1, 1) arrays, whose checks and ufuncs cost ~30x
-    more."""
+    floats (the same IEEE doubles, so the same value) rather than (1, 1) arrays, whose checks and ufuncs cost many
+    times more."""
     (au0, av0, au1, av1), (bu0, bv0, bu1, bv1) = _one_box(a, "iou A"), _one_box(b, "iou B")
     # |A ∩ B| = max(0, min(u1) - max(u0)) * max(0, min(v1) - max(v0))
     w, h = min(au1, bu1) - max(au0, bu0), min(av1, bv1) - max(av0, bv0)

@@ -15,17 +15,14 @@ import numpy as np
 
 @dataclass(frozen=True)
 class PinholeCamera:
-    """Intrinsics of an undistorted pinhole camera.
+    """Intrinsics of an undistorted pinhole camera."""
 
-    fx, fy: focal lengths [px]; cx, cy: principal point [px]; width, height: image size [px].
-    """
-
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-    width: int
-    height: int
+    fx: float  # focal length along the columns [px]
+    fy: float  # focal length along the rows [px]
+    cx: float  # principal point's column [px]
+    cy: float  # principal point's row [px]
+    width: int  # image width [px]
+    height: int  # image height [px]
 
     def __post_init__(self) -> None:
         if not (self.fx > 0 and self.fy > 0):

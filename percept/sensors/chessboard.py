@@ -165,7 +165,7 @@ def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], squar
 
     square_m scales the board (it changes no intrinsic). Only photos of the most common size are used: a photo of
     another size (e.g. 1281x721 among 1280x720) is a resized or cropped copy whose pixels do not share the
-    intrinsics, and keeping such photos raises the RMS error (udacity camera_cal: 1.00 px with, 0.85 px without).
+    intrinsics, and keeping such photos raises the RMS error.
     Raises ValueError when no photo is readable or the board is found in none.
     """
     cols, rows = pattern

@@ -36,14 +36,13 @@ def _default_camera() -> PinholeCamera:
 
 @dataclass(frozen=True)
 class StereoRig:
-    """camera: intrinsics shared by both cameras; baseline_m [m]; mount_height_m [m] above the road;
-    pitch_rad [rad], positive looks down; mount_x_m [m] ahead of the vehicle centre."""
+    """Where the two cameras sit on the car and what they see (see the module docstring)."""
 
-    camera: PinholeCamera = field(default_factory=_default_camera)
-    baseline_m: float = 0.54
-    mount_height_m: float = 1.4
-    pitch_rad: float = 0.0
-    mount_x_m: float = 0.8
+    camera: PinholeCamera = field(default_factory=_default_camera)  # intrinsics shared by both cameras
+    baseline_m: float = 0.54  # distance between the optical centres [m]
+    mount_height_m: float = 1.4  # the optical centres' height above the road [m]
+    pitch_rad: float = 0.0  # positive looks down [rad]
+    mount_x_m: float = 0.8  # how far ahead of the vehicle centre the cameras sit [m]
 
     def __post_init__(self) -> None:
         if not self.baseline_m > 0:

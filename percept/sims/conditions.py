@@ -17,6 +17,8 @@ from .normals import standard_normal_f32
 
 
 class Condition(str, Enum):
+    """The photometric condition a run's cameras see (``CONDITION_SUMMARY`` says what each does)."""
+
     CLEAR = "clear"
     NIGHT = "night"
     RAIN = "rain"
@@ -38,6 +40,7 @@ DROPOUT_RATE = 0.10
 
 
 def frame_rng(seed: int, frame: int, camera: int) -> np.random.Generator:
+    """The generator of one camera's effects in one frame of a run."""
     return np.random.default_rng([seed, frame, camera, 0xC0FFEE])
 
 
@@ -133,7 +136,7 @@ class ConditionEffects:
 
     def _scratch(self, name: str, channels: int = 1) -> np.ndarray:
         """A float32 (H, W[, channels]) buffer kept between frames: a fresh full-frame array each time costs
-        more in page faults than the arithmetic done in it (rain measured 50 against 34 ms a frame)."""
+        more in page faults than the arithmetic done in it."""
         b = self._buffers.get(name)
         if b is None:
             shape = (self.H, self.W) if channels == 1 else (self.H, self.W, channels)
@@ -197,7 +200,7 @@ class ConditionEffects:
             n = standard_normal_f32(rng, self._scratch("out", 3))
             # out = f + 10 n, then a row banding of 3 n_row, clipped and truncated to uint8
             return passes.noisy_uint8(img, n, np.float32(3.0) * rng.standard_normal((self.H, 1), dtype=np.float32))
-        # rain and glare: numpy's clip and cast (a compiled pass for them alone measured no faster; the night's and the
+        # rain and glare: numpy's clip and cast (a compiled pass for them alone is no faster; the night's and the
         # noise's are fused with their last sum above)
         np.clip(out, 0, 255, out=out)
         return out.astype(np.uint8)

@@ -18,10 +18,9 @@ from percept.sensors.vehicle import ACCEL_RANGE_MPS2, STEER_RANGE_RAD
 from .actors import Pedestrian, ScriptedVehicle
 
 
-
 class NoObservation(ObservationType):
-    """percept's agent sees only the cameras (rendered by SimWorld), so highway-env computes no observation
-    (its Kinematics table costs about two thirds of a simulation step)."""
+    """percept's agent sees only the cameras (rendered by SimWorld), so highway-env computes no observation: its
+    Kinematics table would cost more than the rest of a simulation step."""
 
     def space(self) -> spaces.Space:
         return spaces.Box(0.0, 0.0, shape=(0,), dtype=np.float32)

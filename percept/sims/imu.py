@@ -16,15 +16,14 @@ from percept.sensors import ImuSample, wrap_angle
 
 @dataclass(frozen=True)
 class ImuNoise:
-    """accel_sigma_mps2, gyro_sigma_rps: white noise per sample; *_bias_walk: bias random walk per sqrt(s);
-    wheel_sigma_mps: white noise; wheel_scale_sigma: std of the fixed scale error (0.01 = 1 %)."""
+    """Error model of the simulated IMU and wheel-speed sensor."""
 
-    accel_sigma_mps2: float = 0.05
-    gyro_sigma_rps: float = 0.002
-    accel_bias_walk: float = 0.002
-    gyro_bias_walk: float = 0.0002
-    wheel_sigma_mps: float = 0.05
-    wheel_scale_sigma: float = 0.01
+    accel_sigma_mps2: float = 0.05  # accelerometer white noise per sample [m/s²]
+    gyro_sigma_rps: float = 0.002  # gyro white noise per sample [rad/s]
+    accel_bias_walk: float = 0.002  # accelerometer bias random walk [m/s²/sqrt(s)]
+    gyro_bias_walk: float = 0.0002  # gyro bias random walk [rad/s/sqrt(s)]
+    wheel_sigma_mps: float = 0.05  # wheel-speed white noise per sample [m/s]
+    wheel_scale_sigma: float = 0.01  # std of the fixed wheel scale error (tyre radius; 0.01 = 1 %)
 
 
 class ImuModel:

@@ -12,10 +12,9 @@ copy of numpy's tables.
 The uint32s come from the Generator's own bit generator, PCG64 (``np.random.default_rng``'s; O'Neill 2014, "PCG: A
 Family of Simple Fast Space-Efficient Statistically Good Algorithms for Random Number Generation", the XSL-RR
 128/64 output), stepped here in the kernel from its state and written back after, as numpy's pcg64.h steps it: a
-128-bit LCG, each 64-bit output giving two uint32s, the low half first and the high half kept for the next. (Each
-uint32 through numba's call into the bit generator cost a call through a pointer; the draws are about 3x as fast
-stepped in the kernel.) Another bit generator is left to numpy's own draws. The conditions' noise is drawn with it
-(night, noise).
+128-bit LCG, each 64-bit output giving two uint32s, the low half first and the high half kept for the next: stepped
+in the kernel, not through numba's call into the bit generator, which costs a call through a pointer per uint32.
+Another bit generator is left to numpy's own draws. The conditions' noise (night, noise) is drawn with it.
 """
 
 from __future__ import annotations

@@ -22,6 +22,7 @@ class ObjectIds:
         self.static_states: dict[int, ObjectState] = {}
 
     def __call__(self, obj) -> int:
+        """The id of ``obj``, given on its first sight."""
         key = id(obj)
         if key not in self._ids:
             self._ids[key] = len(self._ids) + 1
@@ -30,6 +31,8 @@ class ObjectIds:
 
 
 def object_state(obj, oid: int) -> ObjectState | None:
+    """The renderer's state of a highway-env road object with id ``oid`` (world frame); None for an object that is
+    not drawn (highway-env's goal markers)."""
     pose = hw_pose(obj)
     if isinstance(obj, Pedestrian):
         return ObjectState(oid, ObjectKind.PEDESTRIAN, pose, obj.LENGTH, obj.WIDTH, obj.height_m, style=obj.style,

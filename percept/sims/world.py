@@ -24,11 +24,13 @@ TRUTH_RANGE_M = 200.0
 
 
 def check_scenario(name: str) -> None:
+    """ValueError naming the scenarios unless ``name`` is one of them."""
     if name not in SCENARIOS:
         raise ValueError(f"unknown scenario '{name}'; choose one of: {', '.join(SCENARIOS)}")
 
 
 def check_condition(name: str) -> Condition:
+    """The Condition called ``name``; ValueError naming the conditions when there is none."""
     try:
         return Condition(name)
     except ValueError:
@@ -38,15 +40,15 @@ def check_condition(name: str) -> Condition:
 
 @dataclass(frozen=True)
 class WorldConfig:
-    """scenario: a name from SCENARIOS; seed; condition; rig; autopilot: highway-env's IDM drives the ego
-    (for rendering data sets) instead of the actions passed to ``step``; scenery: roadside clutter on/off."""
+    """What ``SimWorld`` simulates: the scenario, its seed, the condition and the rig."""
 
-    scenario: str = "highway"
-    seed: int = 0
-    condition: Condition = Condition.CLEAR
-    rig: StereoRig = field(default_factory=StereoRig)
+    scenario: str = "highway"  # a name from SCENARIOS
+    seed: int = 0  # seeds the scenario's traffic and people, the textures, the IMU's noise and the condition
+    condition: Condition = Condition.CLEAR  # the photometric condition applied to both cameras
+    rig: StereoRig = field(default_factory=StereoRig)  # the stereo rig on the ego
+    # True for rendering data sets: highway-env's IDM drives the ego instead of the actions passed to ``step``
     autopilot: bool = False
-    scenery: bool = True
+    scenery: bool = True  # roadside clutter (rails, poles, trees, buildings) on or off
 
     def __post_init__(self) -> None:
         check_scenario(self.scenario)

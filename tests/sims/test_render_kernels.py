@@ -109,8 +109,8 @@ def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
 WARM_CHECK = """
 from percept.compiled import dispatchers
 from percept.sims import SimWorld, WorldConfig, condition_passes, conditions, normals
-from percept.sims.render import cull, ground, paint, pedestrian, pixels, spans
-modules = (pixels, cull, spans, pedestrian, ground, paint, condition_passes, normals)
+from percept.sims.render import cull, ground, paint, pedestrian, pixels, small_patches, spans
+modules = (pixels, small_patches, cull, spans, pedestrian, ground, paint, condition_passes, normals)
 kernels = dispatchers(*modules)
 # the world's renderer and its night effects warm their kernels up when they are built, and so do the other
 # conditions' effects

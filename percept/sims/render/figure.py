@@ -1,8 +1,8 @@
 """The primitives a pedestrian's figure is built from, compiled (numba): view-facing tapered limbs, view-facing
 discs and boxes, collected as rows of a buffer, then lowered onto the ground and packed as the renderer's patches.
 
-Building a figure in Python took about 0.4 ms (some fifty thousand tuple operations), 1.6-2 ms of a `crossing`
-stereo pair. These are the same functions compiled, with the same float64 operations in the same order:
+A figure is some fifty thousand tuple operations, too many for the interpreter in every frame. These functions run
+compiled, and do the float64 operations the interpreter would do, in the same order:
 ``vec3``'s tuple functions, Python's ``min``/``max`` (which keep the first of equal arguments; ``pymin``,
 ``pymax``), and no ``math.hypot`` of two non-zero numbers (the C library's, which numba calls, differs from
 CPython's in the last bit for about 0.6% of arguments; see ``pedestrian._body``). So a figure is the same to the
@@ -31,7 +31,7 @@ SUN = vec(SUN_DIR)
 """Light direction (world) for the lit and shadowed halves of a limb: the renderer's sun."""
 
 # Explicit signatures for the functions called with constants (kinds, caps): numba would otherwise compile one
-# version per combination of those constants' values, which doubled the figure's first compile
+# version per combination of those constants' values
 _V3, _F, _I, _B = types.UniTuple(types.float64, 3), types.float64, types.int64, types.boolean
 _ROWS = types.float64[:, ::1]
 

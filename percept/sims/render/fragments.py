@@ -21,7 +21,8 @@ import numpy as np
 
 from percept.compiled import optional
 
-from .pixels import big_patches, clear_boxes, put_albedo, shade_winners, small_fragments, texel_coords, zbuffer_depth
+from .pixels import big_patches, clear_boxes, put_albedo, zbuffer_depth
+from .small_patches import shade_winners, small_fragments, texel_coords
 from .spans import smooth_edges, span_bounds
 from .textures import TextureAtlas
 
@@ -177,8 +178,8 @@ def _put_textures(target, p: PreparedPatches, atlas: TextureAtlas, order: np.nda
 
 def _small_patches(target, p: PreparedPatches, atlas: TextureAtlas, rp, v, first, last, sil) -> None:
     """All small patches at once, one fragment per inside pixel of their row spans (patch rp, row v, columns
-    first..last): the z-test (``pixels.small_fragments``), then the winners' texels sampled by OpenCV and their
-    ids, lamp flags and colours written (``pixels.shade_winners``)."""
+    first..last): the z-test (``small_patches.small_fragments``), then the winners' texels sampled by OpenCV and
+    their ids, lamp flags and colours written (``small_patches.shade_winners``)."""
     W = target.inv_depth.shape[1]
     wpix, wspan, wk, wc, sil_pix, sil_oid = small_fragments(target.inv_depth.reshape(-1), W, rp, v, first, last,
                                                             p.mc, p.obj_id, sil is not None)

@@ -36,15 +36,15 @@ HAZE_START_M, HAZE_RANGE_M, HAZE_MAX = 60.0, 400.0, 0.85
 
 @dataclass(frozen=True)
 class Palette:
-    """BGR colours of the scene's materials (0..255)."""
+    """BGR colours (0..255) of the scene's materials."""
 
-    sky_top: tuple = (215, 160, 105)
-    sky_horizon: tuple = (235, 215, 195)
-    haze: tuple = (205, 195, 185)
-    grass: tuple = (70, 125, 95)
-    asphalt: tuple = (105, 102, 100)
-    white_paint: tuple = (235, 238, 238)
-    yellow_paint: tuple = (60, 190, 225)
+    sky_top: tuple = (215, 160, 105)  # the sky at the image's top row
+    sky_horizon: tuple = (235, 215, 195)  # the sky at the horizon
+    haze: tuple = (205, 195, 185)  # the far ground fades to it
+    grass: tuple = (70, 125, 95)  # the verge, at mean albedo
+    asphalt: tuple = (105, 102, 100)  # the road surface, at mean albedo
+    white_paint: tuple = (235, 238, 238)  # lane lines
+    yellow_paint: tuple = (60, 190, 225)  # the left road edge
 
 
 def _lut(color: tuple, contrast: float) -> np.ndarray:

@@ -7,8 +7,8 @@ stretch over their period while fading to the period's mean (dash/period) — th
 average paint instead of sub-pixel dashes that alias and shimmer as the car moves.
 
 The per-sample and per-piece selection is compiled (numba, ``_surface_samples`` and ``_marking_pieces``) with the
-arithmetic of the numpy version it replaced, in its order (tests/sims/test_paint_reference.py holds it to that
-version bit for bit).
+arithmetic of the vectorised numpy formulas, in their order (tests/sims/test_paint_reference.py holds it to them bit
+for bit).
 """
 
 from __future__ import annotations

@@ -46,8 +46,8 @@ SHOES = [(25, 25, 28), (30, 50, 80), (215, 215, 215), (40, 40, 40)]
 # normative sagittal kinematics. HIP: thigh forwards of the vertical; KNEE: flexion; FOOT: shoe pitch
 # relative to the ground, toe down positive (heel-off late in stance, toe up at heel strike). The swing is on the
 # low side of normal (knee peak 51 deg, not the mean ~60, as at slower speeds: Koopman et al., J. Biomech. 47, 2014;
-# hip back near neutral at toe-off): with the mean curve the trailing shank kicks far back after toe-off, the pose
-# the photo-trained INRIA people detector missed most on crossing frames (tools/inria_look.py).
+# hip back near neutral at toe-off): with the mean curve the trailing shank kicks far back after toe-off, a pose
+# that people detectors trained on photos (INRIA) miss.
 GAIT_C = np.linspace(0.0, 1.0, 11)
 HIP = np.array([22.0, 19.0, 12.0, 5.0, -2.0, -9.0, -1.0, 12.0, 22.0, 25.0, 22.0])
 KNEE = np.array([2.0, 10.0, 15.0, 10.0, 8.0, 22.0, 36.0, 51.0, 38.0, 13.0, 2.0])
@@ -259,7 +259,7 @@ def _arms(rows, n: int, body: Body) -> int:
 def _figure(body: Body) -> np.ndarray:
     """The body's patches, lowered onto the ground and packed: (P, 19)."""
     rows = np.empty((160, ROW))
-    # the parts in the order they have always been added (legs, trunk, head, arms): it is part of the output
+    # the parts in a fixed order (legs, trunk, head, arms): the order is part of the output
     n = _legs(rows, 0, body)
     n = _trunk(rows, n, body)
     n = _head(rows, n, body)

@@ -1,10 +1,11 @@
-"""Compiled per-pixel loops of the rasteriser (numba, cached on disk): the large patches one by one over their
-boxes, the small ones as one fragment per inside pixel, and the shading of the small ones' winners.
+"""Compiled per-pixel loops of the rasteriser's large patches (numba, cached on disk): the patches one by one over
+their boxes, their textures' colours put where they still win, the depth read off the z-buffer and the silhouettes'
+summary. The small patches' loops are in ``small_patches.py``.
 
-The arithmetic is the vectorised numpy version's, operation for operation and in its precision (float32 for
-1/Z and texture coordinates, float64 where numpy promoted), so the images are the same bit for bit: every
-float32 value is cast explicitly, because numba (unlike numpy) widens float32 with a float64 literal to
-float64. ``fragments.py`` holds what OpenCV does (texture warps and samples) and the order of the passes.
+The arithmetic is that of the vectorised numpy formulas, operation for operation and in their precision (float32 for
+1/Z, float64 where numpy promotes), so the images are theirs to the bit: every float32 value is cast explicitly,
+because numba (unlike numpy) widens float32 with a float64 literal to float64. ``fragments.py`` holds what OpenCV
+does (texture warps) and the order of the passes.
 """
 
 from __future__ import annotations
@@ -51,33 +52,47 @@ def _near_columns(xa, xb, ma0, ay, mb0, by, mc0, cy, inv_near):  # pragma: no co
     return xa, xb
 
 
+@njit(cache=True, inline="always")
+def _inside_near(ap, bp, c, ellipse, inv_near):  # pragma: no cover - compiled
+    """The exact inside test of a pixel of a patch crossing the near plane: a' = ``ap``, b' = ``bp`` and c = 1/Z
+    (float32) inside the quad, max(|a'|, |b'|) <= c, or the ``ellipse``, a'^2 + b'^2 <= c^2, with 0 < c <
+    ``inv_near``."""
+    if ellipse:
+        inside = ap * ap + bp * bp <= c * c
+    else:
+        inside = max(abs(ap), abs(bp)) <= c
+    return inside and c < inv_near and c > 0
+
+
+@njit(cache=True)
+def _silhouette_bound(order, obj_id, x0, x1, y0, y1):  # pragma: no cover - compiled
+    """How many pixels the boxes of the patches ``order`` with an object id > 0 cover (with repeats): every inside
+    pixel of a patch lies in its box, so this bounds the silhouettes' pixels."""
+    bound = 0
+    for k in range(len(order)):
+        i = order[k]
+        if obj_id[i] > 0:
+            bound += (x1[i] - x0[i]) * (y1[i] - y0[i])
+    return bound
+
+
 @kernel()
 def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, ellipse, span_row, los, his,
                 obj_id, emissive, color, defer, want_sil, inv_near):  # pragma: no cover - compiled
-    """Patches ``order[k]`` one by one over their boxes, z-tested against ``wbuf`` (H, W) float32 and written to
-    it, to ``ids`` and ``em`` (empty arrays to skip) and to ``img`` (H, W, 3) uint8 in the colour ``color``
-    (float32, truncated),
-    except the patches with ``defer`` (textured), whose colour is written afterwards where ``winner`` (H, W),
-    the order index k of the last patch that won each pixel, still names them. ``span_row[i]``: the patch's
-    first row in ``los``, ``his`` (its inside columns per box row), or -1 for a patch crossing the near plane
-    (the exact test per pixel, c < ``inv_near``). Returns the pixels each k holds at the end, the row after the
-    last one in which it won a pixel (so below it, it holds none) and, when ``want_sil``, every inside pixel (flat
-    index) of the patches with an object id > 0 and that id."""
-    H, W = wbuf.shape
+    """Patches ``order[k]`` one by one over their boxes, z-tested against ``wbuf`` (H, W) float32 and written to it,
+    to ``ids`` and ``em`` (empty arrays to skip) and to ``img`` (H, W, 3) uint8 in the colour ``color`` (float32,
+    truncated), except the patches with ``defer`` (textured), coloured afterwards where ``winner`` (H, W), the
+    order index k of the last patch that won each pixel, still names them. ``span_row[i]``: the patch's first row in
+    ``los``, ``his`` (its inside columns per box row), or -1 for a patch crossing the near plane (the exact test per
+    pixel, c < ``inv_near``). Returns the pixels each k holds at the end, the row after the last one in which it won
+    a pixel and, when ``want_sil``, every inside pixel (flat index) of the patches with an object id > 0 and that id."""
+    W = wbuf.shape[1]
     has_ids, has_em = ids.size > 0, em.size > 0
-    held = np.zeros(len(order), np.int64)
-    ends = np.zeros(len(order), np.int64)
-    # every inside pixel of a patch lies in its box, so the boxes of the patches with an id bound the silhouettes: the
-    # buffers are allocated once, never grown in the loop (an array reassigned in the pixel loop kept LLVM from
-    # optimising it: the kernel ran 4-5x slower, with the same output)
-    bound = 0
-    if want_sil:
-        for k in range(len(order)):
-            i = order[k]
-            if obj_id[i] > 0:
-                bound += (x1[i] - x0[i]) * (y1[i] - y0[i])
-    sil_pix = np.empty(bound, np.int32)
-    sil_oid = np.empty(bound, np.int32)
+    held, ends = np.zeros(len(order), np.int64), np.zeros(len(order), np.int64)
+    # the silhouettes' buffers are allocated once, never grown in the loop (an array reassigned in the pixel loop
+    # keeps LLVM from optimising the loop)
+    bound = _silhouette_bound(order, obj_id, x0, x1, y0, y1) if want_sil else 0
+    sil_pix, sil_oid = np.empty(bound, np.int32), np.empty(bound, np.int32)
     ns = 0
     for k in range(len(order)):
         i = order[k]
@@ -93,24 +108,15 @@ def big_patches(wbuf, ids, em, img, winner, order, x0, x1, y0, y1, ma, mb, mc, e
             cy = mc1 * fy + mc2
             ay = ma1 * fy + ma2
             by = mb1 * fy + mb2
-            xa, xb = x0[i], x1[i]
             if r >= 0:  # the row's span: every pixel in it is inside
-                xa, xb = max(xa, los[r + y - y0[i]]), min(xb, his[r + y - y0[i]] + 1)
+                xa, xb = max(x0[i], los[r + y - y0[i]]), min(x1[i], his[r + y - y0[i]] + 1)
             else:  # the columns where the exact test can pass (a disc lies within its quad)
-                xa, xb = _near_columns(xa, xb, ma0, ay, mb0, by, mc0, cy, inv_near)
+                xa, xb = _near_columns(x0[i], x1[i], ma0, ay, mb0, by, mc0, cy, inv_near)
             for x in range(xa, xb):
                 fx = f32(x)
                 c = mc0 * fx + cy
-                if r < 0:
-                    # crossing the near plane: the exact test per pixel, with c < 1/near
-                    ap = ma0 * fx + ay
-                    bp = mb0 * fx + by
-                    if ellipse[i]:
-                        inside = ap * ap + bp * bp <= c * c
-                    else:
-                        inside = max(abs(ap), abs(bp)) <= c
-                    if not (inside and c < inv_near and c > 0):
-                        continue
+                if r < 0 and not _inside_near(ma0 * fx + ay, mb0 * fx + by, c, ellipse[i], inv_near):
+                    continue
                 if sil:
                     sil_pix[ns] = y * W + x
                     sil_oid[ns] = oid
@@ -167,118 +173,6 @@ def put_albedo(img, alb, lut, winner, k, x0, y0):  # pragma: no cover - compiled
                 a = alb[r, c]
                 for ch in range(3):
                     img[y0 + r, x0 + c, ch] = lut[a, 0, ch]
-
-
-@kernel()
-def small_fragments(wflat, W, rp, v, first, last, mc, obj_id, want_sil):  # pragma: no cover - compiled
-    """One fragment per pixel centre first..last of each span (patch rp, row v): its 1/Z is written to ``wflat``
-    where it is the largest (the z-buffer). Returns the winners (fragments whose 1/Z is the pixel's largest;
-    equal ones are all kept): pixel, span, offset k along the span and 1/Z; and, when ``want_sil``, every
-    fragment's pixel and object id for the patches with an id > 0."""
-    total = 0
-    for s in range(len(rp)):
-        total += max(last[s] - first[s] + 1, 0)
-    fpix = np.empty(total, np.int32)
-    fspan = np.empty(total, np.int32)
-    fk = np.empty(total, np.float32)
-    fc = np.empty(total, np.float32)
-    m = 0
-    for s in range(len(rp)):
-        n = last[s] - first[s] + 1
-        if n <= 0:
-            continue
-        i = rp[s]
-        # c at the span's first pixel plus its slope along the row
-        c0 = f32(mc[i, 0] * first[s] + mc[i, 1] * v[s] + mc[i, 2])
-        slope = f32(mc[i, 0])
-        base = np.int32(v[s] * W + first[s])
-        for k in range(n):
-            kf = f32(k)
-            c = c0 + slope * kf
-            p = base + k
-            fpix[m], fspan[m], fk[m], fc[m] = p, s, kf, c
-            if c > wflat[p]:
-                wflat[p] = c
-            m += 1
-    nw = 0
-    for f in range(total):
-        if fc[f] == wflat[fpix[f]]:
-            nw += 1
-    wpix = np.empty(nw, np.int32)
-    wspan = np.empty(nw, np.int32)
-    wk = np.empty(nw, np.float32)
-    wc = np.empty(nw, np.float32)
-    j = 0
-    for f in range(total):
-        if fc[f] == wflat[fpix[f]]:
-            wpix[j], wspan[j], wk[j], wc[j] = fpix[f], fspan[f], fk[f], fc[f]
-            j += 1
-    ns = 0
-    if want_sil:
-        for f in range(total):
-            if obj_id[rp[fspan[f]]] > 0:
-                ns += 1
-    sil_pix = np.empty(ns, np.int32)
-    sil_oid = np.empty(ns, np.int32)
-    j = 0
-    if want_sil:
-        for f in range(total):
-            o = obj_id[rp[fspan[f]]]
-            if o > 0:
-                sil_pix[j], sil_oid[j] = fpix[f], o
-                j += 1
-    return wpix, wspan, wk, wc, sil_pix, sil_oid
-
-
-@kernel()
-def texel_coords(wspan, wk, wc, rp, v, first, ma, mb, entry, texsize, rects):  # pragma: no cover - compiled
-    """The textured winners (indices into the winners) and their atlas coordinates (x, y) float32:
-    s = (a'/c + 1)/2 times the texels across, wrapped into the entry's tile, plus the tile's origin."""
-    n = 0
-    for w in range(len(wspan)):
-        if entry[rp[wspan[w]]] >= 0:
-            n += 1
-    t = np.empty(n, np.int64)
-    tx = np.empty(n, np.float32)
-    ty = np.empty(n, np.float32)
-    one = f32(1.0)
-    j = 0
-    for w in range(len(wspan)):
-        s = wspan[w]
-        i = rp[s]
-        e = entry[i]
-        if e < 0:
-            continue
-        # a' = a'_0 + a'_u k, b' likewise, with a'_0 = ma0 lo + ma1 v + ma2 at the span's first pixel
-        a0 = f32(ma[i, 0] * first[s] + ma[i, 1] * v[s] + ma[i, 2])
-        b0 = f32(mb[i, 0] * first[s] + mb[i, 1] * v[s] + mb[i, 2])
-        ap = a0 + f32(ma[i, 0]) * wk[w]
-        bp = b0 + f32(mb[i, 0]) * wk[w]
-        hx, hy = f32(0.5 * texsize[i, 0]), f32(0.5 * texsize[i, 1])
-        ex, ey, ew, eh = f32(rects[e, 0]), f32(rects[e, 1]), f32(rects[e, 2]), f32(rects[e, 3])
-        x = (ap / wc[w] + one) * hx
-        y = (bp / wc[w] + one) * hy
-        x -= f32(np.floor(x / ew)) * ew
-        y -= f32(np.floor(y / eh)) * eh
-        t[j], tx[j], ty[j] = w, x + ex, y + ey
-        j += 1
-    return t, tx, ty
-
-
-@kernel()
-def shade_winners(img, ids, em, wpix, wspan, rp, obj_id, emissive, color, albedo):  # pragma: no cover - compiled
-    """Write each winner's object id, lamp flag and colour = shaded colour x albedo (float32, truncated), in
-    order (the last of equal fragments wins); ``img`` (H W, 3), ``ids`` and ``em`` flat (empty to skip)."""
-    has_ids, has_em = ids.size > 0, em.size > 0
-    for w in range(len(wpix)):
-        p, i = wpix[w], rp[wspan[w]]
-        if has_ids:
-            ids[p] = obj_id[i]
-        if has_em:
-            em[p] = f32(emissive[i])
-        a = albedo[w]
-        for ch in range(3):
-            img[p, ch] = np.uint8(color[i, ch] * a)
 
 
 @kernel()

@@ -102,7 +102,7 @@ _WARM: list[bool] = []
 
 def warm_up() -> None:
     """Compile the rasteriser's kernels (numba: the first time after an install) or load them from numba's disk
-    cache (about 0.5 s with the renderer's other kernels), once per process, by drawing a small synthetic scene
+    cache, once per process, by drawing a small synthetic scene
     through every path the renderer takes: large and small patches, textured and not, quads and discs, a lamp, a
     patch cut by the near plane, into a left camera's targets (depth, read off the z-buffer, ids, silhouettes) and a
     right one's, each with a reused winner map. The renderer calls it when it is built, so that no
@@ -141,8 +141,8 @@ def prepare(batch: PatchBatch, cam: PinholeCamera, cams_from_world: list[Transfo
     if not len(batch):
         return [None] * len(cams_from_world)
     R = cams_from_world[0].R
-    # np.allclose's test, |R_k - R| <= atol + rtol |R| (rtol 1e-5, atol 1e-8), without its generic machinery
-    # (~18 µs a call)
+    # np.allclose's test, |R_k - R| <= atol + rtol |R| (rtol 1e-5, atol 1e-8), without its generic machinery (whose
+    # overhead is many times the test's)
     if not all(bool((np.abs(T.R - R) <= 1e-8 + 1e-5 * np.abs(R)).all()) for T in cams_from_world):
         raise ValueError("prepare() needs cameras with one orientation (a rectified rig); render them one by one")
     # shading in the world frame: ambient + diffuse |n·sun| (two-sided lighting); vec3's formulas on the columns

@@ -140,7 +140,7 @@ def _smooth(img, inv, em, W, mc, rp, v, lo, hi, lo_px, hi_px):  # pragma: no cov
             blend[k] = (1.0 - alpha[k]) * em[tgt[k]] + alpha[k] * em[src[k]]
         for k in range(m):
             em[tgt[k]] = blend[k]
-    # channel by channel: a row assigned as an array (img[t] = mixed[k]) cost a third of the kernel
+    # channel by channel: a row assigned as an array (img[t] = mixed[k]) is far slower in numba
     for k in range(m):
         for ch in range(3):
             img[tgt[k], ch] = mixed[k, ch]

@@ -1,9 +1,9 @@
 """3-vectors as tuples of Python floats, for model code that builds geometry a few vectors at a time.
 
-numpy spends about a microsecond dispatching each operation on a (3,) array, several times the arithmetic;
-these plain functions do the same float64 operations in the same order (``mul(k, a)`` is k·aᵢ, ``madd(a, k, b)``
-is aᵢ + k·bᵢ), so a figure built with them has the coordinates the numpy expressions gave. Dot products are
-summed left to right (numpy's BLAS may fuse the multiply-adds; the two differ in the last bit at most).
+numpy's dispatch of each operation on a (3,) array costs several times the arithmetic; these plain functions do
+the same float64 operations in the same order (``mul(k, a)`` is k·aᵢ, ``madd(a, k, b)`` is aᵢ + k·bᵢ), so a
+figure built with them has the coordinates the numpy expressions give. Dot products are summed left to right
+(numpy's BLAS may fuse the multiply-adds; the two differ in the last bit at most).
 
 Each is also ``register_jitable``: a compiled kernel (numba) that calls one compiles it into itself, while Python
 callers (on tuples or on numpy columns) call the plain function.

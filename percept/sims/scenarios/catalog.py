@@ -19,13 +19,13 @@ from .roads import loop_road, straight_road, winding_road
 
 @dataclass(frozen=True)
 class Scenario:
-    """name: CLI name; summary: one line; duration_s: default run length [s]; ego_speed_mps: cruise set speed."""
+    """One scenario of the catalogue: its name, what it is and how its road is built."""
 
-    name: str
-    summary: str
-    duration_s: float
-    build: Callable
-    ego_speed_mps: float = 25.0
+    name: str  # its name on the command line
+    summary: str  # what it is, one line
+    duration_s: float  # default run length [s]
+    build: Callable  # build(env, rng) -> highway-env Road, with the ego made by ``env.make_ego``
+    ego_speed_mps: float = 25.0  # the ego's nominal speed [m/s] (``build`` sets its start and cruise speeds)
 
 
 def _chain(net) -> list[str]:
@@ -197,7 +197,8 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
              build_highway, 25.0),
     Scenario("curves", "3-lane winding road: arcs of radii 150-600 m both ways, joined by clothoids, traffic", 60.0,
              build_curves, 20.0),
-    Scenario("lead-brake", "following a lead at 24 m/s that brakes at -6 m/s^2 to a stop", 25.0, build_lead_brake, 25.0),
+    Scenario("lead-brake", "following a lead at 24 m/s that brakes at -6 m/s^2 to a stop", 25.0, build_lead_brake,
+             25.0),
     Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead; the ego falls back to its time gap", 40.0,
              build_cut_in, 25.0),
     Scenario("crossing", "pedestrians cross the ego lane at 5 km/h from both sides, others stay on the verge; "

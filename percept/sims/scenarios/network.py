@@ -1,7 +1,7 @@
 """highway-env's RoadNetwork with a spatial pre-filter for the closest-lane search.
 
 Every vehicle asks for its closest lane every step, and highway-env answers by measuring the distance to
-every lane of the network: on a winding road of ~100 lane segments that search was most of the simulation
+every lane of the network: on a winding road of ~100 lane segments that search would dominate the simulation
 time. Here each lane gets a bounding circle once; only lanes whose circle comes within ``NEAR_M`` of the
 position are measured. The answer is highway-env's own (same distance, same order, same tie-breaking)
 whenever the closest lane is that near, and the full search runs otherwise.
