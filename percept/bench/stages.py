@@ -22,26 +22,24 @@ from .peers import topdown_ready
 
 @dataclass(frozen=True)
 class StageCost:
-    """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (a slot's mean per frame,
-    else the median; see ``bench_task``); peer: the peer's name and peer_ms its cost in the same run (None where
-    no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any; target_speedup: how many
-    times faster than its peer the stage must be (peer_ms / ms), if any; met: whether it keeps both (None without a
-    target)."""
+    """One stage's cost beside its peer's, and its targets."""
 
-    stage: str
-    what: str
-    ms: float
-    peer: str | None = None
-    peer_ms: float | None = None
-    target_ms: float | None = None
-    target_speedup: float | None = None
+    stage: str  # the timing_ms key
+    what: str  # what was timed, as the table's legend prints it
+    ms: float  # cost per call [ms]: a slot's mean per frame (``slot_ms``), else the median (``median_ms``)
+    peer: str | None = None  # the peer's name (None where no peer does the same job)
+    peer_ms: float | None = None  # the peer's cost in the same run [ms]
+    target_ms: float | None = None  # the stage's budget [ms] (None: none)
+    target_speedup: float | None = None  # how many times faster than its peer the stage must be (None: no target)
 
     @property
     def ratio(self) -> float | None:
+        """ms / peer_ms (None without a peer)."""
         return self.ms / self.peer_ms if self.peer_ms else None
 
     @property
     def met(self) -> bool | None:
+        """Whether the stage keeps its budget and its speed-up (None without a target)."""
         checks = []
         if self.target_ms is not None:
             checks.append(self.ms <= self.target_ms)
@@ -51,6 +49,7 @@ class StageCost:
         return all(checks) if checks else None
 
     def to_dict(self) -> dict:
+        """The JSON object of ``percept bench --json``'s ``stages`` list, figures rounded to 0.001."""
         r = self.ratio
         return {"stage": self.stage, "what": self.what, "ms": round(self.ms, 3), "peer": self.peer,
                 "peer_ms": None if self.peer_ms is None else round(self.peer_ms, 3),

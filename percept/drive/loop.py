@@ -18,7 +18,7 @@ from .tasks import SlotContext
 
 def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, int], None] | None = None,
               render: bool = True) -> dict:
-    """Drive one run; returns the run JSON (DESIGN.md contract, one group per task).
+    """Drive one run; returns the run JSON (docs/design.md, "The run JSON": one group per task).
 
     ``recorder_factory(world)`` returns an object with ``log_step(frame, step_truth, agent_step)``.
     ``render=False`` skips the cameras: only possible while every slot is privileged (baselines, fast tests).
