@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from percept.drive.privileged import TruthFeed
-from percept.drive.tasks import SlotContext, Task
+from percept.drive.tasks import Task
 
 from .peers import topdown_ready
 
@@ -144,16 +144,15 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     it are privileged (computed beforehand, not timed). A slot keeps state from frame to frame (trackers, filters,
     a search spread over frames), so it is timed on consecutive frames from a reset, as its mean cost per frame
     (``slot_ms``); the stateless peer as its median."""
+    from percept.drive.loop import slot_context
     from percept.sims import SimWorld, WorldConfig
-    from percept.sims.coords import hw_pose
 
     if task.vision is None:
         raise ValueError(f"the {task.name} task has no vision slot to time")
     cv2.setNumThreads(1)
     world = SimWorld(WorldConfig(task.bench_scenario, seed=seed, autopilot=True))
     feed = TruthFeed()
-    lm = world.landmark_map()
-    ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, start_pose=hw_pose(world.ego))
+    ctx = slot_context(world, feed)
     providers = {t.provides: t for t in tasks}
     upstream = {rec: providers[rec].privileged(ctx) for rec in task.reads}
     shots = []
