@@ -12,9 +12,9 @@ import cv2
 import numpy as np
 
 from percept.detection import ConstrainedSearch, LinearModel, SearchConfig, iou_matrix, window_of
-from percept.training.samples import for_each_frame
-from percept.training.people import truth_path
 from percept.sensors import ObjectKind, StereoRig
+from percept.training.people import truth_path
+from percept.training.samples import for_each_frame
 
 cv2.setNumThreads(1)
 THRESHOLDS = (-0.4, -0.2, 0.0, 0.25)
@@ -27,6 +27,7 @@ off = {m: [] for m in models}
 
 
 def score_frame(seed, frame, gt):
+    """Each model's best window score on each far person and the scores of the windows touching no person."""
     people = [o for o in gt.objects if o.kind is ObjectKind.PEDESTRIAN and o.box_px is not None]
     far = [o for o in people if 24 <= o.box_px[3] - o.box_px[1] < 40 and o.visible >= 0.5]
     taboo = np.array([window_of(o.box_px) for o in people]).reshape(-1, 4)

@@ -1,8 +1,8 @@
 """INRIA detectMultiScale recall on rendered crossing pedestrians: seeds, every 3rd frame, 100-250 px, visible>=0.5.
 
 The ground truth's ``visible`` counts the frame border (a person half out of the frame is half visible), so the
-sample is the issue's. People the border cuts at all are hard for any sliding window (it cannot centre on them),
-so the recall on people wholly inside the frame is printed too: tight box at least 5 px from the image border, as
+sample includes people the border cuts. Those are hard for any sliding window (it cannot centre on them), so the
+recall on people wholly inside the frame is printed too: tight box at least 5 px from the image border, as
 in the Caltech pedestrian benchmark's evaluation (Dollar et al., PAMI 2012; 'xRng', [5 635], 'yRng', [5 475] in
 its toolbox). OpenCV pads the image by ``padding`` pixels (of each pyramid level) so that windows may reach past
 its border; 8 px is what the bench's peer uses, 32 px lets a window centre on people cut by the border.
@@ -34,6 +34,7 @@ def win(b):
 
 
 def iou(a, b):
+    """Intersection over union of two (u0, v0, u1, v1) boxes."""
     iw = max(0, min(a[2], b[2]) - max(a[0], b[0]))
     ih = max(0, min(a[3], b[3]) - max(a[1], b[1]))
     i = iw * ih
@@ -41,6 +42,7 @@ def iou(a, b):
 
 
 def in_frame(b, shape):
+    """Whether box ``b`` lies at least BORDER_PX inside an image of ``shape``."""
     h, w = shape[:2]
     return b[0] >= BORDER_PX and b[1] >= BORDER_PX and b[2] <= w - BORDER_PX and b[3] <= h - BORDER_PX
 
@@ -50,6 +52,7 @@ miss = {True: [], False: []}
 
 
 def fn(seed, frame, gt):
+    """Tally the frame's people 100-250 px tall and at least half visible: found by detectMultiScale or missed."""
     peds = [o for o in gt.objects if o.kind is ObjectKind.PEDESTRIAN and o.box_px and o.visible >= 0.5
             and 100 <= o.box_px[3] - o.box_px[1] <= 250]
     if not peds:
@@ -71,8 +74,8 @@ n_in = found[True] + len(miss[True])
 n_all = n_in + found[False] + len(miss[False])
 print(f"seeds {seeds}, padding {pad} px")
 print(f"in the frame: found {found[True]}/{n_in} = {found[True] / max(n_in, 1):.3f}  ({time.time() - t:.0f} s)")
-print(f"everyone at least half visible (also people the frame border cuts): found {found[True] + found[False]}/{n_all} = "
-      f"{(found[True] + found[False]) / max(n_all, 1):.3f}")
+print(f"everyone at least half visible (also people the frame border cuts): found {found[True] + found[False]}/"
+      f"{n_all} = {(found[True] + found[False]) / max(n_all, 1):.3f}")
 for m in miss[True]:
     print("miss", m)
 print(f"cut by the border: found {found[False]}/{found[False] + len(miss[False])}")

@@ -19,13 +19,14 @@ from collections import Counter
 import cv2
 import numpy as np
 
+from percept.bench.stages import slot_ms
 from percept.detection import LinearModel, PedestrianSlot
 from percept.detection.constrained import PERSON_PX, ConstrainedSearch
-from percept.bench.stages import slot_ms
+from percept.drive.loop import slot_context
 from percept.drive.privileged import TruthFeed
-from percept.drive.tasks import TASKS, SlotContext
+from percept.drive.tasks import TASKS
+from percept.sensors import EgoPath
 from percept.sims import SimWorld, WorldConfig
-from percept.sims.coords import hw_pose
 
 
 def main() -> None:
@@ -42,13 +43,13 @@ def main() -> None:
         variants.append((v, LinearModel.named(name), {"far_sweep_frames": int(far)} if far else {}))
     world = SimWorld(WorldConfig("crossing", seed=0, autopilot=True))
     feed = TruthFeed()
-    lm = world.landmark_map()
-    ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, start_pose=hw_pose(world.ego))
-    lateral = {t.name: t for t in TASKS}["lateral"].privileged(ctx)
+    ctx = slot_context(world, feed)
+    # the true ego path, from the privileged slot of the task that provides it: the pedestrian slot reads it
+    path_slot = next(t for t in TASKS if t.provides is EgoPath).privileged(ctx)
     shots = []
     for _ in range(args.frames):
         frame, feed.truth = world.observe()
-        shots.append((frame, {"lateral": lateral.step(frame, {})[0]}))
+        shots.append((frame, {EgoPath: path_slot.step(frame, {})[0]}))
         world.step()
     ms = {v: [] for v, _, _ in variants}
     for _ in range(args.passes):

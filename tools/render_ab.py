@@ -1,10 +1,10 @@
 """The renderer of another checkout against this one, in one process: the same frames, and their CPU time.
 
-On a shared machine whose speed drifts by a third within minutes, two timing runs one after the other compare the
-machine more than the code. Here the other checkout's ``percept/sims`` is loaded beside this one (as the package
-``othersims``), both renderers are built for the same world, and each frame is rendered by one and then by the
-other, so that a drift falls on both. Every tenth frame's images, depth, ids and boxes must be identical (the
-renderer's optimisations keep the pictures bit for bit; exit 1 when they do not).
+Two timing runs one after the other compare the machine's speed at two moments as much as the code. Here the other
+checkout's ``percept/sims`` is loaded beside this one (as the package ``othersims``), both renderers are built for
+the same world, and each frame is rendered by one and then by the other, so that a drift falls on both. Every tenth
+frame's images, depth, ids and boxes must be identical (the renderer's optimisations keep the pictures bit for bit;
+exit 1 when they do not).
 
 usage: python tools/render_ab.py OTHER_CHECKOUT [SCENARIO ...]   (default: highway crossing loop curves)
        e.g. git worktree add /tmp/base HEAD~3 && python tools/render_ab.py /tmp/base
@@ -35,8 +35,8 @@ def other_render(checkout: Path):
     if not (sims / "render" / "renderer.py").is_file():
         sys.exit(f"{checkout} is not a percept checkout (no percept/sims/render/renderer.py)")
     # numba caches a kernel beside its source under its module's name: cached as ``othersims``, the other
-    # checkout's kernels would no longer load when it runs as ``percept`` ("No module named 'othersims'"), so its
-    # kernels are compiled here without the disk cache (about 20 s)
+    # checkout's kernels would not load when it runs as ``percept`` ("No module named 'othersims'"), so its
+    # kernels are compiled here without the disk cache
     from numba.core.dispatcher import Dispatcher
 
     enable = Dispatcher.enable_caching

@@ -21,6 +21,8 @@ import numpy as np
 import percept.odometry.fusion as fusion
 from percept.drive.config import DriveConfig
 from percept.drive.loop import run_drive
+from percept.drive.tasks import TASKS
+from percept.sensors import PoseEstimate
 from percept.sims import SimWorld, WorldConfig
 
 
@@ -46,7 +48,9 @@ def spans(scenario: str, seed: int, condition: str) -> list[tuple[np.ndarray, np
 
     SimWorld.observe, fusion.PoseFilter.clone, fusion.PoseFilter.update_relative = observed, cloned, measured
     try:
-        run_drive(DriveConfig(WorldConfig(scenario, seed=seed, condition=condition), sources={"odometry": "vision"}))
+        # the task that provides the pose on vision, the others privileged
+        vision = {t.name: "vision" for t in TASKS if t.provides is PoseEstimate}
+        run_drive(DriveConfig(WorldConfig(scenario, seed=seed, condition=condition), sources=vision))
     finally:
         SimWorld.observe, fusion.PoseFilter.clone, fusion.PoseFilter.update_relative = observe, clone, relative
     out = []

@@ -28,9 +28,10 @@ from .peers import topdown_ready
 from .stages import cycle, median_ms
 
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
+"""The conditions whose render cost is timed."""
 PAIR_FRAMES = 60
-"""Frames whose stereo pair is timed alone on each scenario (the median: a few seconds' slowdown of the machine
-moves a median of 20 by a third)."""
+"""Frames whose stereo pair is timed alone on each scenario; the figure is their median, which a few seconds'
+slowdown of the machine barely moves."""
 PERCEPTION_BUDGET_MS = 16.7
 """The whole perception stack's budget on one thread: 60 frames a second [ms/frame]."""
 STACK_SPEEDUP = 20.0
@@ -54,21 +55,21 @@ def middle(values, key=None):
 
 @dataclass(frozen=True)
 class StackCost:
-    """scenario; frames: frames each closed loop ran; timing_ms: the run JSON's (render, each slot,
-    perception_total) [ms/frame] of the unrecorded drive with the median perception_total (its ``render`` is the mean
-    of the loop's frames, each rendered after the slots have had the caches); stereo_pair_ms: the median cost of one
-    stereo pair alone (``SimWorld.observe``: the render and the ground truth) on the scenario's first
-    ``PAIR_FRAMES`` autopilot frames [ms]; peers_ms: the stock way to do each job on the first of those frames
-    (each task's ``bench_peer``, by task name) and highway-env's top-down render (``render``) [ms/frame]; realtime_factors,
-    realtime_factors_recording: each drive's, without / with recording (the drives alternate, so that a change in
-    the machine's speed falls on both). The median of several is the middle one (``middle``), for the timings as
-    for the realtime factors."""
+    """The whole stack's cost on one scenario; the median of several drives is the middle one (``middle``)."""
 
-    scenario: str
-    frames: int
+    scenario: str  # scenario name
+    frames: int  # frames each closed loop ran
+    # the run JSON's timing_ms (render, each slot, perception_total) of the unrecorded drive with the median
+    # perception_total [ms/frame]; its render is the mean over the loop's frames, each rendered after the slots ran
     timing_ms: dict
+    # the median cost of one stereo pair alone (SimWorld.observe: the render and the ground truth) on the scenario's
+    # first PAIR_FRAMES autopilot frames [ms]
     stereo_pair_ms: float
+    # task name -> its bench_peer on the first of those frames, and "render" -> highway-env's top-down render
+    # [ms/frame]
     peers_ms: dict
+    # each drive's realtime factor without / with recording (the drives alternate, so that a change in the
+    # machine's speed falls on both)
     realtime_factors: tuple[float, ...]
     realtime_factors_recording: tuple[float, ...]
 
@@ -104,6 +105,7 @@ class StackCost:
                                       if self.realtime_factors_recording else None)}
 
     def to_dict(self) -> dict:
+        """The JSON object of ``percept bench --json``'s ``stack`` list, figures rounded to 0.001."""
         r = lambda x: None if x is None else round(float(x), 3)  # noqa: E731
         return {"scenario": self.scenario, "frames": self.frames,
                 "timing_ms": {k: r(v) for k, v in self.timing_ms.items()}, "stereo_pair_ms": r(self.stereo_pair_ms),

@@ -15,33 +15,31 @@ import cv2
 import numpy as np
 
 from percept.drive.privileged import TruthFeed
-from percept.drive.tasks import SlotContext, Task
+from percept.drive.tasks import Task
 
 from .peers import topdown_ready
 
 
 @dataclass(frozen=True)
 class StageCost:
-    """stage: the ``timing_ms`` key; what: what was timed; ms: milliseconds per call (a slot's mean per frame,
-    else the median; see ``bench_task``); peer: the peer's name and peer_ms its cost in the same run (None where
-    no peer does the same job); ratio = ms / peer_ms; target_ms: the stage's budget, if any; target_speedup: how many
-    times faster than its peer the stage must be (peer_ms / ms), if any; met: whether it keeps both (None without a
-    target)."""
+    """One stage's cost beside its peer's, and its targets."""
 
-    stage: str
-    what: str
-    ms: float
-    peer: str | None = None
-    peer_ms: float | None = None
-    target_ms: float | None = None
-    target_speedup: float | None = None
+    stage: str  # the timing_ms key
+    what: str  # what was timed, as the table's legend prints it
+    ms: float  # cost per call [ms]: a slot's mean per frame (``slot_ms``), else the median (``median_ms``)
+    peer: str | None = None  # the peer's name (None where no peer does the same job)
+    peer_ms: float | None = None  # the peer's cost in the same run [ms]
+    target_ms: float | None = None  # the stage's budget [ms] (None: none)
+    target_speedup: float | None = None  # how many times faster than its peer the stage must be (None: no target)
 
     @property
     def ratio(self) -> float | None:
+        """ms / peer_ms (None without a peer)."""
         return self.ms / self.peer_ms if self.peer_ms else None
 
     @property
     def met(self) -> bool | None:
+        """Whether the stage keeps its budget and its speed-up (None without a target)."""
         checks = []
         if self.target_ms is not None:
             checks.append(self.ms <= self.target_ms)
@@ -51,6 +49,7 @@ class StageCost:
         return all(checks) if checks else None
 
     def to_dict(self) -> dict:
+        """The JSON object of ``percept bench --json``'s ``stages`` list, figures rounded to 0.001."""
         r = self.ratio
         return {"stage": self.stage, "what": self.what, "ms": round(self.ms, 3), "peer": self.peer,
                 "peer_ms": None if self.peer_ms is None else round(self.peer_ms, 3),
@@ -145,16 +144,15 @@ def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int 
     it are privileged (computed beforehand, not timed). A slot keeps state from frame to frame (trackers, filters,
     a search spread over frames), so it is timed on consecutive frames from a reset, as its mean cost per frame
     (``slot_ms``); the stateless peer as its median."""
+    from percept.drive.loop import slot_context
     from percept.sims import SimWorld, WorldConfig
-    from percept.sims.coords import hw_pose
 
     if task.vision is None:
         raise ValueError(f"the {task.name} task has no vision slot to time")
     cv2.setNumThreads(1)
     world = SimWorld(WorldConfig(task.bench_scenario, seed=seed, autopilot=True))
     feed = TruthFeed()
-    lm = world.landmark_map()
-    ctx = SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, start_pose=hw_pose(world.ego))
+    ctx = slot_context(world, feed)
     providers = {t.provides: t for t in tasks}
     upstream = {rec: providers[rec].privileged(ctx) for rec in task.reads}
     shots = []

@@ -31,8 +31,8 @@ def bench(
                                                            "with recording, alternating, 1 to 20 (the table shows "
                                                            "the median and the range).")] = 3,
     soak_minutes: Annotated[float, typer.Option("--soak-minutes", help="Also a recorded closed loop (highway, "
-                                                "every slot on vision) this many simulated minutes long, with the "
-                                                "process's memory each minute (0: none; 20 takes ~10 min).")] = 0.0,
+                                                "every slot on vision) this many simulated minutes long, 0 to 600, "
+                                                "with the process's memory each minute (0: none).")] = 0.0,
 ):
     """Per-stage cost on one thread (stages named by the run JSON's timing_ms keys), against the named peers
     measured in the same run (ratio = ours / peer)."""
@@ -96,6 +96,7 @@ def speed_text(ratio: float | None) -> str:
 
 
 def _scenarios(names: list[str] | None) -> list[str]:
+    """The --scenario names, checked (every scenario when none is given); a one-line error on an unknown one."""
     from percept.sims import SCENARIOS, check_scenario
 
     try:

@@ -15,6 +15,7 @@ from .options import flag
 
 
 def _cam_rows(name: str, cal) -> list[tuple[str, str]]:
+    """One camera's intrinsics and distortion as table rows, each label prefixed with ``name``."""
     cam = cal.camera
     return [(f"{name}fx, fy [px]", f"{cam.fx:.1f}, {cam.fy:.1f}"),
             (f"{name}cx, cy [px]", f"{cam.cx:.1f}, {cam.cy:.1f}"),

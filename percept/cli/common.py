@@ -138,9 +138,9 @@ class _HelpWithoutType:
 
 
 def reflow(text: str | None) -> str | None:
-    """A docstring as help text: the line breaks inside each paragraph joined (typer's rich help keeps them, so a
-    paragraph wrapped at 120 columns in the source printed with ragged lines); paragraphs and lines that begin a list
-    item ("- ", "* ", "1. ") stay."""
+    """A docstring as help text: the line breaks inside each paragraph joined, since typer's rich help keeps them and
+    a paragraph wrapped at 120 columns in the source would print with ragged lines; paragraphs and lines that begin
+    a list item ("- ", "* ", "1. ") stay."""
     if not text:
         return text
     out = []
@@ -182,6 +182,7 @@ def on_interrupt(note: Note) -> None:
 
 
 def _interrupt_line() -> str:
+    """The one line printed after an interrupt: what the command's note says was kept."""
     note = _interrupt["note"]
     try:
         text = note() if callable(note) else note
@@ -191,6 +192,7 @@ def _interrupt_line() -> str:
 
 
 def _on_stop_signal(signum, frame) -> None:
+    """SIGINT or SIGTERM: remembered for the exit code, then stops the command as Ctrl-C does."""
     _interrupt["signal"] = signum
     raise KeyboardInterrupt
 
@@ -201,6 +203,7 @@ CHATTER = re.compile(rb"(libpng (warning|error)|Corrupt JPEG data|Premature end 
 
 
 def _pump(source: int, sink: int) -> None:
+    """Copy lines from the pipe ``source`` to ``sink`` except library chatter (``CHATTER``)."""
     with os.fdopen(source, "rb") as lines:
         for line in lines:
             if not CHATTER.match(line.lstrip()):

@@ -69,6 +69,7 @@ def register(app: typer.Typer) -> None:
 
 
 def _detect(image, params: dict) -> tuple[list, float]:
+    """The people found on ``image`` and the time it took [ms]."""
     from percept.detection import detect_multiscale
 
     t0 = time.perf_counter()
@@ -77,23 +78,23 @@ def _detect(image, params: dict) -> tuple[list, float]:
 
 
 def _summary(records: list[dict], ms: list[float]) -> dict:
-    ok = [r for r in records if "error" not in r]
-    return {"count": len(ok), "errors": len(records) - len(ok),
-            "detections": sum(len(r["detections"]) for r in ok),
-            "ms_per_frame_median": float(sorted(ms)[len(ms) // 2]) if ms else None}
+    """The JSON summary: read and unreadable records, the detections in all, the median time [ms]."""
+    from percept.cli.footage_out import summary
+
+    return summary(records, ms, lambda ok: {"detections": sum(len(r["detections"]) for r in ok)})
 
 
 def _print_summary(title: str, summary: dict) -> None:
-    from percept.cli.common import console, fmt
+    """The summary as one line."""
+    from percept.cli.common import console
+    from percept.cli.footage_out import summary_tail
 
-    ms = summary["ms_per_frame_median"]
-    console.print(f"{title}: {summary['detections']} detection(s) in {summary['count']}"
-                  + (f", {summary['errors']} unreadable" if summary["errors"] else "")
-                  + (f"; {fmt(ms, '{:.0f}')} ms each (median)" if ms else ""))
+    console.print(f"{title}: {summary['detections']} detection(s) in {summary['count']}" + summary_tail(summary))
 
 
 def _run_images(files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict, params: dict,
                 single: bool) -> None:
+    """The detector on each image, then the JSON and a summary."""
     from percept.cli.common import console, fail, write_json
     from percept.cli.footage_out import process_images
     from percept.detection import detect_multiscale
@@ -115,6 +116,7 @@ def _run_images(files: list[Path], out: Optional[Path], json_path: Optional[Path
 
 
 def _frames(video, path: Path, params: dict, writer) -> tuple[list[dict], list[float]]:
+    """Records and per-frame times of the detector over ``video``, each frame's overlay to ``writer`` if given."""
     from percept.cli.common import progress_bar
     from percept.detection.overlay import draw_detections
 
@@ -137,6 +139,7 @@ def _frames(video, path: Path, params: dict, writer) -> tuple[list[dict], list[f
 
 def _run_video(path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict,
                params: dict) -> None:
+    """The detector through a video, then the JSON and a summary."""
     from percept.cli.common import console, write_json
     from percept.cli.footage_out import process_video, video_header
 

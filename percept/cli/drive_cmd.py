@@ -9,7 +9,6 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-
 from . import options as opt
 from .common import check_outputs, console, fail, fmt, on_interrupt, progress_bar, write_error, write_json
 
@@ -27,7 +26,7 @@ def drive(
                                          "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,
     no_record: Annotated[bool, opt.flag("--no-record", help="Do not write a Rerun recording.")] = False,
     camera_hz: Annotated[float, typer.Option("--camera-hz", help="Camera images stored per simulated second in "
-                                             "the recording (15 = every frame).")] = 5.0,
+                                             "the recording, 0.01 to 1000 (15 = every frame).")] = 5.0,
     camera_quality: Annotated[int, typer.Option("--camera-quality", help="JPEG quality of the recorded camera "
                                                 "images, 1 to 100.")] = 70,
     camera_scale: Annotated[float, typer.Option("--camera-scale", help="Recorded image size relative to the "
@@ -88,6 +87,7 @@ class Recording:
                f"{where}; no JSON was written or replaced"
 
     def open(self, world):
+        """The recorder of ``world``'s run (``run_drive``'s recorder factory)."""
         from percept.review import RunRecorder
 
         self.recorder = RunRecorder(self.path, world.cfg.rig, world.road_geometry.lane_lines, self.tasks, self.options)

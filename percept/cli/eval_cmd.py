@@ -10,7 +10,6 @@ from rich import box
 from rich.markup import escape
 from rich.table import Table
 
-
 from . import options as opt
 from .common import check_outputs, console, err, fail, fmt, on_interrupt, progress_bar, write_json
 
@@ -20,11 +19,14 @@ def eval_(
     out: Annotated[Path, typer.Option("--out", file_okay=False, help="Output folder: runs/<scenario>-<condition>-"
                                       "<seed>.json and summary.json. Runs already there with the same settings are "
                                       "reused (resume); runs made with other settings stop the batch (see --redo).")],
-    seeds: Annotated[str, typer.Option("--seeds", help="Seeds: A-B (inclusive), N, or A,B,C.")] = "0-4",
-    condition: Annotated[List[str], typer.Option("--condition", help="Condition; repeat for several.")] = ["clear"],
+    seeds: Annotated[str, typer.Option("--seeds", help="Seeds: A-B (inclusive), N, or A,B,C; each 0 to 2^31-1, at "
+                                                       "most 10,000 of them.")] = "0-4",
+    condition: Annotated[List[str], typer.Option("--condition", help="Condition (see `percept scenarios`); repeat "
+                                                                     "for several.")] = ["clear"],
     workers: Annotated[int, typer.Option("--workers", help="Parallel runs on this machine (local engine), 1 to "
                                                            "256.")] = 1,
-    engine: Annotated[str, typer.Option("--engine", help="local | ray.")] = "local",
+    engine: Annotated[str, typer.Option("--engine", help="Where the runs go: local (worker processes on this "
+                                                         "machine) or ray (a Ray cluster, see --address).")] = "local",
     address: Annotated[Optional[str], typer.Option("--address", help="Ray cluster address (default: start a "
                                                                      "local Ray).")] = None,
     duration: opt.Duration = None,
@@ -117,7 +119,6 @@ def _report_failures(summary: dict, total: int, out: Path) -> None:
 def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict:
     """The batch under a progress bar; Ctrl-C says how many finished runs are kept."""
     from percept.evaluate.batch import evaluate
-
     from percept.evaluate.resume import run_path
 
     failed = [0]

@@ -1,9 +1,10 @@
-"""Overlay outputs shared by the footage commands (``percept lanes``, ``percept detect``): where an overlay goes,
-writing an image overlay atomically, and a video writer."""
+"""What the footage commands (``percept lanes``, ``percept detect``) share: where an overlay goes, writing an image
+overlay atomically, a video writer, the image and video jobs, and the summary of their records."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Callable
 
 
 def overlay_path(out: Path, source: Path, tag: str, video: bool) -> Path:
@@ -66,6 +67,24 @@ def process_video(path: Path, out: Path | None, tag: str, max_frames: int | None
                   f"{video.declared_frames} frames its header declares (truncated or damaged?)", highlight=False,
                   soft_wrap=True)
     return video, target, records, ms
+
+
+def summary(records: list[dict], ms: list[float], counts: Callable[[list[dict]], dict]) -> dict:
+    """The JSON summary of a footage command's records: how many were read (``count``) and not (``errors``), the
+    command's ``counts(read records)``, and the median time a frame [ms] (the upper one of an even count; None
+    without a timed frame)."""
+    ok = [r for r in records if "error" not in r]
+    return {"count": len(ok), "errors": len(records) - len(ok), **counts(ok),
+            "ms_per_frame_median": float(sorted(ms)[len(ms) // 2]) if ms else None}
+
+
+def summary_tail(summary: dict) -> str:
+    """The end of a footage command's summary line: the unreadable ones and the median time, where there are any."""
+    from percept.cli.common import fmt
+
+    ms = summary["ms_per_frame_median"]
+    return ((f", {summary['errors']} unreadable" if summary["errors"] else "")
+            + (f"; {fmt(ms, '{:.0f}')} ms each (median)" if ms else ""))
 
 
 def video_header(video, target: Path | None, records: list) -> dict:

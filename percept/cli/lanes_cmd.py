@@ -24,6 +24,7 @@ class LanesFormat(str, Enum):
     PERCEPT = "percept"  # every estimate
     TUSIMPLE = "tusimple"  # the TuSimple benchmark's prediction lines
 
+
 CALIBRATION_IMAGES = 30
 """At most this many images of a folder (evenly spread) measure the camera height."""
 
@@ -113,24 +114,26 @@ def _check_options(mount_height, lane_width, hfov, speed, max_frames, fmt: Lanes
 
 
 def _record(result, **keys) -> dict:
+    """One image's or frame's JSON record: ``keys`` (file, frame, time) and the fit's figures."""
     return {**keys, **result.to_dict()}
 
 
 def _summary(records: list[dict], ms: list[float]) -> dict:
-    ok = [r for r in records if "error" not in r]
-    return {"count": len(ok), "errors": len(records) - len(ok),
-            "both_boundaries": sum(bool(r["both_boundaries"]) for r in ok),
-            "lane_found": sum(r["offset_m"] is not None for r in ok),
-            "ms_per_frame_median": float(sorted(ms)[len(ms) // 2]) if ms else None}
+    """The JSON summary: read and unreadable records, in how many a lane and both boundaries were found, the median
+    time [ms]."""
+    from percept.cli.footage_out import summary
+
+    return summary(records, ms, lambda ok: {"both_boundaries": sum(bool(r["both_boundaries"]) for r in ok),
+                                            "lane_found": sum(r["offset_m"] is not None for r in ok)})
 
 
 def _print_summary(title: str, summary: dict, out: Optional[Path]) -> None:
-    from percept.cli.common import console, fmt
+    """The summary as one line, and where the overlays are."""
+    from percept.cli.common import console
+    from percept.cli.footage_out import summary_tail
 
-    ms = summary["ms_per_frame_median"]
     console.print(f"{title}: lane found in {summary['lane_found']} of {summary['count']}, both boundaries in "
-                  f"{summary['both_boundaries']}" + (f", {summary['errors']} unreadable" if summary["errors"] else "")
-                  + (f"; {fmt(ms, '{:.0f}')} ms each (median)" if ms else ""))
+                  f"{summary['both_boundaries']}" + summary_tail(summary))
     if out is not None:
         console.print(f"overlays in {out}")
 
@@ -157,6 +160,7 @@ def _calibrate(runner, files: list[Path], header: dict) -> None:
 
 def _run_images(runner, files: list[Path], out: Optional[Path], json_path: Optional[Path], header: dict,
                 single: bool, tusimple: bool = False) -> None:
+    """The lane fit on each image, then the JSON (percept's or TuSimple's layout) and a summary."""
     from percept.cli.common import fail, write_json
     from percept.cli.footage_out import process_images
     from percept.lanes.overlay import draw_overlay
@@ -230,6 +234,7 @@ def _lanes_on_video(runner, video, path: Path, writer) -> tuple[list[dict], list
 
 
 def _run_video(runner, path: Path, out: Optional[Path], json_path: Optional[Path], max_frames, header: dict) -> None:
+    """The lane fit through a video, then the JSON and a summary."""
     from percept.cli.common import console, write_json
     from percept.cli.footage_out import process_video, video_header
 

@@ -125,6 +125,7 @@ def _scores(est: np.ndarray, true: Optional[np.ndarray]) -> dict:
 
 
 def _print_summary(d: dict) -> None:
+    """The run's figures as a table."""
     from rich.table import Table
 
     from percept.cli.common import console, fmt

@@ -21,9 +21,10 @@ _SLOT = ("The {task} slot, {help}: vision (its perception module; the default) o
 Scenario = Annotated[str, typer.Option("--scenario", help="Scenario name (see `percept scenarios`).")]
 Seed = Annotated[int, typer.Option("--seed", help="Random seed (0 to 2^31-1); the same seed and options give the "
                                                   "same metrics.")]
-Condition = Annotated[str, typer.Option("--condition", help="clear | night | rain | glare | noise | dropout.")]
-Duration = Annotated[Optional[float], typer.Option("--duration", help="Simulated seconds (default: the "
-                                                                      "scenario's own).")]
+Condition = Annotated[str, typer.Option("--condition", help="Weather or camera condition: clear | night | rain | "
+                                                            "glare | noise | dropout (see `percept scenarios`).")]
+Duration = Annotated[Optional[float], typer.Option("--duration", help=f"Simulated seconds, at most "
+                                                   f"{MAX_DURATION_S:g} (default: the scenario's own).")]
 Detector = Annotated[str, typer.Option("--detector", help="People model of the vision pedestrian slot: sim "
                                        "(trained on rendered people), inria (OpenCV's) or a model file.")]
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",

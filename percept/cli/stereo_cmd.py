@@ -15,7 +15,8 @@ import typer
 from . import options as opt
 
 MAX_AUTO_WIDTH = 1000
-"""Without --scale, images wider than this are halved until they are not (a few seconds on two cores)."""
+"""Without --scale, images wider than this are halved until they are not [px]: dense matching's cost grows with the
+pixel count times the disparity range, and both grow with the width."""
 MAX_ROW_MISALIGNMENT_PX = 1.5
 """A pair whose matched features differ by more rows than this (median) is refused as not rectified."""
 LABELS = {"percept": "percept dense", "sgbm": "SGBM plain", "sgbm_sample": "SGBM sample"}
@@ -80,12 +81,14 @@ def stereo(
 
 
 def _note(s: float, with_gt: bool) -> str:
+    """The JSON's note on the units of pixel values at the working scale ``s``."""
     return (f"pixel values (disparities, errors) are at the working scale {s:g} of the input images"
             + ("; the ground truth was resized by nearest neighbour and its disparities multiplied by the scale"
                if with_gt and s != 1.0 else ""))
 
 
 def _auto_scale(width: int) -> float:
+    """The working scale without --scale: 1 halved until ``width`` [px] is at most MAX_AUTO_WIDTH."""
     s = 1.0
     while width * s > MAX_AUTO_WIDTH:
         s /= 2.0
@@ -156,6 +159,7 @@ def _run(left: np.ndarray, right: np.ndarray, truth: Optional[np.ndarray], rig, 
 
 
 def _print_table(results: dict, s: float, w: int, h: int, n: int, with_gt: bool) -> None:
+    """Each method's metrics and time as a table."""
     from rich.table import Table
 
     from percept.cli.common import console, fmt

@@ -5,7 +5,7 @@ short of a person, a = -v^2 / (2 s) over the room s left; an emergency brake whe
 cancel the closing speed before the margin, a_req = closing^2 / (2 s), exceeds a trigger (braking 30 % harder
 than needed); a hold at standstill. Yielding to a pedestrian is a commitment: the car stops before their line
 and goes once stopped and clear, or at once when the pedestrian slot withdraws its request (what it asked to stop
-for has turned out to be no person). Then the command limits.
+for has turned out to be no person). The comfort and braking limits clip the result.
 """
 
 from __future__ import annotations
@@ -27,32 +27,33 @@ MAX_ACCEL_MPS2 = 2.5
 
 @dataclass(frozen=True)
 class EmergencyBrakingDebug:
-    """terms: every active term [m/s²] by name (follow, yield, emergency, hold, commitment); limited_by: the one
-    that set the command (or "brake_limit"/"accel_limit" when clipped); stop_in_m: distance left to a committed
-    stop [m] (None without one); command_mps2: the final command."""
+    """How the emergency-braking law made its command."""
 
-    terms: dict
-    limited_by: str
-    stop_in_m: float | None
-    command_mps2: float
+    terms: dict  # every active term by name (follow, yield, emergency, hold, commitment) [m/s²]
+    limited_by: str  # the term that set the command, or "brake_limit" / "accel_limit" when a limit clipped it
+    stop_in_m: float | None  # distance left to a committed stop [m] (None without one)
+    command_mps2: float  # the final command [m/s²]
 
 
 class EmergencyBraking(Controller):
-    """standstill_m: margin kept to a vehicle [m]; ped_margin_m: margin kept to a pedestrian [m];
-    trigger_mps2: required deceleration that triggers an emergency brake; gain: braking / required."""
+    """Acceleration [m/s²]: the following law's command, lowered where a stop or an emergency demands."""
 
     def __init__(self, standstill_m: float = STANDSTILL_GAP_M, ped_margin_m: float = PERSON_STOP_MARGIN_M,
                  trigger_mps2: float = 2.0, gain: float = STOP_GAIN):
+        """standstill_m: margin kept to a vehicle [m]; ped_margin_m: margin kept to a pedestrian [m]; trigger_mps2:
+        the required deceleration that triggers an emergency brake [m/s²]; gain: braking over the required."""
         self.d0, self.ped_margin, self.trigger, self.gain = standstill_m, ped_margin_m, trigger_mps2, gain
         self.reset()
 
     def reset(self) -> None:
-        self.travelled_m = 0.0
+        self.travelled_m = 0.0  # odometer: distance driven since the reset [m]
         self.stop_at_m: float | None = None  # odometer reading to stop at while yielding to a pedestrian
 
     def update(self, target: Target | None, speed_mps: float, follow_mps2: float, dt: float = 1.0 / 15,
                withdrawn: bool = False) -> tuple[float, EmergencyBrakingDebug]:
-        """withdrawn: the pedestrian slot has withdrawn its request this frame (releases a commitment)."""
+        """The command [m/s²] and its debug record. target: the nearest target (None: nothing ahead); speed_mps:
+        the ego's speed; follow_mps2: the following law's command; dt: the frame period [s]; withdrawn: the
+        pedestrian slot has withdrawn its request this frame (releases a commitment)."""
         v = speed_mps
         self.travelled_m += v * dt
         if withdrawn:
@@ -78,6 +79,7 @@ class EmergencyBraking(Controller):
             terms["commitment"] = -MAX_BRAKE_MPS2 if stop_in < 0.2 else -v * v / (2 * stop_in)
         a, name = limiting(terms)
         if v <= 0.05:
+            # standing: a braking term weaker than 1e-3 m/s² (round-off) counts as none
             a = max(a, 0.0) if a > -1e-3 else a
         out = float(np.clip(a, -MAX_BRAKE_MPS2, MAX_ACCEL_MPS2))
         if out != a:

@@ -24,14 +24,13 @@ from .tuning import STANDING_MPS, STANDSTILL_GAP_M, STOP_GAIN
 
 @dataclass(frozen=True)
 class FollowingDebug:
-    """cruise_mps2, follow_mps2 (None without a target): the two terms [m/s²]; target_gap_m: the gap aimed at
-    (None without a target); limited_by: "cruise" or "follow"."""
+    """How the following law made its command."""
 
-    cruise_mps2: float
-    follow_mps2: float | None
-    target_gap_m: float | None
-    limited_by: str
-    stop_cap_mps2: float | None = None
+    cruise_mps2: float  # the cruise term [m/s²]
+    follow_mps2: float | None  # the gap term [m/s²] (None without a target)
+    target_gap_m: float | None  # the gap aimed at [m] (None without a target)
+    limited_by: str  # the term that set the command: "cruise" or "follow"
+    stop_cap_mps2: float | None = None  # the bound on braking towards a standing target [m/s²] (None: not active)
 
 
 class Following(Controller):
@@ -40,6 +39,11 @@ class Following(Controller):
     def __init__(self, set_speed_mps: float, time_gap_s: float = 1.8, standstill_m: float = STANDSTILL_GAP_M,
                  gap_time_constant_s: float = 2.5, speed_time_constant_s: float = 2.5, stop_gain: float = STOP_GAIN,
                  standing_mps: float = STANDING_MPS):
+        """set_speed_mps: the cruise speed [m/s]; time_gap_s: h, the time gap kept to a lead vehicle [s];
+        standstill_m: d0, the gap kept at a standstill [m]; gap_time_constant_s: Td [s]; speed_time_constant_s: Tv
+        [s]; stop_gain: braking towards a standing target over the constant deceleration stopping needs;
+        standing_mps: a target slower than this stands still [m/s]. ValueError on a non-positive time or a
+        negative set speed."""
         for name, v in (("time_gap_s", time_gap_s), ("gap_time_constant_s", gap_time_constant_s),
                         ("speed_time_constant_s", speed_time_constant_s)):
             if not v > 0:
@@ -51,6 +55,7 @@ class Following(Controller):
         self.stop_gain, self.standing_mps = stop_gain, standing_mps
 
     def update(self, target: Target | None, speed_mps: float) -> tuple[float, FollowingDebug]:
+        """The command [m/s²] and its debug record; target: the nearest target (None: cruise), speed_mps: the ego's."""
         v = speed_mps
         # cruise: first-order approach to the set speed
         cruise = (self.set_speed - v) / self.Tv

@@ -18,20 +18,21 @@ from .base import Controller, sideslip_for_curvature, steering_for_curvature
 
 @dataclass(frozen=True)
 class LaneKeepingDebug:
-    """The curvature terms [1/m] of the command: feed-forward (the lane's), offset and heading feedback; the
-    uncommanded steering [rad]; limited_by: "path" (no lane: hold straight), "steer_limit" or "none"."""
+    """How the lane-keeping law made its command: the curvature terms it adds up and the steering they give."""
 
-    feedforward_1pm: float
-    offset_1pm: float
-    heading_1pm: float
-    steering_rad: float
-    limited_by: str
+    feedforward_1pm: float  # the lane's own curvature [1/m]
+    offset_1pm: float  # the offset feedback term, -w^2 y / v^2 [1/m]
+    heading_1pm: float  # the heading feedback term, -2 w sin(theta) / v [1/m]
+    steering_rad: float  # the front-wheel angle asked for, before the vehicle's steering range [rad]
+    limited_by: str  # "path" (no lane: hold straight), "steer_limit" (outside the steering range) or "none"
 
 
 class LaneKeeping(Controller):
     """Curvature feed-forward plus offset/heading feedback; the gain is a time constant [s]."""
 
     def __init__(self, time_constant_s: float = 0.8, min_speed_mps: float = 3.0):
+        """time_constant_s: T = 1/w of the lateral error [s]; min_speed_mps: the speed the gains assume below it
+        [m/s], since they grow as 1/v and 1/v^2 towards a standstill."""
         if time_constant_s <= 0:
             raise ValueError(f"time_constant_s must be positive, got {time_constant_s}")
         self.T = time_constant_s

@@ -10,13 +10,12 @@ from percept.sensors.vehicle import bumper_gap_m
 
 @dataclass(frozen=True)
 class Target:
-    """gap_m: free distance from the front bumper [m]; closing_mps: how fast the gap shrinks [m/s] (-range rate);
-    kind: what is there; source: "lead" or "request"."""
+    """What a longitudinal law acts on."""
 
-    gap_m: float
-    closing_mps: float
-    kind: ObjectKind
-    source: str
+    gap_m: float  # free distance from the front bumper [m]
+    closing_mps: float  # how fast the gap shrinks, -range rate [m/s]
+    kind: ObjectKind  # what is there
+    source: str  # the record it comes from: "lead" or "request"
 
     @property
     def is_pedestrian(self) -> bool:

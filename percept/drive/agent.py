@@ -13,16 +13,14 @@ from .tasks import SlotContext, Task, task_order, upstream_of
 
 @dataclass(frozen=True)
 class AgentStep:
-    """One step of the agent. accel_mps2, steering_rad: the command (ISO 8855, steering + left); estimates, debug:
-    each task's record and debug object by task name; timing_ms: each slot's step [ms]; control: the laws' debug
-    records by law name (lane_keeping, following, emergency_braking)."""
+    """One step of the agent: the command, and what each slot and law made of the frame."""
 
-    accel_mps2: float
-    steering_rad: float
-    estimates: dict
-    debug: dict
-    timing_ms: dict
-    control: dict
+    accel_mps2: float  # the commanded acceleration [m/s²]
+    steering_rad: float  # the commanded front-wheel angle, ISO 8855 (positive turns left) [rad]
+    estimates: dict  # task name -> the record its slot returned (or None)
+    debug: dict  # task name -> its slot's debug object (or None)
+    timing_ms: dict  # task name -> the wall time of its slot's step [ms]
+    control: dict  # law name (lane_keeping, following, emergency_braking) -> its debug record
 
 
 class Agent:
@@ -45,12 +43,14 @@ class Agent:
         self.braking = EmergencyBraking()
 
     def reset(self) -> None:
+        """Every slot and law forgets the past."""
         for slot in self.slots.values():
             slot.reset()
         for law in (self.keeping, self.following, self.braking):
             law.reset()
 
     def step(self, frame: Frame) -> AgentStep:
+        """Each slot on ``frame`` in dependency order (timed), then the laws on the records they produced."""
         estimates, debug, timing, by_record = {}, {}, {}, {}
         for task in self.order:
             t0 = time.perf_counter()

@@ -15,15 +15,13 @@ from .tasks import Task
 
 @dataclass(frozen=True)
 class DriveConfig:
-    """world: scenario, seed, condition, rig; duration_s: None = the scenario's default [s]; sources: task name ->
-    Source (missing = privileged); tasks: the slot table; detector: the vision pedestrian slot's people model
-    ('sim', 'inria' or a model file). Validated on construction (ValueError naming the bad value)."""
+    """One drive run, validated on construction (ValueError naming the bad value)."""
 
-    world: WorldConfig = field(default_factory=WorldConfig)
-    duration_s: float | None = None
-    sources: dict = field(default_factory=dict)
-    tasks: tuple[Task, ...] = field(default_factory=lambda: tasks_module.TASKS)
-    detector: str = "sim"
+    world: WorldConfig = field(default_factory=WorldConfig)  # scenario, seed, condition, rig
+    duration_s: float | None = None  # simulated length [s] (None: the scenario's own)
+    sources: dict = field(default_factory=dict)  # task name -> Source (a task not given: privileged)
+    tasks: tuple[Task, ...] = field(default_factory=lambda: tasks_module.TASKS)  # the slot table
+    detector: str = "sim"  # people model of the vision pedestrian slot: "sim", "inria" or a model file
 
     def __post_init__(self) -> None:
         d = self.duration_s
@@ -49,6 +47,7 @@ class DriveConfig:
             raise ValueError(f"--detector must be sim, inria or a model file, got '{self.detector}'")
 
     def source(self, task: str) -> Source:
+        """Where ``task``'s estimate comes from."""
         return self.sources[task]
 
     @property

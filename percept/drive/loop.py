@@ -18,7 +18,7 @@ from .tasks import SlotContext
 
 def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, int], None] | None = None,
               render: bool = True) -> dict:
-    """Drive one run; returns the run JSON (DESIGN.md contract, one group per task).
+    """Drive one run; returns the run JSON (docs/design.md, "The run JSON": one group per task).
 
     ``recorder_factory(world)`` returns an object with ``log_step(frame, step_truth, agent_step)``.
     ``render=False`` skips the cameras: only possible while every slot is privileged (baselines, fast tests).
@@ -27,10 +27,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         raise ValueError("vision slots need the cameras (render=True)")
     world = SimWorld(cfg.world)
     feed = TruthFeed()
-    lm = world.landmark_map()
-    agent = Agent(cfg.tasks, cfg.sources, SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed,
-                                                       cfg.detector, hw_pose(world.ego)),
-                  world.cruise_speed_mps)
+    agent = Agent(cfg.tasks, cfg.sources, slot_context(world, feed, cfg.detector), world.cruise_speed_mps)
     rig = world.cfg.rig
     scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
                                              world.crossing_pedestrians, agent.following.time_gap,
@@ -68,6 +65,13 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     result.update({t.name: scorers[t.name].result() for t in cfg.tasks})
     result["timing_ms"] = timing_json(cfg, slot_ms, render_ms if render else None, frames)
     return result
+
+
+def slot_context(world: SimWorld, feed: TruthFeed, detector: str = "sim") -> SlotContext:
+    """What the slots of a run in ``world`` may use: its rig and frame period, its landmark map (None on a road
+    without signs), the truth ``feed``, the people model ``detector`` and the ego's start pose."""
+    lm = world.landmark_map()
+    return SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, detector, hw_pose(world.ego))
 
 
 def timing_json(cfg: DriveConfig, slot_ms: dict, render_ms: float | None, frames: int) -> dict:

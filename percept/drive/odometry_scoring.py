@@ -17,6 +17,7 @@ from .rows import Rows
 # P(chi2 with 2 dof <= 11.83) = 0.9973, the probability of a 1-D +-3 sigma interval
 NEES_3SIGMA_2DOF = 11.83
 TRAJECTORIES = ("vo", "dead_reckoning", "fused", "landmarks")
+"""The trajectories scored, each under its own keys: VO alone, dead reckoning, fused, the slot's estimate."""
 TRAJECTORY_EVERY = 15
 """The run JSON keeps one pose in this many frames of each trajectory (for plots), rounded to 1 cm."""
 

@@ -34,6 +34,7 @@ class TruthFeed:
         self._truth, self._ahead = gt, None
 
     def get(self):
+        """This frame's ground truth; RuntimeError before the loop has set one."""
         if self._truth is None:
             raise RuntimeError("no ground truth yet: the loop sets it before the slots step")
         return self._truth
@@ -47,14 +48,13 @@ class TruthFeed:
 
 @dataclass(frozen=True)
 class InPath:
-    """An object ahead in the ego lane's corridor. gap_m: bumper to object [m]; vx_mps: its speed along the ego's
-    x [m/s]; now: inside the corridor; entering: a person who will step into it before the ego gets there."""
+    """An object ahead in the true ego lane's corridor, or a person about to step into it."""
 
-    obj: object
-    gap_m: float
-    vx_mps: float
-    now: bool
-    entering: bool
+    obj: object  # the ground truth's object
+    gap_m: float  # free distance from the front bumper to it [m]
+    vx_mps: float  # its speed along the ego's x [m/s]
+    now: bool  # inside the corridor this frame
+    entering: bool  # a person who will step into the corridor before the ego gets there
 
 
 def true_centre_y(lane, x_m: float) -> float:
@@ -64,7 +64,8 @@ def true_centre_y(lane, x_m: float) -> float:
 
 
 def path_objects(gt, horizon_s: float = 4.0) -> list[InPath]:
-    """Objects ahead that are in the true ego lane's corridor now or (pedestrians) will enter it."""
+    """Objects of the ground truth ``gt`` ahead that are in the true ego lane's corridor now or (pedestrians) will
+    enter it within ``horizon_s`` [s]."""
     lane = gt.lane
     out = []
     for o in gt.objects:
@@ -97,12 +98,11 @@ def _nearest(items: list[InPath]) -> InPath | None:
 
 @dataclass(frozen=True)
 class Obstacle:
-    """The nearest thing in the true ego path (for scoring): gap_m bumper to object [m]; speed_mps along the ego's
-    x; kind."""
+    """The nearest thing in the true ego path that the ego must respect (for scoring)."""
 
-    gap_m: float
-    speed_mps: float
-    kind: ObjectKind
+    gap_m: float  # free distance from the front bumper to it [m]
+    speed_mps: float  # its speed along the ego's x [m/s]
+    kind: ObjectKind  # what it is
 
 
 def in_path_obstacle(ahead: list[InPath]) -> Obstacle | None:

@@ -1,9 +1,8 @@
 """Per-frame rows of numbers kept compactly for scoring at the end of a run.
 
-A list of Python lists costs about 150 bytes a row of three floats, and a numpy view kept per frame holds its
-whole base array; over a 20-minute drive (18,000 frames) the scorers' histories grew the process by about
-1.5 MB a minute. ``Rows`` keeps the same values as float64 in the standard library's ``array`` (8 bytes each,
-amortised growth), and hands them to numpy at the end.
+``Rows`` keeps the values as float64 in the standard library's ``array`` (8 bytes each, amortised growth) and
+hands them to numpy at the end: a list of Python lists costs about 150 bytes a row of three floats, and a numpy
+view kept per frame holds its whole base array, which over a long drive grows the process steadily.
 """
 
 from __future__ import annotations

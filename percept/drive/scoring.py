@@ -1,4 +1,4 @@
-"""Run metrics against ground truth (DESIGN.md, "Scoring definitions"), one scorer per task returning its JSON
+"""Run metrics against ground truth (docs/design.md, "Scoring definitions"), one scorer per task returning its JSON
 group, plus the run-level safety counts. A metric that does not apply is None. The formulas live in each task's
 ``metrics`` module (pure numpy), shared with the footage commands.
 
@@ -30,48 +30,50 @@ PHANTOM_DECEL_MPS2 = -3.0
 PHANTOM_MIN_SPEED_MPS = 2.0
 """Below this speed a hard deceleration is the end of a stop, not a phantom brake [m/s]."""
 STEADY_REL_MPS = 0.5
+"""The ego's and the lead's speeds match when within this of each other [m/s]."""
 STEADY_S = 2.0
-"""Following is steady once the ego's and the lead's speeds have stayed within STEADY_REL_MPS [m/s] of each other
-for STEADY_S [s]; ``time_gap_steady_s`` averages the time gap over those frames."""
+"""Following is steady once the speeds have matched for this long [s]; ``time_gap_steady_s`` averages the time gap
+over those frames."""
 
 
 @dataclass(frozen=True)
 class ScoreContext:
-    """vision: the task's slot is a vision one (its estimates are scored); pedestrians, crossing_pedestrians: how
-    many the scenario has, and how many of them cross; time_gap_setting_s: the following law's setting;
-    stereo_fb_px_m: the rig's focal length times its baseline [px m] (one disparity pixel is Z^2 / (f b) of range
-    at range Z), or None without a stereo rig; detector: the people model of the vision pedestrian slot."""
+    """What a scorer knows of its run besides the frames."""
 
-    vision: bool
-    pedestrians: int
-    crossing_pedestrians: int
-    time_gap_setting_s: float
+    vision: bool  # the task's slot is a vision one (its estimates are scored)
+    pedestrians: int  # how many pedestrians the scenario has
+    crossing_pedestrians: int  # how many of them cross the road
+    time_gap_setting_s: float  # the following law's time gap [s]
+    # the rig's focal length times its baseline [px m]: one disparity pixel is Z^2 / (f b) of range at range Z
+    # (None without a stereo rig)
     stereo_fb_px_m: float | None = None
-    detector: str = "sim"
+    detector: str = "sim"  # the people model of the vision pedestrian slot
 
 
 @dataclass(frozen=True)
 class StepTruth:
-    """One frame for the scorers: truth (GroundTruth), ahead (``path_objects`` of it: what stands in the true ego
-    corridor), in_path (the true obstacle the ego must respect, or None), the commands sent (accel_mps2,
-    steering_rad)."""
+    """One frame for the scorers: the truth and the commands sent."""
 
-    truth: object
-    ahead: list[InPath]
-    in_path: Obstacle | None
-    accel_mps2: float
-    steering_rad: float
+    truth: object  # the frame's GroundTruth
+    ahead: list[InPath]  # ``path_objects`` of it: what stands in (or steps into) the true ego corridor
+    in_path: Obstacle | None  # the true obstacle the ego must respect (None: nothing)
+    accel_mps2: float  # the commanded acceleration [m/s²]
+    steering_rad: float  # the commanded front-wheel angle [rad]
+
+
+def hard_braking(step: StepTruth) -> bool:
+    """A commanded deceleration below PHANTOM_DECEL_MPS2 above PHANTOM_MIN_SPEED_MPS."""
+    return step.accel_mps2 < PHANTOM_DECEL_MPS2 and step.truth.speed_mps >= PHANTOM_MIN_SPEED_MPS
 
 
 @dataclass
 class SafetyScorer:
-    """Run-level counts: collisions (0/1), pedestrians hit, lane departures (a body edge crossing a lane boundary;
-    no lane change is ever commanded)."""
+    """Run-level counts: collisions, pedestrians hit, lane departures (no lane change is ever commanded)."""
 
-    departures: int = 0
-    crashed: bool = False
-    ped_hits: set = field(default_factory=set)
-    _outside: bool = False
+    departures: int = 0  # times a body edge crossed a lane boundary
+    crashed: bool = False  # the ego hit something other than a pedestrian (those count in ped_hits)
+    ped_hits: set = field(default_factory=set)  # ids of the pedestrians hit
+    _outside: bool = False  # a body edge is over a lane boundary this frame
 
     def update(self, step: StepTruth) -> None:
         gt = step.truth
@@ -138,7 +140,7 @@ class LongitudinalScorer:
         # it has gone)
         reach = gt.speed_mps ** 2 / (2 * -PHANTOM_DECEL_MPS2) + 10.0
         justified = obstacle is not None and obstacle.gap_m <= reach
-        braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
+        braking = hard_braking(step)
         if braking and not self._braking and not justified:
             self.phantom_brakes += 1
         self._braking = braking
@@ -230,7 +232,7 @@ class PedestrianScorer:
         if stopped and not self._stopped and not near_crossing and not halted:
             self.false_stops += 1
         self._stopped = stopped
-        braking = step.accel_mps2 < PHANTOM_DECEL_MPS2 and gt.speed_mps >= PHANTOM_MIN_SPEED_MPS
+        braking = hard_braking(step)
         if braking and not self._braking and BrakingRequest.asking(request) is not None:
             person = self._requested_person(request, debug, gt)
             self.verge_brakes += int(person is not None and not person.crossing)

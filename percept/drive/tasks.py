@@ -5,8 +5,10 @@ one entry here.
 A task has one name wherever a user meets it: its CLI option (``--lanes vision``), its JSON group, its
 ``timing_ms`` key, its recording part and its ``percept bench`` stage. Task names appear as string literals only in
 this module; the same words elsewhere name other things: the footage commands ``percept lanes`` and ``percept
-odometry`` (and their overlay files' suffix), and the TuSimple format's ``"lanes"`` key. A slot is anything with ``reset()`` and ``step(frame, upstream) -> (estimate, debug)``; ``upstream``
-maps each record type the entry ``reads`` to the estimate of the task that ``provides`` it, so a slot asks for
+odometry`` (and their overlay files' suffix), and the TuSimple format's ``"lanes"`` key.
+
+A slot is anything with ``reset()`` and ``step(frame, upstream) -> (estimate, debug)``; ``upstream`` maps each
+record type the entry ``reads`` to the estimate of the task that ``provides`` it, so a slot asks for
 ``upstream[EgoPath]`` and never for another task by name, and the agent finds what steers, what brakes and what
 measures speed by the record each task provides (docs/design.md, "Agent and slots").
 """
@@ -40,6 +42,8 @@ class lazy:  # noqa: N801 - used like a function in the table
 
 
 class Slot(Protocol):
+    """What the agent steps: a task's estimator, vision or privileged."""
+
     def reset(self) -> None: ...
 
     def step(self, frame: Frame, upstream: dict) -> tuple[object, object]: ...

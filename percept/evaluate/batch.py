@@ -35,6 +35,7 @@ from .resume import (COUNTS, RunFiles, groups, differences, refuse_other_setting
 __all__ = ["MAX_SEED", "MAX_SEEDS", "Engine", "EvalPlan", "Job", "RunFiles", "differences", "evaluate",
            "parse_seeds", "refuse_other_settings", "run_job", "run_settings", "scan_runs", "summarize"]
 
+
 def _worker_init() -> None:
     """A worker process: Ctrl-C is the parent's to handle (it terminates the workers)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -55,6 +56,7 @@ def run_job(plan: EvalPlan, job: Job) -> dict:
 
 
 def _local(plan: EvalPlan, jobs: list[Job], workers: int) -> Iterator[tuple[Job, dict]]:
+    """Each job's (job, run JSON) as it finishes, in this process (one worker) or in ``workers`` processes."""
     if workers == 1:
         for job in jobs:
             yield job, run_job(plan, job)
@@ -85,6 +87,7 @@ def _stop_pool(pool: ProcessPoolExecutor) -> None:
 
 
 def _ray(plan: EvalPlan, jobs: list[Job], address: str | None) -> Iterator[tuple[Job, dict]]:
+    """Each job's (job, run JSON) as it finishes on the Ray cluster at ``address`` (None: a local Ray)."""
     try:
         import ray
     except ImportError:
@@ -140,6 +143,7 @@ def evaluate(plan: EvalPlan, out_dir: Path, workers: int = 1, engine: Engine = E
 
 
 def _stats(values: list) -> dict | None:
+    """Mean, max and min of the numbers among ``values`` (None where there are none)."""
     v = [x for x in values if x is not None and not isinstance(x, (list, dict, bool, str))]
     if not v:
         return None

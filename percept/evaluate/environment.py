@@ -3,11 +3,9 @@ they chose.
 
 The same code, scenario and seed give the same run JSON on one machine, bit for bit, but not always on another:
 OpenBLAS picks its kernels by CPU (its ``architecture``, e.g. Haswell or SkylakeX), and the order of a product's sums
-goes with the kernel; OpenCV and numba likewise dispatch by CPU features, and a library's new release may compute a
-value differently. Measured (2026-11-28): `highway`, clear, seeds 0-19, on one machine with OpenBLAS's SkylakeX
-kernels and with them forced to Haswell's (``OPENBLAS_CORETYPE=Haswell``) gave VO drift means of 0.156 % and 0.161 %
-(the same safety counts). So each evaluation run records its environment, and a report lists the environments its
-runs came from.
+goes with the kernel; OpenCV and numba likewise dispatch by CPU features, and another release of a library may
+compute a value differently. So each evaluation run records its environment, and a report lists the environments
+its runs came from.
 """
 
 from __future__ import annotations
@@ -66,7 +64,7 @@ def numeric_environment() -> dict:
 
 def environments(results: list[dict]) -> list[dict]:
     """The distinct ``environment`` records of the finished runs, each with how many runs it drove (``runs``), most
-    runs first; runs made before runs recorded one count under {"environment": "not recorded"}."""
+    runs first; runs without one count under {"environment": "not recorded"}."""
     counts: dict[str, list] = {}
     for r in results:
         if "error" in r:

@@ -15,6 +15,8 @@ MAX_SEEDS = 10_000
 
 
 class Engine(str, Enum):
+    """Where a batch's runs go: worker processes on this machine, or a Ray cluster."""
+
     LOCAL = "local"
     RAY = "ray"
 
@@ -47,27 +49,26 @@ def parse_seeds(text: str, option: str = "--seeds") -> list[int]:
 class Job:
     """One run of the batch."""
 
-    scenario: str
-    condition: str
-    seed: int
+    scenario: str  # scenario name
+    condition: str  # condition name
+    seed: int  # the run's seed
 
     @property
     def name(self) -> str:
+        """``<scenario>-<condition>-<seed>``: the run file's name."""
         return f"{self.scenario}-{self.condition}-{self.seed}"
 
 
 @dataclass(frozen=True)
 class EvalPlan:
-    """scenarios, conditions: names; seeds: the seeds of every (scenario, condition); slots: Source per task name
-    (missing ones privileged); duration_s: None = each scenario's own. Validated here: a bad name, condition or
-    slot raises ValueError before any run starts. detector: the vision pedestrian slot's people model."""
+    """A batch, validated on construction: a bad name, condition or slot raises ValueError before any run starts."""
 
-    scenarios: tuple[str, ...]
-    conditions: tuple[str, ...]
-    seeds: tuple[int, ...]
-    slots: dict = field(default_factory=dict)
-    duration_s: float | None = None
-    detector: str = "sim"
+    scenarios: tuple[str, ...]  # scenario names
+    conditions: tuple[str, ...]  # condition names
+    seeds: tuple[int, ...]  # the seeds of every (scenario, condition)
+    slots: dict = field(default_factory=dict)  # task name -> Source (a task not given: privileged)
+    duration_s: float | None = None  # simulated length of each run [s] (None: each scenario's own)
+    detector: str = "sim"  # people model of the vision pedestrian slot
 
     def __post_init__(self) -> None:
         if not self.scenarios or not self.conditions or not self.seeds:
@@ -78,6 +79,7 @@ class EvalPlan:
                 self.config(Job(sc, c, self.seeds[0]))
 
     def config(self, job: Job) -> DriveConfig:
+        """The drive configuration of one job."""
         return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
                            dict(self.slots), detector=self.detector)
 
@@ -88,4 +90,5 @@ class EvalPlan:
 
     @property
     def jobs(self) -> list[Job]:
+        """Every run of the batch: scenario by scenario, condition by condition, seed by seed."""
         return [Job(sc, c, s) for sc in self.scenarios for c in self.conditions for s in self.seeds]

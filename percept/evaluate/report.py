@@ -19,7 +19,9 @@ from percept.outputs import write_text_atomic
 from .environment import environments
 from .metrics import UNSAFE, higher_is_better, run_metrics, safety_counts
 
+
 def _stat_row(name: str, values: list[float], up: bool, total: bool) -> dict:
+    """One metric's row of the long table; ``up``: higher is better; ``total``: a count, summed too."""
     a = np.asarray(values, dtype=float)
     return {"metric": name, "runs": len(a), "mean": float(a.mean()),
             "p95": float(np.percentile(a, 5 if up else 95)), "worst": float(a.min() if up else a.max()),
@@ -81,6 +83,7 @@ def listed_runs(results: list[dict], tasks) -> list[tuple[dict, str]]:
 
 
 def summary_csv(rows: list[dict]) -> str:
+    """The long table (``metric_rows``) as CSV, numbers to 6 significant digits."""
     buf = io.StringIO()
     fields = ["scenario", "condition", "metric", "runs", "mean", "p95", "worst", "total", "better"]
     w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n")
@@ -95,8 +98,8 @@ def _fmt(v, spec: str = "{:.3g}") -> str:
 
 
 def _environment_lines(results: list[dict]) -> list[str]:
-    """Where the runs were driven (``batch.environments``): the same code gives other numbers, slightly, with other
-    numeric libraries or CPU code paths."""
+    """Where the runs were driven (``environment.environments``): the same code gives other numbers, slightly, with
+    other numeric libraries or CPU code paths."""
     lines = []
     for env in environments(results):
         if "numpy" in env:
@@ -146,6 +149,7 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
 
 
 def _problems_md(results: list[dict], settings: dict, tasks) -> list[str]:
+    """The "Runs to look at" section: unsafe, listed and failed runs, each with its reproduce command."""
     bad = unsafe_runs(results) + listed_runs(results, tasks)
     errors = [r for r in results if "error" in r]
     if not bad and not errors:
@@ -160,6 +164,7 @@ def _problems_md(results: list[dict], settings: dict, tasks) -> list[str]:
 
 
 def _seed_text(seeds) -> str:
+    """Seeds as the report prints them: "0–19" for a run of consecutive seeds, else listed."""
     s = sorted(seeds)
     return f"{s[0]}–{s[-1]}" if s == list(range(s[0], s[-1] + 1)) and len(s) > 1 else ", ".join(map(str, s))
 

@@ -20,6 +20,8 @@ if TYPE_CHECKING:
 
 COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
 """Safety counts every run JSON has (integers)."""
+
+
 def groups(tasks=None) -> tuple[str, ...]:
     """Metric groups every run JSON has (objects): one per task (of the slot table unless given), and
     ``timing_ms``."""
@@ -60,12 +62,11 @@ def run_path(out_dir: Path, job: Job) -> Path:
 
 @dataclass
 class RunFiles:
-    """What ``OUT/runs`` holds for a plan: ``done`` runs to reuse (job -> run JSON), ``damaged`` files to redo
-    ((path, why)), runs made under ``other`` settings ((path, differing settings))."""
+    """What ``OUT/runs`` holds for a plan."""
 
-    done: dict = field(default_factory=dict)
-    damaged: list = field(default_factory=list)
-    other: list = field(default_factory=list)
+    done: dict = field(default_factory=dict)  # runs to reuse: Job -> run JSON
+    damaged: list = field(default_factory=list)  # files to redo: (path, why)
+    other: list = field(default_factory=list)  # runs made under other settings: (path, the settings that differ)
 
 
 def _not_a_run(data) -> str | None:

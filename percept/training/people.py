@@ -6,12 +6,10 @@ Negatives: random windows where the constrained search looks (its levels and cor
 then hard negatives: the first model's false positives over the same frames, searched as the slot searches, and
 optionally over frames of traffic scenarios (``negative_scenarios``, none by default), whose vehicles' corners (a
 tail light over a wheel) the first model takes for people 30-45 m ahead (Dalal & Triggs 2005, sec. 4: hard
-negatives are mined from the images the detector will search). Measured with highway, curves, cut-in and loop: no
-braking for no one left on the 27 runs that had 40, half the false positives on `crossing`, but in rain the far
-field's recall fell from 0.71 to 0.49 and a crossing person was hit (README, Pedestrians); so in the shipped model
-such a model is only the second stage of a cascade (``LinearModel.second``: it confirms what a model trained
-without them finds). Seeds are disjoint from every evaluation seed (0-19 closed loop, 100-119 detection); the
-conditions rotate over them so that the model sees day, night and rain.
+negatives are mined from the images the detector will search). A model trained with traffic negatives loses recall
+on far people, so the shipped model uses one only as the second stage of a cascade (``LinearModel.second``: it
+confirms what a model trained without them finds). Seeds are disjoint from every evaluation seed (0-19 closed
+loop, 100-119 detection); the conditions rotate over them so that the model sees day, night and rain.
 """
 
 from __future__ import annotations
@@ -29,31 +27,27 @@ from percept.sims.world import check_condition, check_scenario
 from .samples import for_each_frame
 
 EVALUATION_SEEDS = frozenset(range(0, 20)) | frozenset(range(100, 120))
+"""Seeds the evaluations use (0-19 closed loop, 100-119 detection): no training run may use one."""
 
 
 @dataclass(frozen=True)
 class TrainPlan:
-    """scenario; seeds: training seeds (none may be an evaluation seed); conditions: rotated over the seeds; every:
-    frame step; duration_s: of each run (None = the scenario's); min_person_px: smallest positive [px];
-    negatives_per_frame: random negatives; hard_per_frame: most hard negatives kept per frame; c: the SVM's C;
-    jitter_seed: the random generator's seed; negative_scenarios: traffic scenarios whose frames give hard
-    negatives too, each driven with ``negative_seeds`` (conditions rotated the same way) and at most
-    ``traffic_hard_per_frame`` windows kept per frame."""
+    """What ``train_people_model`` renders and how it trains, validated on construction (ValueError)."""
 
-    scenario: str = "crossing"
-    seeds: tuple[int, ...] = tuple(range(1000, 1010))
-    conditions: tuple[str, ...] = ("clear", "night", "rain")
-    every: int = 3
-    duration_s: float | None = None
-    min_person_px: float = 30.0
-    negatives_per_frame: int = 8
-    hard_per_frame: int = 10
-    c: float = 0.01
-    jitter_seed: int = 7
-    search: SearchConfig = field(default_factory=SearchConfig)
-    negative_scenarios: tuple[str, ...] = ()
-    negative_seeds: tuple[int, ...] = tuple(range(1000, 1005))
-    traffic_hard_per_frame: int = 3
+    scenario: str = "crossing"  # the scenario whose people are the positives
+    seeds: tuple[int, ...] = tuple(range(1000, 1010))  # training seeds (none may be an evaluation seed)
+    conditions: tuple[str, ...] = ("clear", "night", "rain")  # rotated over the seeds
+    every: int = 3  # sample every this many frames
+    duration_s: float | None = None  # simulated length of each run [s] (None: the scenario's own)
+    min_person_px: float = 30.0  # smallest positive, the person's box height [px]
+    negatives_per_frame: int = 8  # random negative windows drawn per frame
+    hard_per_frame: int = 10  # most hard negatives kept per frame (the highest scores)
+    c: float = 0.01  # the linear SVM's C
+    jitter_seed: int = 7  # seed of the random generator (jitter and random negatives)
+    search: SearchConfig = field(default_factory=SearchConfig)  # the constrained search the windows come from
+    negative_scenarios: tuple[str, ...] = ()  # traffic scenarios whose frames give hard negatives too
+    negative_seeds: tuple[int, ...] = tuple(range(1000, 1005))  # their seeds (conditions rotated the same way)
+    traffic_hard_per_frame: int = 3  # most hard negatives kept per frame of those scenarios
 
     def __post_init__(self) -> None:
         clash = sorted((set(self.seeds) | set(self.negative_seeds)) & EVALUATION_SEEDS)
@@ -76,6 +70,7 @@ def truth_path(gt) -> EgoPath:
 
 
 def _people(gt) -> list:
+    """The ground truth's pedestrians with a box on the image."""
     return [o for o in gt.objects if o.kind is ObjectKind.PEDESTRIAN and o.box_px is not None]
 
 

@@ -1,6 +1,6 @@
 """Rendered frames with their ground truth, from a closed-loop run on the privileged slots (so the ego drives as a
-perfect stack would: it stops for people, follows leads). Used to measure how the renderer looks to a detector,
-to collect training crops for the sim-trained people model and to score detectors frame by frame.
+perfect stack would: it stops for people, follows leads): the training crops of the sim people model, and the
+frames on which detectors are scored one by one.
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ FrameFn = Callable[[int, object, object], None]
 
 
 class _Sampler:
+    """A recorder for ``run_drive`` that hands every ``every``-th rendered frame and its truth to ``fn``."""
+
     def __init__(self, seed: int, every: int, fn: FrameFn):
         self.seed, self.every, self.fn = seed, every, fn
 

@@ -48,6 +48,7 @@ def _draw_path(rec: rr.RecordingStream, ctx: PartContext, path, lane) -> None:
 
 
 def _draw_on_image(rec: rr.RecordingStream, ctx: PartContext, lane, debug) -> None:
+    """The lane boundaries and the vision slot's marking evidence on the left image."""
     if lane is not None:
         px = boundary_points_px(ctx.rig, lane, *DRAW_M, n=POINTS)
         rec.log(ctx.on_image("boundaries"), rr.LineStrips2D([ctx.px(px["left"]), ctx.px(px["right"])],

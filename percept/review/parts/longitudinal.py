@@ -24,10 +24,12 @@ def true_lead(ctx: PartContext, truth) -> tuple[float | None, float | None, floa
 
 
 def _shown(ttc_s: float | None) -> float | None:
+    """``ttc_s`` if the plot shows it (at most TTC_SHOWN_S), else None."""
     return ttc_s if ttc_s is not None and ttc_s <= TTC_SHOWN_S else None
 
 
 def label(lead) -> str:
+    """The lead's label: its range and time to contact ("opening" when the gap grows)."""
     ttc = f"TTC {lead.ttc_s:.1f} s" if lead.ttc_s is not None else "opening"
     return f"{lead.range_m:.1f} m {ttc}"
 

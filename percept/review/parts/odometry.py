@@ -25,6 +25,7 @@ OTHERS = (("vo_pose", "world/odometry/vo_trail", VO_RGB), ("dead_reckoning_pose"
 
 
 def _error(pose, gt) -> float:
+    """Distance from ``pose`` to the true ego position [m]."""
     return math.hypot(pose.x_m - gt.ego.x_m, pose.y_m - gt.ego.y_m)
 
 
@@ -51,6 +52,7 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, estimate, debug, truth) -> N
 
 
 def _draw_vision(rec: rr.RecordingStream, ctx: PartContext, pose, debug) -> None:
+    """The vision slot's other trails and this frame's landmark fixes."""
     for attr, path, rgb in OTHERS:
         p = getattr(debug, attr)
         ctx.buffer.add(path, rr.Points3D, positions=[[p.x_m, p.y_m, 0.1]], colors=[rgb], radii=[0.1])

@@ -13,8 +13,7 @@ from ..context import Part, PartContext, Plot, cross_line, log_on_change
 
 STOP_RGB = (240, 50, 50)
 LOG = "pedestrians/requests"
-
-
+"""The text log of braking requests: one line when a request starts, changes reason or ends."""
 DETECTION_RGB, TRACK_RGB = (160, 160, 255), (60, 220, 255)
 
 
