@@ -111,7 +111,9 @@ def summary_table(cfg, result: dict) -> Table:
                     f"frames, {result['duration_s']:.1f} s, realtime x{result['realtime_factor']:.2f}")
     for col, just in (("task", "left"), ("metric", "left"), ("value", "right")):
         t.add_column(col, justify=just)
-    for k in ("collisions", "pedestrian_collisions", "lane_departures"):
+    from percept.drive.scoring import SAFETY_COUNTS
+
+    for k in SAFETY_COUNTS:
         t.add_row("run", k.replace("_", " "), fmt(result[k], "{}"))
     for task in cfg.tasks:
         group = result[task.name]

@@ -7,6 +7,7 @@ from typing import Annotated, List, Optional
 
 import typer
 from rich import box
+from rich.console import Group
 from rich.markup import escape
 from rich.table import Table
 
@@ -57,7 +58,7 @@ def eval_(
     for path, why in files.damaged:
         err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
     summary = _run(plan, out, workers, eng, address, redo, files)
-    console.print(summary_table(summary, plan.tasks))
+    console.print(summary_tables(summary, plan.tasks))
     console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
                   f"{out / 'summary.md'}; plots in {out / 'plots'}")
     write_json(json_path, summary)
@@ -145,21 +146,34 @@ def _run(plan, out: Path, workers: int, eng, address, redo: bool, files) -> dict
             fail(f"cannot write into {out}: {e.strerror or e}; the finished runs are kept, the same command resumes")
 
 
-def summary_table(summary: dict, tasks) -> Table:
-    """Per scenario and condition: runs, summed safety counts, and each task's headline metrics (mean over seeds)
-    for the metrics some run has."""
-    cols = [(t, h) for t in tasks for h in t.headline
-            if any((g[t.name].get(h.key) or None) is not None for g in summary["groups"])]
-    t = Table(title=f"{sum(len(g['seeds']) for g in summary['groups'])} runs; slots: "
-                    + ", ".join(f"{k} {v}" for k, v in summary["settings"]["slots"].items()),
-              box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True, caption="means over seeds")
-    for col in ("scenario", "cond", "runs", "coll", "ped", "dep"):
-        t.add_column(col, justify="left" if col in ("scenario", "cond") else "right", no_wrap=True)
-    for _, h in cols:
-        t.add_column(escape(h.label), justify="right")
-    for g in summary["groups"]:
-        cells = [fmt((g[task.name].get(h.key) or {}).get("mean"), h.fmt.replace("{}", "{:.1f}"))
-                 for task, h in cols]
-        t.add_row(g["scenario"], g["condition"], str(len(g["seeds"])), fmt(g["collisions"], "{}"),
-                  fmt(g["pedestrian_collisions"], "{}"), fmt(g["lane_departures"], "{}"), *cells)
+def summary_tables(summary: dict, tasks) -> Group:
+    """Per scenario and condition, in tables that each fit 80 columns: the runs and their summed safety counts;
+    then, per task, its headline metrics (mean over seeds) that some run has."""
+    groups = summary["groups"]
+    title = (f"{sum(len(g['seeds']) for g in groups)} runs; slots: "
+             + ", ".join(f"{k} {v}" for k, v in summary["settings"]["slots"].items()))
+    safety = _cells_table(title, ("runs", "collisions", "pedestrian collisions", "lane departures"))
+    for g in groups:
+        safety.add_row(g["scenario"], g["condition"], str(len(g["seeds"])), fmt(g["collisions"], "{}"),
+                       fmt(g["pedestrian_collisions"], "{}"), fmt(g["lane_departures"], "{}"))
+    tables = [safety]
+    for task in tasks:
+        heads = [h for h in task.headline if any((g[task.name].get(h.key) or None) is not None for g in groups)]
+        if not heads:
+            continue
+        t = _cells_table(f"{task.name} (means over seeds)", [h.label for h in heads])
+        for g in groups:
+            t.add_row(g["scenario"], g["condition"], *(fmt((g[task.name].get(h.key) or {}).get("mean"),
+                                                           h.fmt.replace("{}", "{:.1f}")) for h in heads))
+        tables.append(t)
+    return Group(*tables)
+
+
+def _cells_table(title: str, columns) -> Table:
+    """A table of one row per scenario and condition with these value columns (headers wrap, values do not)."""
+    t = Table(title=escape(title), box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True, title_justify="left")
+    t.add_column("scenario", no_wrap=True)
+    t.add_column("condition", no_wrap=True)
+    for col in columns:
+        t.add_column(escape(col), justify="right", min_width=8)
     return t

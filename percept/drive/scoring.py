@@ -21,6 +21,8 @@ from percept.sensors.vehicle import EGO_WIDTH_M
 from .privileged import InPath, Obstacle, true_centre_y
 from .rows import Rows
 
+SAFETY_COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
+"""The safety counts every run JSON has (integers); any of them makes a run unsafe."""
 STOP_SPEED_MPS = 0.5
 """Below this speed the car has stopped [m/s]."""
 HALTING_VEHICLE_MPS = 2.0
@@ -85,8 +87,8 @@ class SafetyScorer:
         self.ped_hits.update(gt.pedestrians_hit)
 
     def result(self) -> dict:
-        return {"collisions": int(self.crashed), "pedestrian_collisions": len(self.ped_hits),
-                "lane_departures": self.departures}
+        """The run's safety counts, under the names in ``SAFETY_COUNTS``."""
+        return dict(zip(SAFETY_COUNTS, (int(self.crashed), len(self.ped_hits), self.departures)))
 
 
 class LaneScorer:

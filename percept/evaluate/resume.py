@@ -14,12 +14,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from percept.drive import tasks as tasks_module
+from percept.drive.scoring import SAFETY_COUNTS as COUNTS
 
 if TYPE_CHECKING:
     from .plan import EvalPlan, Job
-
-COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
-"""Safety counts every run JSON has (integers)."""
 
 
 def groups(tasks=None) -> tuple[str, ...]:

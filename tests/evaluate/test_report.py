@@ -33,7 +33,7 @@ def run(seed, collisions=0, recall=None, offset=0.01, stops=None, phantom=0, tra
             "pedestrians": {"recall": recall, "stops": stops}, "odometry": odo, "timing_ms": {"lanes": 1.0}}
 
 
-PLAN = SimpleNamespace(scenarios=("highway",), conditions=("clear",), seeds=(0, 1, 2, 3))
+PLAN = SimpleNamespace(scenarios=("highway",), conditions=("clear",), seeds=(0, 1, 2, 3), tasks=TASKS)
 
 
 def test_rows_have_mean_p95_and_the_worst_on_the_right_side():
@@ -107,3 +107,20 @@ def test_strict_lists_unsafe_runs_and_exits_1(tmp_path, monkeypatch):
     assert "unsafe highway/clear/seed 1: 1 collisions; reproduce: percept drive --scenario highway --seed 1" in r.output
     assert (tmp_path / "summary.md").exists() and (tmp_path / "summary.csv").exists()
     assert runner.invoke(app, args).exit_code == 0  # without --strict the same batch is a success
+
+
+def test_the_eval_tables_fit_an_80_column_terminal():
+    from rich.console import Console
+
+    from percept.cli.eval_cmd import summary_tables
+
+    runs = [run(k, recall=0.8, offset=0.0123, stops=[True], traj=True) for k in range(4)]
+    summary = {**ev.summarize(PLAN, runs), "settings": SETTINGS}
+    console = Console(width=80, record=True, file=io.StringIO())
+    console.print(summary_tables(summary, TASKS))
+    lines = console.export_text().splitlines()
+    assert max(len(line) for line in lines) <= 80
+    # each task with a metric some run has gets its table, every value on the scenario's line, none cut
+    rows = [line for line in lines if line.split()[:2] == ["highway", "clear"]]
+    assert len(rows) == 5 and "0.0123" in rows[1] and "0.800" in rows[3]
+    assert all(line.rstrip()[-1].isdigit() or line.rstrip().endswith("n/a") for line in rows)
