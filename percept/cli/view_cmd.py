@@ -51,7 +51,8 @@ def recording_problem(exe: str, recording: Path) -> str | None:
     if head != RRD_MAGIC:
         return "it does not start like a Rerun recording"
     try:
-        # percept's recordings have no footer (``review.recorder``), nor has any file cut short: not required here
+        # an interrupted recording (RUN.partial.rrd, ``review.recorder``) has no footer, nor has any file cut short:
+        # not required here
         r = subprocess.run([exe, "rrd", "verify", "--check-footers", "false", str(recording)], env=rerun_env(),
                            capture_output=True, text=True)
     except OSError as e:

@@ -2,9 +2,10 @@
 
 import os
 
-# The recorder writes its files without an RRD footer (``recorder.py``: the footer's manifest would grow in memory
-# through a long drive), and Rerun warns of that once per file. Its logging reads RUST_LOG when rerun is first
-# imported, here: that one warning is silenced unless the user set RUST_LOG.
+# The recorder streams a drive without an RRD footer and adds the footer when the run finishes (``recorder.py``: the
+# footer's manifest would grow in memory through a long drive), and Rerun warns of the missing footer once per file.
+# Its logging reads RUST_LOG when rerun is first imported, here: that one warning is silenced unless the user set
+# RUST_LOG.
 os.environ.setdefault("RUST_LOG", "warn,re_log_encoding::rrd::file_sink=error")
 
 from .blueprint import blueprint

@@ -6,19 +6,23 @@ box, static), ``world/ego/camera/left`` (mount and pinhole, static; the JPEG ima
 ``world/ego/objects`` (true 3D boxes in the vehicle frame), ``world/ego/camera/left/objects`` (their true boxes in
 the image), ``world/trajectory`` (one true position per frame; the 3D view shows its whole past) and the control
 part's ``control/*``. Each task part adds ``<task>/*`` scalars and its drawings (see ``percept.review.context``).
-The file is written to a temporary name beside the target (``.RUN.rrd.part``) and moved into place by ``close``: a
-finished run becomes ``RUN.rrd``, an interrupted or failed one ``RUN.partial.rrd``, so a finished recording is
-never replaced by a truncated one. The file has no RRD footer (the manifest of its chunks that allows random access):
-Rerun's SDK keeps that manifest in memory until the file closes, a row per chunk, which made a recorded drive grow by
-about 3 MB a simulated minute. The viewer reads the file from its start as it reads one cut short;
-``rerun rrd optimize RUN.rrd -o OUT.rrd`` writes a compacted copy with a footer.
+The drive is streamed to a temporary name beside the target (``.RUN.rrd.part``) without an RRD footer, the manifest
+of its chunks that Rerun's SDK would hold in memory, a row per chunk, until the file closes. ``close`` then writes a
+finished run's stream compacted and with its footer to ``RUN.rrd`` (``finish``: ``rerun rrd optimize`` in a child
+process, to a temporary name, then renamed), so that the drive's memory stays flat and the finished recording
+passes ``rerun rrd verify``; an interrupted or failed run's stream becomes ``RUN.partial.rrd`` as it is (no
+footer: the viewer reads it from its start as it reads any file cut short), and a finished recording is never
+replaced by a truncated one.
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import math
 import os
+import subprocess
+import sys
 from dataclasses import replace
 from datetime import timedelta
 from pathlib import Path
@@ -27,6 +31,7 @@ import cv2
 import numpy as np
 import rerun as rr
 
+from percept.outputs import atomic_path
 from percept.sensors import ObjectKind, Side, StereoRig
 from percept.sensors.vehicle import EGO_LENGTH_M, EGO_WIDTH_M
 
@@ -69,6 +74,31 @@ def resolve_part(spec):
 def partial_path(path: Path) -> Path:
     """Where an interrupted recording of ``path`` is kept: RUN.rrd -> RUN.partial.rrd."""
     return path.with_name(f"{path.stem}.partial{path.suffix or '.rrd'}")
+
+
+def rerun_cli() -> str:
+    """The ``rerun`` command-line binary that rerun-sdk's wheel ships (package ``rerun_cli``); OSError without it."""
+    spec = importlib.util.find_spec("rerun_cli")
+    if spec is not None and spec.origin:
+        exe = Path(spec.origin).with_name("rerun.exe" if sys.platform == "win32" else "rerun")
+        if exe.is_file():
+            return str(exe)
+    raise OSError("the rerun command-line tool (package rerun_cli, installed with rerun-sdk) is missing")
+
+
+def finish(stream: Path, path: Path) -> None:
+    """Write the recording ``stream`` (as streamed, without a footer) to ``path`` compacted and with its RRD footer:
+    ``rerun rrd optimize`` in a child process, whose memory is given back when it ends, to a temporary name renamed
+    into place. OSError when it fails (``path`` is then untouched); Ctrl-C stops the child."""
+    exe = rerun_cli()
+    env = {**os.environ, "RERUN_ANALYTICS": os.environ.get("RERUN_ANALYTICS", "0")}
+    with atomic_path(path) as out:
+        r = subprocess.run([exe, "rrd", "optimize", str(stream), "-o", str(out)], env=env, stdin=subprocess.DEVNULL,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, errors="replace")
+        if r.returncode != 0:
+            lines = [ln.strip() for ln in r.stderr.splitlines() if ln.strip()]
+            why = lines[-1] if lines else f"exit code {r.returncode}"
+            raise OSError(f"`rerun rrd optimize` could not finish the recording ({why})")
 
 
 class RunRecorder:
@@ -190,20 +220,24 @@ class RunRecorder:
             self.buffer.clear(f"{CAMERA}/objects")
 
     def close(self, complete: bool = True) -> Path:
-        """Flush and move the recording into place: ``path`` when ``complete``, else ``RUN.partial.rrd`` beside it
-        (an interrupted or failed run; a finished ``RUN.rrd`` is never touched). Returns where it went; a second
-        call does nothing."""
+        """Flush and move the recording into place: ``path`` when ``complete`` (compacted, with its footer:
+        ``finish``), else ``RUN.partial.rrd`` beside it (an interrupted or failed run, or one whose end could not be
+        written; a finished ``RUN.rrd`` is never touched). Returns where it went; a second call does nothing."""
         if self.closed_as is not None:
             return self.closed_as
-        target = self.path if complete else partial_path(self.path)
+        target = partial_path(self.path)
         try:
-            self.buffer.flush(self.rec)
-            self.rec.flush()
-        except BaseException:  # Ctrl-C or a full disk while flushing: the file may lack its end, it is partial
-            target = partial_path(self.path)
-            raise
-        finally:
-            self.rec.disconnect()
+            try:
+                self.buffer.flush(self.rec)
+                self.rec.flush()
+            finally:
+                self.rec.disconnect()
+            if complete:
+                if self.tmp.exists():
+                    finish(self.tmp, self.path)
+                    self.tmp.unlink()
+                target = self.path
+        finally:  # Ctrl-C or a full disk while flushing or finishing: the stream is kept as partial
             try:
                 if self.tmp.exists():
                     os.replace(self.tmp, target)

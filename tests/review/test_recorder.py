@@ -1,9 +1,10 @@
 """The run recording: every task's part is recorded, objects ride under the ego, the camera options change what is
-stored, and an interrupted recording never replaces a finished one. Checked with the rerun CLI (`rrd verify`,
-`rrd print`)."""
+stored, a finished recording has its RRD footer, and an interrupted recording (kept as streamed, without one) never
+replaces a finished one. Checked with the rerun CLI (`rrd verify`, `rrd print`)."""
 
 import os
 import re
+import shutil
 import subprocess
 from collections import defaultdict
 from pathlib import Path
@@ -14,6 +15,7 @@ import pytest
 from percept.cli.view_cmd import rerun_executable
 from percept.drive import TASKS, DriveConfig, Task, run_drive
 from percept.review import RecordOptions, RunRecorder, partial_path
+from percept.review import recorder as recorder_module
 from percept.review.recorder import resolve_part
 from percept.sensors import StereoRig
 from percept.sims import WorldConfig
@@ -24,8 +26,8 @@ COMMON = ["/world/road", "/world/ego", "/world/ego/body", "/world/ego/camera/lef
           "/world/ego/camera/left/objects", "/world/trajectory", "/control/speed_mps/truth",
           "/control/accel_mps2/command", "/control/steering_rad/command", "/control/limits"]
 TASK_ENTITIES = {
-    "lateral": ["/lateral/offset_m/truth", "/lateral/offset_m/estimate", "/lateral/heading_rad/estimate",
-                "/lateral/curvature_1pm/truth", "/world/ego/lateral/path", "/world/ego/camera/left/lateral/boundaries"],
+    "lanes": ["/lanes/offset_m/truth", "/lanes/offset_m/estimate", "/lanes/heading_rad/estimate",
+              "/lanes/curvature_1pm/truth", "/world/ego/lanes/path", "/world/ego/camera/left/lanes/boundaries"],
     "longitudinal": ["/longitudinal/range_m/truth", "/longitudinal/range_m/estimate",
                      "/longitudinal/range_rate_mps/estimate", "/longitudinal/ttc_s/estimate",
                      "/world/ego/longitudinal/lead"],
@@ -40,10 +42,18 @@ def rerun(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([rerun_executable(), *args], env=ENV, capture_output=True, text=True, timeout=120)
 
 
-def verify(path: Path, footer: bool = False) -> None:
-    """``path`` loads (``rrd verify``); with a footer that lists its chunks when ``footer``."""
-    r = rerun("rrd", "verify", "--check-footers", str(footer).lower(), str(path))
+def verify(path: Path, footer: bool = True) -> None:
+    """``path`` loads: ``rrd verify`` as it is (a footer that lists its chunks) when ``footer``, else with
+    ``--check-footers false`` (a stream without one: an interrupted recording)."""
+    r = rerun("rrd", "verify", str(path)) if footer else rerun("rrd", "verify", "--check-footers", "false", str(path))
     assert r.returncode == 0 and "1 file verified" in r.stdout + r.stderr, r.stdout + r.stderr
+
+
+def no_footer(path: Path) -> bool:
+    """``rrd verify`` as it is fails on ``path`` for want of its footer."""
+    r = rerun("rrd", "verify", str(path))
+    return r.returncode != 0 and "footer" in (r.stdout + r.stderr).lower()
+
 
 
 def columns_by_entity(path: Path) -> dict[str, dict[str, int]]:
@@ -74,8 +84,18 @@ def record(path: Path, sources: dict, options: RecordOptions = RecordOptions(), 
 
 @pytest.fixture(scope="module")
 def privileged(tmp_path_factory):
-    path = tmp_path_factory.mktemp("priv") / "run.rrd"
-    return path, record(path, {})
+    """A privileged 1 s drive's finished recording, its result and a copy of its stream as ``finish`` got it."""
+    path, stream = tmp_path_factory.mktemp("priv") / "run.rrd", tmp_path_factory.mktemp("stream") / "stream.rrd"
+    real_finish = recorder_module.finish
+
+    def finish(part: Path, out: Path) -> None:
+        shutil.copyfile(part, stream)
+        real_finish(part, out)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(recorder_module, "finish", finish)
+        result = record(path, {})
+    return path, result, stream
 
 
 @pytest.fixture(scope="module")
@@ -89,7 +109,7 @@ def images(cols: dict) -> int:
 
 
 def test_every_task_is_recorded_with_all_slots_privileged(privileged):
-    path, result = privileged
+    path, result, _ = privileged
     cols = columns_by_entity(path)
     missing = [e for e in COMMON + [e for es in TASK_ENTITIES.values() for e in es] if e not in cols]
     assert not missing, f"missing entities: {missing}"
@@ -99,15 +119,13 @@ def test_every_task_is_recorded_with_all_slots_privileged(privileged):
     assert cols["/world/ego"]["Transform3D:translation"] == result["frames"]
 
 
-def test_the_recording_has_no_footer_and_optimize_gives_one_with_the_same_data(privileged, tmp_path):
-    """No footer: Rerun's SDK would hold its manifest, a row per chunk, in memory until the file closes."""
-    path = privileged[0]
-    r = rerun("rrd", "verify", str(path))
-    assert r.returncode != 0 and "footer" in (r.stdout + r.stderr).lower(), r.stdout + r.stderr
-    out = tmp_path / "optimized.rrd"
-    assert rerun("rrd", "optimize", str(path), "-o", str(out)).returncode == 0
-    verify(out, footer=True)
-    assert columns_by_entity(out) == columns_by_entity(path)
+def test_the_drive_is_streamed_without_a_footer_and_finished_with_one_holding_the_same_data(privileged):
+    """The stream has no footer (Rerun's SDK would hold its manifest, a row per chunk, in memory until the file
+    closes); the finished recording is the stream compacted, with its footer."""
+    path, _, stream = privileged
+    assert no_footer(stream)
+    verify(path)
+    assert columns_by_entity(path) == columns_by_entity(stream)
 
 
 def test_objects_are_under_the_ego_in_its_frame(privileged):
@@ -116,12 +134,12 @@ def test_objects_are_under_the_ego_in_its_frame(privileged):
     assert not [e for e in cols if e.startswith("/world/objects")]
 
 
-def test_the_vision_lateral_slot_draws_its_evidence(vision):
+def test_the_vision_lanes_slot_draws_its_evidence(vision):
     cols = columns_by_entity(vision[0])
-    for entity in TASK_ENTITIES["lateral"] + ["/world/ego/camera/left/lateral/evidence"]:
+    for entity in TASK_ENTITIES["lanes"] + ["/world/ego/camera/left/lanes/evidence"]:
         assert entity in cols, entity
     # drawings on the image are stored with the image, not every frame
-    assert cols["/world/ego/camera/left/lateral/boundaries"]["LineStrips2D:strips"] <= images(cols)
+    assert cols["/world/ego/camera/left/lanes/boundaries"]["LineStrips2D:strips"] <= images(cols)
 
 
 def test_the_vision_longitudinal_slot_records_each_cue_beside_the_fused_estimate(vision):
@@ -171,7 +189,7 @@ def test_an_interrupted_recording_is_kept_beside_a_finished_one(tmp_path):
     rec = RunRecorder(final, StereoRig(), [np.array([[0.0, 0.0], [100.0, 0.0]])], TASKS)
     assert rec.close(complete=False) == partial_path(final) == tmp_path / "X.partial.rrd"
     assert final.read_bytes() == b"a finished recording"
-    verify(tmp_path / "X.partial.rrd")
+    verify(tmp_path / "X.partial.rrd", footer=False)
     assert sorted(os.listdir(tmp_path)) == ["X.partial.rrd", "X.rrd"]
     assert rec.close() == tmp_path / "X.partial.rrd"  # closing twice changes nothing
 
@@ -193,7 +211,7 @@ def test_a_run_interrupted_midway_keeps_what_was_recorded(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         run_drive(DriveConfig(WorldConfig("highway", 0), 1.0), recorder_factory=factory, render=True)
     kept = holder["r"].close(complete=False)
-    verify(kept)
+    verify(kept, footer=False)
     # the rows held as columns (trail, scalars) are sent when the recorder closes
     cols = columns_by_entity(kept)
     assert cols["/world/trajectory"]["Points3D:positions"] == 5
@@ -210,7 +228,7 @@ def test_a_recording_that_raises_is_closed_as_partial(tmp_path):
 
 
 def test_ctrl_c_while_flushing_never_replaces_a_finished_recording(tmp_path):
-    """Ctrl-C during the last flush once moved the unfinished file over RUN.rrd; now it becomes RUN.partial.rrd."""
+    """Ctrl-C during the last flush keeps the unfinished file as RUN.partial.rrd."""
     final = tmp_path / "Z.rrd"
     final.write_bytes(b"a finished recording")
     rec = RunRecorder(final, StereoRig(), [], TASKS)
@@ -227,6 +245,47 @@ def test_ctrl_c_while_flushing_never_replaces_a_finished_recording(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["Z.partial.rrd", "Z.rrd"] and rec.closed_as == tmp_path / "Z.partial.rrd"
 
 
+def test_ctrl_c_while_finishing_keeps_the_stream_as_partial_and_the_finished_recording(tmp_path, monkeypatch):
+    """Ctrl-C as the footer is written (the child process has written its output, not yet renamed): the stream is
+    RUN.partial.rrd, the finished RUN.rrd is untouched, no temporary is left."""
+    final = tmp_path / "F.rrd"
+    final.write_bytes(b"a finished recording")
+    real_run = subprocess.run
+
+    def interrupted(*args, **kwargs):
+        real_run(*args, **kwargs)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(recorder_module.subprocess, "run", interrupted)
+    rec = RunRecorder(final, StereoRig(), [], TASKS)
+    with pytest.raises(KeyboardInterrupt):
+        rec.close()
+    monkeypatch.undo()
+    assert final.read_bytes() == b"a finished recording"
+    assert sorted(os.listdir(tmp_path)) == ["F.partial.rrd", "F.rrd"] and rec.closed_as == tmp_path / "F.partial.rrd"
+    verify(tmp_path / "F.partial.rrd", footer=False)
+
+
+def test_a_finishing_step_that_fails_is_an_os_error_and_keeps_the_stream_as_partial(tmp_path, monkeypatch):
+    final = tmp_path / "G.rrd"
+    final.write_bytes(b"a finished recording")
+    monkeypatch.setattr(recorder_module, "rerun_cli", lambda: shutil.which("false"))
+    rec = RunRecorder(final, StereoRig(), [], TASKS)
+    with pytest.raises(OSError, match="could not finish the recording"):
+        rec.close()
+    assert final.read_bytes() == b"a finished recording"
+    assert sorted(os.listdir(tmp_path)) == ["G.partial.rrd", "G.rrd"]
+    verify(tmp_path / "G.partial.rrd", footer=False)
+
+
+def test_a_folder_in_the_way_of_the_finished_recording_keeps_the_stream_as_partial(tmp_path):
+    (tmp_path / "U.rrd").mkdir()
+    rec = RunRecorder(tmp_path / "U.rrd", StereoRig(), [], TASKS)
+    with pytest.raises(OSError):
+        rec.close()
+    assert sorted(os.listdir(tmp_path)) == ["U.partial.rrd", "U.rrd"] and (tmp_path / "U.rrd").is_dir()
+
+
 def test_a_folder_in_the_way_leaves_no_temporary(tmp_path):
     (tmp_path / "V.partial.rrd").mkdir()
     rec = RunRecorder(tmp_path / "V.rrd", StereoRig(), [], TASKS)
@@ -240,10 +299,10 @@ def test_parts_are_resolved_from_the_table(tmp_path):
         pass
 
     assert resolve_part(part) is part
-    assert resolve_part("percept.review.parts:lateral").plots
+    assert resolve_part("percept.review.parts:lanes").plots
     for bad in ("percept.review.parts", "percept.review.parts:nothing", "no.such.module:x"):
         with pytest.raises(ValueError, match="recorder part"):
             resolve_part(bad)
-    task = Task("extra", "extra", "extra", privileged=None, scorer=None, recorder=part)
+    task = Task("extra", object, privileged=None, scorer=None, recorder=part)
     RunRecorder(tmp_path / "Z.rrd", StereoRig(), [], (*TASKS, task)).close()
     verify(tmp_path / "Z.rrd")
