@@ -1,10 +1,10 @@
 """Matched stereo pixels lifted to the vehicle frame in one compiled pass over the bands' disparity maps (the
-finder's two bands into one set of arrays, which it used to concatenate).
+finder's two bands into one set of arrays).
 
-The numpy it replaces (kept as the reference in tests/longitudinal/test_lift.py) took five passes and as many
-temporaries over the ~7 000 matches of a frame: the mask of matched pixels, the gathers of their columns, rows and
-rays, the depth, the range cut and the lift. The arithmetic is numpy's, operation for operation and type for type,
-so the points are the same bit for bit.
+One pass instead of numpy's five passes and temporaries over a frame's matches (the mask of matched pixels, the
+gathers of their columns, rows and rays, the depth, the range cut and the lift). The arithmetic is numpy's,
+operation for operation and type for type, so the points are the same bit for bit as the numpy form kept as the
+reference in tests/longitudinal/test_lift.py.
 """
 
 from __future__ import annotations

@@ -40,7 +40,7 @@ def surface_mask(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, 
     w = right.shape[1]
     lo = int(np.floor(d0)) - radius
     # the candidates d = lo .. lo + 2 radius + 1 read the right image's columns u0 - d .. u1 - d - 1, all of which
-    # must exist (a box nearer the left edge made a crop the costs could not be formed on)
+    # must exist for the costs to be formed
     if u0 - lo - 2 * radius - 1 < 0 or lo < 1 or u1 - lo + 1 > w:
         return None
     L = left[v0:v1, u0:u1]
