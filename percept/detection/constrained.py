@@ -153,8 +153,9 @@ class ConstrainedSearch:
         return [(k, found.get(k)) for k in levels]
 
     def _clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
+        """``box`` clipped to the image in whole pixels, or None when a window at ``scale`` no longer fits in it."""
         cam = self.rig.camera
-        # (clipped before rounding: the same whole pixels, and a corner at infinity clips as it did)
+        # (clipped before rounding, which a corner at infinity could not be)
         b = (math.floor(max(box[0], 0)), math.floor(max(box[1], 0)), math.ceil(min(box[2], cam.width)),
              math.ceil(min(box[3], cam.height)))
         if b[2] - b[0] < WINDOW_PX[0] * scale or b[3] - b[1] < WINDOW_PX[1] * scale:

@@ -122,6 +122,7 @@ class PedestrianSlot:
         self.asked = {}
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
+        """One frame: search, track, and the braking request (or its withdrawal) for the nearest person in the path."""
         motion = self.motion.update(frame)
         speed, yaw_rate = motion.speed_mps, motion.yaw_rate_rps
         path = upstream.get(EgoPath) or EgoPath.straight(speed)
@@ -152,6 +153,8 @@ class PedestrianSlot:
         return lambda box, z_ground_m: box_depth(frame.left, frame.right, box, self.tracker.rig, z_ground_m)
 
     def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
+        """(the braking request, its track id) for the nearest track that may act and conflicts with the path, or
+        (None, None)."""
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M
         best = None
         for t in tracks:

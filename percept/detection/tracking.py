@@ -92,6 +92,8 @@ class PersonTrack:
 
 
 class _Track:
+    """One person's filters (the person's and the free motion's) and counts."""
+
     def __init__(self, tid: int, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float,
                  stereo_ok: bool, cfg: TrackConfig):
         # two filters on the same detections: the person's (a person barely moves: a tight prior on the speed) and
@@ -256,6 +258,7 @@ class PersonTracker:
         return pairs
 
     def _public(self, t: _Track) -> PersonTrack:
+        """The record reported of a track, its box clipped to the image."""
         x = t.kf.x
         box = t.box if t.misses == 0 else t.predicted
         w, h = self.rig.camera.width, self.rig.camera.height

@@ -132,6 +132,7 @@ class MarkingExtractor:
         return marking_brightness(top)
 
     def extract(self, image: np.ndarray) -> MarkingEvidence:
+        """The marking evidence of one BGR image: one point per stripe per bird's-eye grid row."""
         b = self.birdseye(image)
         w = self.w_px
         # top-hat: centre mean minus the brighter of the two flank means at 1.5 widths (the flank means are the

@@ -28,6 +28,7 @@ from .vehicles import VehicleConfig
 
 
 def _real_lane_config() -> LaneConfig:
+    """The detector's settings for recorded footage."""
     # lower stripe thresholds than in the simulator: white dashes on pale concrete are faint. Grid rows every 4 image
     # rows near the camera (a 0.25 m step there skips 20 rows of a 720-row frame, leaving a near dash 2-3 points and
     # the near boundary to the far evidence). Freeway geometry (radius >= ~500 m, spirals >= ~100 m at
@@ -149,6 +150,7 @@ class LaneResult:
                 for name, side in (("left", 1), ("right", -1))}
 
     def to_dict(self) -> dict:
+        """The result as JSON-ready values (None where there is no lane)."""
         e, g = self.estimate, self.geometry
         vp = g.vanishing_point
         num = (lambda v: float(v) if e.valid else None)
@@ -208,6 +210,7 @@ class FootageLanes:
         return out
 
     def camera(self, width: int, height: int) -> PinholeCamera:
+        """The calibrated camera, or one of ``cfg.hfov_rad`` for images ``width`` x ``height`` [px]."""
         if self.calibration is not None:
             return self.calibration.camera
         return PinholeCamera.from_hfov(width, height, self.cfg.hfov_rad)

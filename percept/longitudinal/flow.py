@@ -83,6 +83,8 @@ class ExpansionTracker:
 
 def _expansion(g0: np.ndarray, g1: np.ndarray, box: tuple[int, int, int, int], dt: float,
                cfg: FlowConfig) -> Expansion | None:
+    """The expansion of the features of ``box`` (u0, v0, u1, v1) in grey image g0 tracked into g1, dt [s] later;
+    None with too few features or pairs."""
     u0, v0, u1, v1 = box
     if dt <= 0 or u1 - u0 < 8 or v1 - v0 < 8:
         return None

@@ -46,12 +46,12 @@ def range_bins(k, area):  # pragma: no cover - compiled
 
 @kernel()
 def first_grounded_blob(cands, los, his, needs, order, u, v, h, area, cell, q, grounded):  # pragma: no cover
-    """The first candidate bin c (of ``cands``, indices into ``los``, ``his``, ``needs``) whose points ``order[los:his]``
-    (taken in index order) hold ``needs`` [px] of ``area``, and whose largest blob (by area) of image cells ``cell``
-    [px] square, 8-connected, holds it too with its ``q``-th height percentile below ``grounded`` [m]: (1, the blob's
-    point indices). (0, none) when no candidate has one; (-1 - c, none) when the largest blob at candidate c is not
-    unique (two of equal area: which one is first is cv2's labelling order's to say, so the caller takes it from
-    there)."""
+    """The first candidate bin c (of ``cands``, indices into ``los``, ``his``, ``needs``) whose points
+    ``order[los:his]`` (taken in index order) hold ``needs`` [px] of ``area``, and whose largest blob (by area) of
+    image cells ``cell`` [px] square, 8-connected, holds it too with its ``q``-th height percentile below
+    ``grounded`` [m]: (1, the blob's point indices). (0, none) when no candidate has one; (-1 - c, none) when the
+    largest blob at candidate c is not unique (two of equal area: which one is first is cv2's labelling order's to
+    say, so the caller takes it from there)."""
     empty = np.empty(0, np.int64)
     cellf = np.float32(cell)
     for c in range(cands.shape[0]):

@@ -54,6 +54,7 @@ def lift_bands(bands, z_min_m: float, z_max_m: float, origin: np.ndarray):
 @kernel()
 def _lift2(d16, c0, skip, u, v, rays, k, area, d16b, c0b, skipb, ub, vb, raysb, kb, areab, z_min, z_max,
            origin):  # pragma: no cover - compiled
+    """``lift_bands``' arrays from the two bands' arguments, each band's matches counted first to size them."""
     n = _matched(d16, skip) + _matched(d16b, skipb)
     uo, vo, zo = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
     po, ao = np.empty((n, 3), np.float64), np.empty(n, np.float32)

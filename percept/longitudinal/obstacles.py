@@ -172,6 +172,8 @@ class ObstacleFinder:
         return self._nearest_group(u[stand], v[stand], z[stand], pv[stand], area[stand]), debug
 
     def _nearest_group(self, u, v, z, pv, area) -> Obstacle | None:
+        """The nearest range group of the standing points (columns, rows, depths, vehicle-frame points, areas) that
+        covers ``min_area_m2`` in one grounded blob, or None."""
         cfg, cam = self.cfg, self.rig.camera
         # range bins of relative width bin_rel: log(Z) in steps of log(1 + bin_rel); points sorted by bin, so that
         # bins b-1..b+1 are one slice and their area a difference of running sums

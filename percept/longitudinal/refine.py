@@ -142,7 +142,7 @@ class PatchAligner:
 def _weighted_sums(L, both, keep, huber):  # pragma: no cover - compiled
     """sum(w g^2), sum(w g r), sum(w r^2) over the patch, float32, for the residual r = L - R and Huber weights
     w = (1 if |r| <= huber else huber / max(|r|, 1e-6)) x keep, with R, g the two channels of ``both`` (h, w, 2): the
-    float32 arrays numpy made of those products, summed as numpy sums them (``pairwise_sum``), so equal bit for bit."""
+    float32 arrays numpy makes of those products, summed as numpy sums them (``pairwise_sum``), so equal bit for bit."""
     h, w = L.shape
     n = h * w
     wgg, wgr, wrr = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)

@@ -110,6 +110,7 @@ class LongitudinalSlot:
         self.flow.reset()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
+        """One frame: the confirmed lead in the path (None without one) and what each cue measured."""
         motion = self.motion.update(frame)
         path = upstream.get(EgoPath) or EgoPath.straight(motion.speed_mps)
         # nothing in the path comes towards the ego faster than it drives: range rate >= -(v_ego + reverse_mps)
@@ -261,6 +262,7 @@ class LongitudinalSlot:
         return self._gated_update(e.range_rate_mps(z), sigma, RATE)
 
     def _lead(self) -> Lead | None:
+        """The confirmed track as a Lead, its confidence falling while it is only predicted."""
         if self.track is None or self.hits < self.cfg.confirm:
             return None
         rng, rate = self.track.range_m, self.track.rate_mps
