@@ -1,8 +1,9 @@
-"""Detection: pedestrians (HOG features shared across windows, the image-pyramid search, scoring).
+"""Detection: pedestrians (HOG features shared across windows, the image-pyramid search, tracking, scoring).
 
 ``hog``: Dalal & Triggs HOG blocks computed once per image and scale (OpenCV's gradients, summed into blocks by
 ``hog_blocks``) and a linear model scored over every window from them; ``pyramid``: the unconstrained search over
-every scale (``percept detect``);
+every scale (``percept detect``); ``constrained``: the search over the windows where a person standing on the road
+can appear; ``tracking``: people tracked on the ground plane; ``slot``: the vision pedestrians slot;
 ``metrics``: the scoring formulas; ``overlay``: drawings.
 """
 

@@ -1,5 +1,5 @@
 """Every HOG block of an image in one compiled pass, from OpenCV's gradients: the blocks OpenCV's
-``HOGDescriptor.compute`` returns, to float32 rounding, in two thirds of its time at 4-pixel cells (half at 8).
+``HOGDescriptor.compute`` returns, to float32 rounding, reading each pixel once instead of once per block.
 
 OpenCV's gradient (``HOGDescriptor.computeGradient``: the square-root gamma, the colour channel with the largest
 gradient, each pixel's magnitude split between its two nearest of 9 orientation bins) is used as it is. What
@@ -90,7 +90,6 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
     """Blocks (nbx, nby, 36) from magnitudes (h, w, 2) and bins (h, w, 2); wx: ``axis_weights(c)``."""
     h, w = mag.shape[0], mag.shape[1]
     nbx, nby = (w - 2 * c) // c + 1, (h - 2 * c) // c + 1
-    half = c // 2
     out = np.empty((nbx, nby, 36), np.float32)
     # acc[by mod 2, 36 i + bx]: value i (OpenCV's order, 18 cx + 9 cy + bin) of block bx, unnormalised, in the two
     # block rows a pixel row feeds; a block row is normalised into ``out`` as soon as its last pixel row is in.
@@ -102,63 +101,81 @@ def _blocks(mag, bins, c, wx, clip):  # pragma: no cover - compiled
         by = y // c
         if y % c == 0 and by < nby:
             acc[by % 2] = 0
-        # R[9 cx + bin, bx] = sum_dx X_cx(dx) m_bin(y, c bx + dx): pixel c j + e lies in blocks j (dx = e) and
-        # j - 1 (dx = e + c); X_1(e) is zero for e < c/2 and X_0(e + c) for e >= c/2
-        row[:] = 0
-        for j in range(nbx + 1):
-            p = j - 1
-            for e in range(c):
-                x = c * j + e
-                g0, g1 = mag[y, x, 0], mag[y, x, 1]
-                q0, q1 = np.int64(bins[y, x, 0]), np.int64(bins[y, x, 1])
-                if j < nbx:
-                    wt = wx[0, e]
-                    row[q0, j] += wt * g0
-                    row[q1, j] += wt * g1
-                    if e >= half:
-                        wt = wx[1, e]
-                        row[9 + q0, j] += wt * g0
-                        row[9 + q1, j] += wt * g1
-                if j >= 1:
-                    if e < half:
-                        wt = wx[0, e + c]
-                        row[q0, p] += wt * g0
-                        row[q1, p] += wt * g1
-                    wt = wx[1, e + c]
-                    row[9 + q0, p] += wt * g0
-                    row[9 + q1, p] += wt * g1
-        # H[by, cy] += Y_cy(dy) R for the block rows by = y // c (dy = y mod c) and by - 1 (dy + c)
-        r = row.reshape(18 * nbx)
-        for k in range(2):
-            b = by - k
-            if b < 0 or b >= nby:
-                continue
-            dy = y - c * by + c * k
-            a = acc[b % 2]
-            for cy in range(2):
-                wt = wx[cy, dy]
-                # X_1(dy) = 0 for dy < c/2 and X_0(dy) = 0 for dy >= 3c/2: the +0 those rows would add to the
-                # (non-negative) sums leaves them as they are, so one of the four (k, cy) is skipped in every row
-                if wt == 0:
-                    continue
-                for cx in range(2):
-                    o, src = (18 * cx + 9 * cy) * nbx, 9 * cx * nbx
-                    for m in range(9 * nbx):
-                        a[o + m] += wt * r[src + m]
+        _row_sums(mag, bins, y, c, nbx, wx, row)
+        _add_row(acc, row.reshape(18 * nbx), y, by, c, nby, nbx, wx)
         # block row by - 1 is complete after the last pixel row of cell row by
         done = by - 1
         if y % c == c - 1 and 0 <= done < nby:
-            v = acc[done % 2].reshape(36, nbx)
-            _l2hys_scales(v, clip, scale1, scale2)
-            # v <- min(v scale1, clip) scale2 in place, over the blocks as vectors; then each block's 36 values out
-            for i in range(36):
-                for bx in range(nbx):
-                    t = v[i, bx] * scale1[bx]
-                    v[i, bx] = (t if t < clip else clip) * scale2[bx]
-            for bx in range(nbx):
-                for i in range(36):
-                    out[bx, done, i] = v[i, bx]
+            _normalise_row(acc[done % 2].reshape(36, nbx), clip, scale1, scale2, out, done)
     return out
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _row_sums(mag, bins, y, c, nbx, wx, row):  # pragma: no cover - compiled
+    """Pixel row y summed along x into every block column: row[9 cx + bin, bx] (18, nbx) float32."""
+    half = c // 2
+    # R[9 cx + bin, bx] = sum_dx X_cx(dx) m_bin(y, c bx + dx): pixel c j + e lies in blocks j (dx = e) and
+    # j - 1 (dx = e + c); X_1(e) is zero for e < c/2 and X_0(e + c) for e >= c/2
+    row[:] = 0
+    for j in range(nbx + 1):
+        p = j - 1
+        for e in range(c):
+            x = c * j + e
+            g0, g1 = mag[y, x, 0], mag[y, x, 1]
+            q0, q1 = np.int64(bins[y, x, 0]), np.int64(bins[y, x, 1])
+            if j < nbx:
+                wt = wx[0, e]
+                row[q0, j] += wt * g0
+                row[q1, j] += wt * g1
+                if e >= half:
+                    wt = wx[1, e]
+                    row[9 + q0, j] += wt * g0
+                    row[9 + q1, j] += wt * g1
+            if j >= 1:
+                if e < half:
+                    wt = wx[0, e + c]
+                    row[q0, p] += wt * g0
+                    row[q1, p] += wt * g1
+                wt = wx[1, e + c]
+                row[9 + q0, p] += wt * g0
+                row[9 + q1, p] += wt * g1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _add_row(acc, r, y, by, c, nby, nbx, wx):  # pragma: no cover - compiled
+    """Pixel row y's column sums ``r`` (18 nbx,) added, weighted along y, into the block rows that hold it."""
+    # H[by, cy] += Y_cy(dy) R for the block rows by = y // c (dy = y mod c) and by - 1 (dy + c)
+    for k in range(2):
+        b = by - k
+        if b < 0 or b >= nby:
+            continue
+        dy = y - c * by + c * k
+        a = acc[b % 2]
+        for cy in range(2):
+            wt = wx[cy, dy]
+            # X_1(dy) = 0 for dy < c/2 and X_0(dy) = 0 for dy >= 3c/2: the +0 those rows would add to the
+            # (non-negative) sums leaves them as they are, so one of the four (k, cy) is skipped in every row
+            if wt == 0:
+                continue
+            for cx in range(2):
+                o, src = (18 * cx + 9 * cy) * nbx, 9 * cx * nbx
+                for m in range(9 * nbx):
+                    a[o + m] += wt * r[src + m]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _normalise_row(v, clip, scale1, scale2, out, done):  # pragma: no cover - compiled
+    """Block row ``done``'s sums ``v`` (36, nbx) normalised (L2-Hys) in place and written to out[:, done]."""
+    nbx = v.shape[1]
+    _l2hys_scales(v, clip, scale1, scale2)
+    # v <- min(v scale1, clip) scale2 in place, over the blocks as vectors; then each block's 36 values out
+    for i in range(36):
+        for bx in range(nbx):
+            t = v[i, bx] * scale1[bx]
+            v[i, bx] = (t if t < clip else clip) * scale2[bx]
+    for bx in range(nbx):
+        for i in range(36):
+            out[bx, done, i] = v[i, bx]
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -42,22 +42,18 @@ Box = tuple[float, float, float, float]
 
 @dataclass(frozen=True)
 class SearchConfig:
-    """heights_m: plausible person heights [m]; min_person_px: the smallest person searched for [px];
-    min_range_m, max_range_m: depths searched [m]; half_width_m: the corridor about the ego path (its lane, the
-    next lane's width and the verge) [m]; step: scale step of the pyramid; cell_px: HOG cell on the resized strip
-    [px] (8 = Dalal & Triggs' own scale, 4 = a quarter of the pixels); threshold: smallest window score kept;
-    group_threshold: as ``detectMultiScale``'s."""
+    """Settings of the constrained search: which people, where, and at which scales and thresholds."""
 
-    heights_m: tuple[float, float] = (1.0, 2.1)
-    min_person_px: float = 24.0
-    min_range_m: float = 4.0
-    max_range_m: float = 40.0
-    half_width_m: float = 5.5
-    step: float = 1.2
-    cell_px: int = 4
-    threshold: float = 0.0
-    group_threshold: int = 1
-    lone_threshold: float | None = 0.25
+    heights_m: tuple[float, float] = (1.0, 2.1)  # plausible person heights [m]
+    min_person_px: float = 24.0  # the smallest person searched for [px]
+    min_range_m: float = 4.0  # nearest depth searched [m]
+    max_range_m: float = 40.0  # farthest depth searched [m]
+    half_width_m: float = 5.5  # the corridor about the ego path (its lane, the next lane's width and the verge) [m]
+    step: float = 1.2  # scale step of the pyramid
+    cell_px: int = 4  # HOG cell on the resized strip [px] (8 = Dalal & Triggs' own scale, 4 = a quarter of the pixels)
+    threshold: float = 0.0  # smallest window score kept
+    group_threshold: int = 1  # as ``detectMultiScale``'s: clusters of fewer than this + 1 windows are dropped
+    lone_threshold: float | None = 0.25  # smallest score of a lone window (one grouping drops) kept; None: none kept
 
 
 @dataclass(frozen=True)
@@ -157,8 +153,9 @@ class ConstrainedSearch:
         return [(k, found.get(k)) for k in levels]
 
     def _clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
+        """``box`` clipped to the image in whole pixels, or None when a window at ``scale`` no longer fits in it."""
         cam = self.rig.camera
-        # (clipped before rounding: the same whole pixels, and a corner at infinity clips as it did)
+        # (clipped before rounding, which a corner at infinity could not be)
         b = (math.floor(max(box[0], 0)), math.floor(max(box[1], 0)), math.ceil(min(box[2], cam.width)),
              math.ceil(min(box[3], cam.height)))
         if b[2] - b[0] < WINDOW_PX[0] * scale or b[3] - b[1] < WINDOW_PX[1] * scale:

@@ -8,9 +8,7 @@ same vehicle (a taller window that puts the feet 10-16 m nearer) would drag it b
 its update is robust: a detection whose innovation lies beyond the gate has its measurement noise inflated by
 d^2 / gate, so that (where the measurement noise dominates the innovation's) it lies on the gate, and the farther
 beyond it lies the less it moves the free motion. A lasting change is followed as the filter's own uncertainty
-grows. It does not help a young filter, whose uncertainty dominates: on `cut-in` seed 13 (clear) a window 12 m
-nearer than the seven before it still pulled a free motion of 12.3 +- 3.8 m/s to 2.3 +- 0.8 (shortening the
-innovation onto the gate instead gave 2.6 +- 1.2).
+grows. It does not help a young filter, whose own uncertainty dominates the innovation's.
 
 References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Tracking and Navigation" (2001), the
 white-noise-acceleration model (ch. 6) and gating (ch. 7); Chang, "Robust Kalman filtering based on Mahalanobis

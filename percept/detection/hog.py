@@ -6,7 +6,7 @@ its 7x15 blocks in a row. Every block of an image (block (bx, by) covers pixels 
 8 by + 15)) is computed once and shared by all the windows that contain them (OpenCV's own ``detectMultiScale``
 shares them too, within a scale): OpenCV's ``HOGDescriptor`` computes the gradients, and ``hog_blocks`` sums them
 into blocks separably in one compiled pass (OpenCV's own blocks, from ``compute`` with one window as large as the
-image, to float32 rounding, in two thirds of its time). A linear model w on a window at block (x, y) scores
+image, to float32 rounding). A linear model w on a window at block (x, y) scores
 
     s(x, y) = b + sum_{i < 7, j < 15} w_ij . B(x + i, y + j)
 
@@ -55,8 +55,7 @@ def block_grid(image: np.ndarray, cell_px: int = CELL_PX) -> np.ndarray:
     """Every HOG block of ``image`` (grey or BGR uint8, at least one window): (nbx, nby, 36) float32, block (bx, by)
     at pixel (c bx, c by) for cells of c = ``cell_px`` pixels (a window is 8 c x 16 c px). Columns and rows past
     the last whole block are not covered. The blocks are OpenCV's (``hog_descriptor(...).compute`` with one window
-    as large as the image) to float32 rounding, computed by ``hog_blocks`` from OpenCV's gradients in about two
-    thirds of the time (half at 8-pixel cells)."""
+    as large as the image) to float32 rounding, computed by ``hog_blocks`` from OpenCV's gradients."""
     h, w = image.shape[:2]
     c = int(cell_px)
     win = (WINDOW_PX[0] * c // CELL_PX, WINDOW_PX[1] * c // CELL_PX)
@@ -97,7 +96,7 @@ class LinearModel:
     @classmethod
     def sim(cls) -> "LinearModel":
         """percept's own model, trained on rendered people by ``percept train-detector`` (shipped in the package,
-        its training record beside it in ``people_sim.json``): a cascade whose first stage was made by the command's
+        its training record beside it in ``people_sim.json``): a cascade whose first stage has the command's
         defaults and whose second stage, trained with hard negatives from the traffic scenarios too, confirms a
         detection when it scores one of its windows at least -0.5."""
         return cls.load(SIM_MODEL_PATH)

@@ -1,6 +1,6 @@
 """Scoring formulas for pedestrian detection: IoU, greedy matching with ignore regions, rates.
 
-DESIGN, "Scoring definitions": a detection matches a ground-truth box of a pedestrian at least half
+docs/design.md, "Scoring definitions": a detection matches a ground-truth box of a pedestrian at least half
 visible and at least 24 px tall when IoU >= 0.5; recall, precision, false positives per image.
 Boxes are (u0, v0, u1, v1) in pixels, u = column, v = row, u0 <= u1 and v0 <= v1.
 

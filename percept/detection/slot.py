@@ -56,9 +56,7 @@ the car to stop."""
 YOUNG_FAST_STOP_MPS2 = 7.5
 """The same for a young track whose free motion reads faster than ``TrackConfig.vehicle_min_mps`` (more likely a
 vehicle's than a walk, not yet clearly so): it waits until a stop would need this deceleration, 0.5 m/s² short of
-the strongest braking. On `curves` and `cut-in` vehicles' corners read as people at 33-37 m while the car drove at
-17-20 m/s asked at 3-7 detections with free speeds of 11-17 +- 4-8 m/s, a frame or three before their free motion
-showed the vehicle [m/s²]."""
+the strongest braking, which gives the free motion a few more frames to show a vehicle [m/s²]."""
 STANDING_MPS = 0.3
 """At or below this speed the car stands, and what the slot has asked for is settled [m/s]."""
 STEREO_HITS = 1
@@ -109,11 +107,8 @@ class PedestrianSlot:
         texture_side(np.zeros((6, 3), np.uint8), 1.0)
         best_match(np.zeros(3, np.float32))
         # frames between two searches of each level: the far field's levels (people up to far_person_px tall)
-        # every far_sweep_frames, the others every sweep_frames. Every crossing person of b02c612's strict
-        # evaluations (90 runs) was first found 28.3 m away or farther, beyond the depths of the fourth level
-        # (people of 41.5 px, feet at 28.1 m at most): the three smallest levels keep every third frame; the ones
-        # above them, which find again people whose track was lost, every eighth (a fifth to a quarter less of the
-        # slot's time; README, Speed)
+        # every far_sweep_frames, where crossing people are first found; the levels above them, which only find
+        # again people whose track was lost, every sweep_frames
         self.periods = tuple(far_sweep_frames if PERSON_PX * s <= far_person_px else sweep_frames
                              for s in self.search.scales)
         self.cam_x = float(rig.camera_position()[0])
@@ -127,6 +122,7 @@ class PedestrianSlot:
         self.asked = {}
 
     def step(self, frame: Frame, upstream: dict) -> tuple[BrakingRequest | None, PedestrianDebug]:
+        """One frame: search, track, and the braking request (or its withdrawal) for the nearest person in the path."""
         motion = self.motion.update(frame)
         speed, yaw_rate = motion.speed_mps, motion.yaw_rate_rps
         path = upstream.get(EgoPath) or EgoPath.straight(speed)
@@ -157,6 +153,8 @@ class PedestrianSlot:
         return lambda box, z_ground_m: box_depth(frame.left, frame.right, box, self.tracker.rig, z_ground_m)
 
     def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
+        """(the braking request, its track id) for the nearest track that may act and conflicts with the path, or
+        (None, None)."""
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M
         best = None
         for t in tracks:
@@ -185,11 +183,9 @@ class PedestrianSlot:
                          withdrawn: bool = False) -> BrakingRequest:
         """The request about a track whose feet are x_m ahead of the vehicle frame's origin."""
         # range: the left camera's depth of the feet; its rate: the ego's speed alone, the person taken to stand along
-        # the road. The track's own x speed comes from depths whose noise grows with Z^2: for a person crossing 35 m
-        # ahead (`crossing` seed 7) it put the closing speed 0.7-1.3 m/s below the car's, and the following law's
-        # standing test (ego speed - closing < 1 m/s) flipped frame to frame, its command swinging between -2.7 and
-        # -4.2 m/s^2. People cross; one walking along the path at 1.5 m/s changes the closing speed by a tenth at
-        # 15 m/s, and the yield law does not read it.
+        # the road, because the track's own x speed comes from depths whose noise grows with Z^2 and would flip the
+        # following law's standing test (ego speed - closing < 1 m/s) frame to frame for a far person. People cross;
+        # one walking along the path at 1.5 m/s changes the closing speed by a tenth at 15 m/s.
         return BrakingRequest(x_m - self.cam_x, -speed_mps, why, ObjectKind.PEDESTRIAN, track_id, withdrawn=withdrawn)
 
     def _can_wait(self, x_m: float, speed_mps: float, t: PersonTrack) -> bool:

@@ -13,15 +13,14 @@ white-noise-acceleration model (ch. 6) and gating (ch. 7).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Callable
 
 import numpy as np
-from filterpy.common import Q_discrete_white_noise
 
 from percept.sensors import StereoRig, iou
 
 from .constrained import standing_box
+from .ego_step import EgoStep
 from .free_motion import FreeMotion, constant_velocity_filter
 
 Box = tuple[float, float, float, float]
@@ -31,38 +30,30 @@ StereoDepth = Callable[[Box, float], "tuple[float, float] | None"]
 
 @dataclass(frozen=True)
 class TrackConfig:
-    """confirm_hits: hits before a track is reported; max_misses: frames a track coasts without a detection (it
-    keeps acting on braking); report_misses: frames without a detection after which it is no longer reported as
-    seen;
-    accel_mps2: the people's white-noise acceleration [m/s²]; row_sigma_frac: feet-row noise as a fraction of the
-    person's height; col_sigma_frac: column noise as a fraction of the height; iou_gate: smallest overlap of a
-    detection with a track's predicted box that pairs them; gate_chi2: squared Mahalanobis gate on the ground (2
-    degrees of freedom, 99 %); sigma_v0_mps: a new track's speed uncertainty (people walk at up to ~2 m/s);
-    free_sigma_v0_mps: the same for the track's free motion, which assumes no person (a vehicle's speed);
-    free_gate_chi2: squared Mahalanobis distance beyond which a detection's noise is inflated in the free motion
-    (``FreeMotion``; 2 degrees of freedom, 99.9 %: one window on another part of a vehicle, its feet 10 m nearer,
-    pulled the free motion from 14.8 +- 2.7 to 1.9 +- 1.0 m/s in one frame on `cut-in` seed 17 at night);
-    vehicle_min_mps: a track whose free motion is faster than this by ``too_fast_sigmas`` of its standard deviation
-    moves like a vehicle and is no person on foot until its free motion is as clearly slower (a vehicle's tail light
-    and wheel can read as legs; people walk at up to 2.5 m/s, and far away, where the feet's row is quantised, a
-    person's free motion read 7.2 +- 1.1 m/s on `crossing` seed 15 when their range caught up by 8 m in 0.2 s, and
-    11 +- 2 m/s on `crossing` seed 2 in rain, before it settled at 1.4 +- 0.2);
-    verify_chi2: a detection that must be verified (a lone window) is kept only when its stereo depth and its
-    ground contact's agree within this squared number of standard deviations (one degree of freedom)."""
+    """Settings of the person tracker: confirmation, coasting, measurement noise, gates and the vehicle test."""
 
-    confirm_hits: int = 3
-    max_misses: int = 8
-    report_misses: int = 2
-    accel_mps2: float = 0.7
-    row_sigma_frac: float = 0.05
-    col_sigma_frac: float = 0.15
-    iou_gate: float = 0.3
-    gate_chi2: float = 9.21
-    sigma_v0_mps: float = 1.0
-    free_sigma_v0_mps: float = 30.0
+    confirm_hits: int = 3  # hits before a track is reported
+    max_misses: int = 8  # frames a track coasts without a detection (it keeps acting on braking)
+    report_misses: int = 2  # frames without a detection after which a track is no longer reported as seen
+    accel_mps2: float = 0.7  # the people's white-noise acceleration [m/s²]
+    row_sigma_frac: float = 0.05  # feet-row noise as a fraction of the person's height
+    col_sigma_frac: float = 0.15  # column noise as a fraction of the person's height
+    iou_gate: float = 0.3  # smallest overlap of a detection with a track's predicted box that pairs them
+    gate_chi2: float = 9.21  # squared Mahalanobis gate on the ground (2 degrees of freedom, 99 %)
+    sigma_v0_mps: float = 1.0  # a new track's speed uncertainty [m/s] (people walk at up to ~2 m/s)
+    free_sigma_v0_mps: float = 30.0  # the same for the free motion, which assumes no person (a vehicle's speed) [m/s]
+    # squared Mahalanobis distance beyond which a detection's noise is inflated in the free motion (``FreeMotion``; 2
+    # degrees of freedom, 99.9 %): one window on another part of a vehicle, its feet 10 m nearer, must not pull the
+    # free motion to a standstill in one frame
     free_gate_chi2: float = 13.8
+    # a track whose free motion is faster than this by ``too_fast_sigmas`` of its standard deviation moves like a
+    # vehicle (whose tail light and wheel can read as legs) and is no person on foot until its free motion is as
+    # clearly slower [m/s]; people walk at up to 2.5 m/s, and a far person's first ranges (the feet's row quantised)
+    # can read several times that for a few frames
     vehicle_min_mps: float = 8.0
-    too_fast_sigmas: float = 2.5
+    too_fast_sigmas: float = 2.5  # the margin of ``vehicle_min_mps``, in standard deviations of the free speed
+    # a detection that must be verified (a lone window) is kept only when its stereo depth and its ground contact's
+    # agree within this squared number of standard deviations (one degree of freedom)
     verify_chi2: float = 9.0
 
 
@@ -100,46 +91,9 @@ class PersonTrack:
     too_fast: bool
 
 
-@dataclass(frozen=True)
-class EgoStep:
-    """The motion model of every track over one frame of the ego's own motion (read-only arrays): rt (2, 2), R(th)^T
-    for the turn th; f (4, 4) and b (4, 2) with x_k+1 = F x_k + B t for the ego's travel t (2,) [m]; q (4, 4) the
-    white-noise acceleration's covariance."""
-
-    rt: np.ndarray
-    f: np.ndarray
-    b: np.ndarray
-    q: np.ndarray
-    travel: np.ndarray
-
-    @classmethod
-    def of(cls, dt: float, ego_speed_mps: float, yaw_rate_rps: float, accel_mps2: float) -> "EgoStep":
-        """The step over dt [s] at ``ego_speed_mps`` turning at ``yaw_rate_rps``, people's white-noise acceleration
-        ``accel_mps2`` [m/s²]."""
-        th = yaw_rate_rps * dt
-        c, s = np.cos(th), np.sin(th)
-        rt = np.array([[c, s], [-s, c]])  # R(th)^T: the old vehicle frame's vectors in the new one
-        # p_k+1 = R^T (p_k + v_k dt - t), v_k+1 = R^T v_k, with the ego's travel t = v_ego dt (cos th/2, sin th/2)
-        # (the chord of its arc): the ego's own motion moves and turns everything the other way
-        f = np.zeros((4, 4))
-        f[:2, :2], f[:2, 2:], f[2:, 2:] = rt, rt * dt, rt
-        b = np.zeros((4, 2))
-        b[:2] = -rt
-        travel = ego_speed_mps * dt * np.array([np.cos(th / 2), np.sin(th / 2)])
-        for a in (rt, f, b, travel):
-            a.flags.writeable = False
-        return cls(rt, f, b, _white_noise(dt, accel_mps2 ** 2), travel)
-
-
-@lru_cache(maxsize=8)
-def _white_noise(dt: float, var: float) -> np.ndarray:
-    """filterpy's white-noise acceleration covariance (4, 4) of (x, y, vx, vy) over dt [s] (read-only)."""
-    q = Q_discrete_white_noise(2, dt, var, block_size=2, order_by_dim=False)
-    q.flags.writeable = False
-    return q
-
-
 class _Track:
+    """One person's filters (the person's and the free motion's) and counts."""
+
     def __init__(self, tid: int, xy: np.ndarray, r: np.ndarray, height_m: float, box: Box, score: float,
                  stereo_ok: bool, cfg: TrackConfig):
         # two filters on the same detections: the person's (a person barely moves: a tight prior on the speed) and
@@ -304,6 +258,7 @@ class PersonTracker:
         return pairs
 
     def _public(self, t: _Track) -> PersonTrack:
+        """The record reported of a track, its box clipped to the image."""
         x = t.kf.x
         box = t.box if t.misses == 0 else t.predicted
         w, h = self.rig.camera.width, self.rig.camera.height

@@ -35,8 +35,10 @@ class LaneDebug:
 
 @dataclass(frozen=True)
 class LaneConfig:
-    evidence: EvidenceConfig = field(default_factory=EvidenceConfig)
-    fit: FitConfig = field(default_factory=FitConfig)
+    """Settings of the lane detector."""
+
+    evidence: EvidenceConfig = field(default_factory=EvidenceConfig)  # the marking evidence's settings
+    fit: FitConfig = field(default_factory=FitConfig)  # the joint fit's settings (its width prior also the tracker's)
 
 
 class LaneDetector:
@@ -56,10 +58,10 @@ class LaneDetector:
 
         ``pace`` CRAWLING or STANDING: the lane moves relative to the car by the car's own motion alone (none when
         standing), so the tracked lane is predicted without the per-second drift (not at all when standing) and is
-        not searched for afresh: each fit is taken around it and averaged into it, never restarting it. Behind a
-        stopped lead (in rain above all) the few metres of road the camera sees give fits that can lie a lane
-        apart, and a fresh search took them outright: the lane, the steering and the corridor that holds the lead
-        swung under a car that was not moving."""
+        not searched for afresh: each fit is taken around it and averaged into it, never restarting it, because
+        behind a stopped lead (in rain above all) the few metres of road the camera sees give fits that can lie a
+        lane apart, and a fresh search would swing the lane, the steering and the corridor under a car that does
+        not move."""
         held = pace is not Pace.DRIVING and self.tracker.initialised
         if self.tracker.initialised and pace is not Pace.STANDING:
             self.tracker.predict(speed_mps, yaw_rate_rps, dt, drift=not held)

@@ -40,27 +40,25 @@ def marking_brightness(image: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class EvidenceConfig:
-    """x_near_m, x_far_m: ground range ahead of the vehicle centre [m]; half_width_m: lateral half range [m];
-    dx_m, dy_m: grid steps [m]; marking_width_m: expected stripe width [m]; full_weight_span_m: a point counts fully
-    where one pixel spans at most this much ground across [m] (further away its weight falls as the span squared);
-    min_contrast: absolute top-hat threshold [grey levels]; rel_contrast: threshold relative to the frame's strong
-    responses; brightness: the paint measure; max_row_px: image rows below this are not road (a car's hood),
-    None = all rows; row_step_px: None = grid rows every dx_m; else every row_step_px image rows where that is
-    closer (near the camera, where a dx_m step skips many image rows), never further apart than dx_m; vehicles:
-    None = keep all evidence, else the evidence a vehicle covers is dropped (``vehicles.find_vehicles``)."""
+    """Settings of the marking evidence: the bird's-eye grid, the stripe test and what is not road."""
 
-    x_near_m: float = 6.0
-    x_far_m: float = 50.0
-    half_width_m: float = 8.0
-    dx_m: float = 0.25
-    dy_m: float = 0.05
-    marking_width_m: float = 0.15
+    x_near_m: float = 6.0  # nearest ground range ahead of the vehicle centre [m]
+    x_far_m: float = 50.0  # farthest ground range ahead of the vehicle centre [m]
+    half_width_m: float = 8.0  # lateral half range [m]
+    dx_m: float = 0.25  # grid step along the road [m]
+    dy_m: float = 0.05  # grid step across the road [m]
+    marking_width_m: float = 0.15  # expected stripe width [m]
+    # a point counts fully where one pixel spans at most this much ground across [m]; further away its weight falls as
+    # the span squared
     full_weight_span_m: float = 0.025
-    min_contrast: float = 10.0
-    rel_contrast: float = 0.3
-    brightness: Brightness = Brightness.MAX_RG
-    max_row_px: float | None = None
+    min_contrast: float = 10.0  # absolute top-hat threshold [grey levels]
+    rel_contrast: float = 0.3  # threshold relative to the frame's strong responses
+    brightness: Brightness = Brightness.MAX_RG  # the paint measure
+    max_row_px: float | None = None  # image rows below this are not road (a car's hood) [px]; None: all rows
+    # None: grid rows every dx_m; else every row_step_px image rows where that is closer (near the camera, where a
+    # dx_m step skips many image rows), never further apart than dx_m [px]
     row_step_px: float | None = None
+    # None: keep all evidence; else the evidence a vehicle covers is dropped (``vehicles.find_vehicles``)
     vehicles: VehicleConfig | None = None
 
     def __post_init__(self) -> None:
@@ -134,6 +132,7 @@ class MarkingExtractor:
         return marking_brightness(top)
 
     def extract(self, image: np.ndarray) -> MarkingEvidence:
+        """The marking evidence of one BGR image: one point per stripe per bird's-eye grid row."""
         b = self.birdseye(image)
         w = self.w_px
         # top-hat: centre mean minus the brighter of the two flank means at 1.5 widths (the flank means are the

@@ -21,21 +21,18 @@ from .types import LaneEstimate, LaneFit, MarkingEvidence
 
 @dataclass(frozen=True)
 class FitConfig:
-    """width_prior_m, width_sigma_m: lane width prior; curvature_sigma_1pm: prior spread of curvature around 0;
-    curvature_rate_sigma_1pm2: prior spread of the curvature's change along the road; heading_sigma_rad: prior
-    spread of the car's heading relative to its lane;
-    gate_m: side-assignment gate around a prediction [m]; huber_m: Huber threshold [m]; min_points: per fit;
-    straight_seeds: a fresh search also grows each seed from a straight line, not only from its own near-range fit
-    (a few scattered near points can bend a short fit, and the bent boundary then gates out its own far markings)."""
+    """Settings of the joint lane fit: the priors, the side gate, the robust loss and the seeds of a fresh search."""
 
-    width_prior_m: float = 3.7
-    width_sigma_m: float = 0.4
-    curvature_sigma_1pm: float = 0.01
-    curvature_rate_sigma_1pm2: float = 1e-4
-    heading_sigma_rad: float = 0.05
-    gate_m: float = 0.7
-    huber_m: float = 0.08
-    min_points: int = 12
+    width_prior_m: float = 3.7  # the lane width prior's mean [m]
+    width_sigma_m: float = 0.4  # and its standard deviation [m]
+    curvature_sigma_1pm: float = 0.01  # prior spread of the curvature around 0 [1/m]
+    curvature_rate_sigma_1pm2: float = 1e-4  # prior spread of the curvature's change along the road [1/m²]
+    heading_sigma_rad: float = 0.05  # prior spread of the car's heading relative to its lane [rad]
+    gate_m: float = 0.7  # side-assignment gate around a prediction [m]
+    huber_m: float = 0.08  # Huber threshold [m]
+    min_points: int = 12  # fewest assigned points for a fit
+    # a fresh search also grows each seed from a straight line, not only from its own near-range fit: a few scattered
+    # near points can bend a short fit, and the bent boundary then gates out its own far markings
     straight_seeds: bool = False
 
 
@@ -165,19 +162,15 @@ def _straight(cfg: FitConfig) -> FitConfig:
 
 STRAIGHT_MARGIN = 1.1
 """With ``FitConfig.straight_seeds``, a lane grown from a straight start replaces the best grown from the seeds' own
-near-range fits only when its evidence is this many times stronger. Measured on TuSimple 1.jpg, and on it with a
-car pasted over the far end of its right line, at camera heights 1.55-1.85 m: where a few scattered near points
-bent the near-range fit and its boundaries then gated out their own far dashes (curvature down to -0.0145 1/m,
-heading down to -7.5 deg), the straight start gathered 1.12-1.30 times the evidence; where nothing bent, a straight
-start that was stronger was so by 1.01-1.06 times (at 1.64 m it took 1.jpg's right boundary 15 px to the left at
-the bottom row, and less on its dashes than 25 px to the right). The margin lies between the two, with little room
-on either side."""
+near-range fits only when its evidence is this many times stronger: where scattered near points bent the near-range
+fit, a straight start gathers 1.1-1.3 times its evidence; where nothing bent, a straight start is at most a few per
+cent stronger and would pull a boundary off its dashes."""
 
 
 GROW_REACH_M = (35.0,)
 """A fresh search (no prediction) grows the fit outwards: points nearer than each of these ranges first, so that a
-boundary follows its own markings before far clutter (a vehicle ahead) can bend it [m]. Tried on the TuSimple
-samples: (25, 40) and (20, 30, 40) straighten 1.jpg as well but leave its right boundary off its dashes."""
+boundary follows its own markings before far clutter (a vehicle ahead) can bend it [m]; one step, since more steps
+can leave a boundary off its dashes."""
 
 
 def _grow(pts: _Points, sides: np.ndarray, cfg: FitConfig, reach: tuple[float, ...] = (),
@@ -211,6 +204,7 @@ RIVAL_SHIFT_M = 0.5
 """A fitted lane is a rival of the best when either of its boundaries lies this far from the best's [m] (at
 RIVAL_RANGE_M ahead): another pair of markings, not the same pair fitted again."""
 RIVAL_RANGE_M = 10.0
+"""The range ahead at which a rival's boundaries are compared with the best's [m]."""
 
 
 def _boundaries_at(params: np.ndarray, x: float) -> np.ndarray:

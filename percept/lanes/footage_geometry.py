@@ -24,8 +24,11 @@ from .hood import common_hood_row
 from .horizon import VanishingPoint, estimate_vanishing_point, make_rig, marking_vanishing_point
 
 NOMINAL_HEIGHT_M = 1.2
+"""The camera height assumed before (or without) a measurement [m]."""
 HEIGHT_RANGE_M = (0.5, 5.0)
+"""The heights a measurement is clipped to [m]."""
 MIN_SIDE_INLIERS = 10
+"""Inliers a fit needs on each side for its width to measure the height."""
 
 
 @dataclass(frozen=True)
@@ -58,6 +61,7 @@ def make_detector(rig: StereoRig, cfg, bottom_row_px: float) -> LaneDetector:
 
 
 def median_vp(vps: list[VanishingPoint | None]) -> VanishingPoint | None:
+    """The per-coordinate median of the vanishing points found (None entries left out), or None without one."""
     vps = [v for v in vps if v is not None]
     if not vps:
         return None
@@ -77,6 +81,7 @@ def bottom_row(images: list[np.ndarray], cfg) -> tuple[float, float | None]:
 
 
 def _fits(images: list[np.ndarray], det: LaneDetector) -> list:
+    """(evidence, fit) of each image that gives a fit, each fitted afresh (no tracking)."""
     out = []
     for im in images:
         det.reset()

@@ -28,9 +28,10 @@ from .vehicles import VehicleConfig
 
 
 def _real_lane_config() -> LaneConfig:
+    """The detector's settings for recorded footage."""
     # lower stripe thresholds than in the simulator: white dashes on pale concrete are faint. Grid rows every 4 image
-    # rows near the camera (a 0.25 m step there skips 20 rows of a 720-row frame: a near dash gave 2-3 points and
-    # the far evidence placed the near boundary). Freeway geometry (radius >= ~500 m, spirals >= ~100 m at
+    # rows near the camera (a 0.25 m step there skips 20 rows of a 720-row frame, leaving a near dash 2-3 points and
+    # the near boundary to the far evidence). Freeway geometry (radius >= ~500 m, spirals >= ~100 m at
     # 100 km/h) changes curvature by at most ~2e-5 per metre, and a single frame seen to 40 m cannot tell a cubic
     # from a quadratic: the curvature-rate prior is that tight. A vehicle over a marking masks it (``vehicles.py``).
     return LaneConfig(evidence=EvidenceConfig(min_contrast=6.0, rel_contrast=0.2, brightness=Brightness.MAX_RG_YELLOW,
@@ -40,25 +41,21 @@ def _real_lane_config() -> LaneConfig:
 
 @dataclass(frozen=True)
 class RealLaneConfig:
-    """hfov_rad: assumed horizontal field of view without calibration [rad]; mount_height_m: camera height above
-    the road [m], None = estimated from the lane-width prior; lane_width_m: the width of the lanes filmed (US
-    freeways 3.6-3.7 m), which sets the height when it is not given; horizon_frac: horizon row as a fraction of the
-    image height when no vanishing point is found; roi_top_frac: top of the rows searched for lane segments, as a
-    fraction of the height; bottom_margin_frac: rows left out at the bottom, as a fraction of the height, None =
-    down to the car's hood when one is seen (``hood.py``), else to the last row; x_far_m: farthest ground range
-    used [m]; speed_mps: assumed speed for tracking through a video (no odometry) [m/s]; horizon_frames: video
-    frames whose median horizon (and height) is used; lane: the detector's configuration (x_near_m is set from the
-    lowest usable row)."""
+    """Settings of the lane detector on recorded footage: the assumed camera, the rows used and the tracking."""
 
-    hfov_rad: float = math.radians(60.0)
-    mount_height_m: float | None = None
+    hfov_rad: float = math.radians(60.0)  # assumed horizontal field of view without calibration [rad]
+    mount_height_m: float | None = None  # camera height above the road [m]; None: estimated from the lane width
+    # the width of the lanes filmed (US freeways 3.6-3.7 m) [m], which sets the height when it is not given
     lane_width_m: float = 3.65
-    horizon_frac: float = 0.58
-    roi_top_frac: float = 0.5
+    horizon_frac: float = 0.58  # horizon row as a fraction of the image height when no vanishing point is found
+    roi_top_frac: float = 0.5  # top of the rows searched for lane segments, as a fraction of the height
+    # rows left out at the bottom, as a fraction of the height; None: down to the car's hood when one is seen
+    # (``hood.py``), else to the last row
     bottom_margin_frac: float | None = None
-    x_far_m: float = 60.0
-    speed_mps: float = 0.0
-    horizon_frames: int = 15
+    x_far_m: float = 60.0  # farthest ground range used [m]
+    speed_mps: float = 0.0  # assumed speed for tracking through a video (no odometry) [m/s]
+    horizon_frames: int = 15  # video frames whose median horizon (and height) is used
+    # the detector's configuration (x_near_m is set from the lowest usable row)
     lane: LaneConfig = field(default_factory=_real_lane_config)
 
     def __post_init__(self) -> None:
@@ -153,6 +150,7 @@ class LaneResult:
                 for name, side in (("left", 1), ("right", -1))}
 
     def to_dict(self) -> dict:
+        """The result as JSON-ready values (None where there is no lane)."""
         e, g = self.estimate, self.geometry
         vp = g.vanishing_point
         num = (lambda v: float(v) if e.valid else None)
@@ -212,6 +210,7 @@ class FootageLanes:
         return out
 
     def camera(self, width: int, height: int) -> PinholeCamera:
+        """The calibrated camera, or one of ``cfg.hfov_rad`` for images ``width`` x ``height`` [px]."""
         if self.calibration is not None:
             return self.calibration.camera
         return PinholeCamera.from_hfov(width, height, self.cfg.hfov_rad)

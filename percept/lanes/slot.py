@@ -34,6 +34,7 @@ class LaneSlot:
         self.motion.reset()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[EgoPath, LaneDebug]:
+        """One frame: the ego path (the tracked lane at the gated wheel speed) and what the detector saw."""
         m = self.motion.update(frame)
         est, debug = self.detector.process(frame.left, m.speed_mps, m.yaw_rate_rps, self.dt_s,
                                            pace=pace(m.speed_mps))

@@ -58,6 +58,7 @@ class LaneTracker:
             self.confidence *= 0.85
 
     def update(self, fit: LaneFit) -> None:
+        """Take one frame's fit (the first starts the track); a fit outside the gate of a confident track is ignored."""
         e = fit.estimate
         z = np.array([e.offset_m, e.heading_rad, e.curvature_1pm, e.curvature_rate_1pm2, e.width_m])
         # the fit's covariance, inflated for correlated pixel errors, with a floor per parameter
@@ -82,6 +83,7 @@ class LaneTracker:
 
     @property
     def estimate(self) -> LaneEstimate:
+        """The tracked lane (invalid until the first fit) with the tracker's confidence."""
         x = self.kf.x
         return LaneEstimate(float(x[0]), float(x[1]), float(x[2]), float(x[4]), float(self.confidence),
                             valid=self.initialised, curvature_rate_1pm2=float(x[3]))

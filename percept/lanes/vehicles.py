@@ -9,8 +9,8 @@ the mean gradient magnitude over the vehicle's first metre above it is ``edge_ra
 it and few of those pixels have the road's brightness.
 
 A vehicle hides the markings behind it and its own edges pass the stripe test: the evidence in the columns of each
-vehicle (10 % wider), from the horizon down to its bottom row, is dropped (``mask_evidence``). Tried on footage only
-(``EvidenceConfig.vehicles``); the simulator's fit is unchanged.
+vehicle (10 % wider), from the horizon down to its bottom row, is dropped (``mask_evidence``). Used on footage only
+(``EvidenceConfig.vehicles``); the simulator's fit does not use it.
 """
 
 from __future__ import annotations
@@ -28,31 +28,28 @@ from .types import MarkingEvidence
 
 @dataclass(frozen=True)
 class VehicleConfig:
-    """dark_ratio: the shade under a vehicle is darker than this share of the row's road level (the 60th
-    percentile of the row's middle 80 %); lit_ratio: the road 3 rows below it is at least this share of its own
-    row's level; width_m: (min, max) width of a vehicle's shade [m]; gap_m: gaps in the shade closed up to this
-    [m] (the wheels); edge_ratio: mean gradient magnitude over the first ``body_m`` above the bottom against that of
-    the road under it (at least); max_road_like: the share of that body's pixels within ``road_band`` of the row's
-    road level (less than: a body is darker or brighter than the road, a barrier's base or a strip of lit road above
-    a shadow is not); max_range_m: bottoms further than this are not looked for [m]; pad: the mask is this share
-    of the width wider on each side."""
+    """Settings of the vehicle finder: the shade under a vehicle, the body above it and the mask over the evidence."""
 
+    # the shade under a vehicle is darker than this share of the row's road level (the 60th percentile of the row's
+    # middle 80 %)
     dark_ratio: float = 0.55
-    lit_ratio: float = 0.8
-    width_m: tuple[float, float] = (0.9, 3.2)
-    gap_m: float = 0.25
-    edge_ratio: float = 1.5
-    body_m: float = 1.0
-    road_band: float = 0.2
+    lit_ratio: float = 0.8  # the road 3 rows below the shade is at least this share of its own row's level
+    width_m: tuple[float, float] = (0.9, 3.2)  # (min, max) width of a vehicle's shade [m]
+    gap_m: float = 0.25  # gaps in the shade closed up to this [m] (the wheels)
+    edge_ratio: float = 1.5  # least mean gradient magnitude over the body against that of the road under it
+    body_m: float = 1.0  # the height above the bottom over which the body is looked at [m]
+    road_band: float = 0.2  # a body pixel within this share of the row's road level is road-like
+    # the body's road-like pixels must be less than this share: a body is darker or brighter than the road, a
+    # barrier's base or a strip of lit road above a shadow is not
     max_road_like: float = 0.4
-    max_range_m: float = 60.0
-    pad: float = 0.1
+    max_range_m: float = 60.0  # bottoms further than this are not looked for [m]
+    pad: float = 0.1  # the mask is this share of the width wider on each side
 
 
 @dataclass(frozen=True)
 class VehicleBox:
     """A vehicle's shade: columns u0_px..u1_px (end exclusive) at image row bottom_px, range_m ahead [m] (flat
-    road), edge_ratio as measured."""
+    road), edge_ratio: its body's mean gradient magnitude against the road's under it."""
 
     u0_px: int
     u1_px: int

@@ -20,16 +20,14 @@ from percept.sensors import StereoRig
 
 @dataclass(frozen=True)
 class ContactConfig:
-    """rear_overhang_m: from the rear face to where the rear tyres touch the road [m] (a car's is 0.5-1.0 m; the
-    simulator's cars 0.57 m); wheel_frac: fraction of the box width on each side searched for tyres; window:
-    ranges searched, as factors of the guess (nearer, farther); min_step: smallest dark-to-bright step, grey
-    levels; sigma_row_px: the edge row's noise [px] (an unsmoothed edge: uniform over a pixel, 1/sqrt(12))."""
+    """Settings of the ground-contact range: the tyres' place, the search window and the edge's strength and noise."""
 
+    # from the rear face to where the rear tyres touch the road [m] (a car's is 0.5-1.0 m; the simulator's cars 0.57 m)
     rear_overhang_m: float = 0.57
-    wheel_frac: float = 0.15
-    window: tuple[float, float] = (0.8, 1.25)
-    min_step: float = 12.0
-    sigma_row_px: float = 0.29
+    wheel_frac: float = 0.15  # fraction of the box width on each side searched for tyres
+    window: tuple[float, float] = (0.8, 1.25)  # ranges searched, as factors of the guess (nearer, farther)
+    min_step: float = 12.0  # smallest dark-to-bright step [grey levels]
+    sigma_row_px: float = 0.29  # the edge row's noise [px] (an unsmoothed edge: uniform over a pixel, 1/sqrt(12))
 
 
 @dataclass(frozen=True)

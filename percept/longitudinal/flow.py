@@ -22,20 +22,19 @@ from .quantiles import median
 
 @dataclass(frozen=True)
 class FlowConfig:
-    """frames_back: the scale is measured against the frame this many frames earlier (a longer baseline in time
-    resolves slower expansion) ; max_features, quality, min_distance_px: goodFeaturesToTrack's; win_px, levels:
-    the pyramidal KLT window and pyramid levels; fb_max_px: largest forward-backward error kept [px]; min_pairs:
-    fewest feature pairs for a measurement; min_pair_px: shortest pair distance used [px]."""
+    """Settings of the expansion measurement: the time baseline, the features, the KLT tracker and the pairs used."""
 
+    # the scale is measured against the frame this many frames earlier (a longer baseline in time resolves slower
+    # expansion)
     frames_back: int = 4
-    max_features: int = 80
-    quality: float = 0.002
-    min_distance_px: int = 2
-    win_px: int = 11
-    levels: int = 2
-    fb_max_px: float = 0.3
-    min_pairs: int = 6
-    min_pair_px: float = 6.0
+    max_features: int = 80  # goodFeaturesToTrack's maxCorners
+    quality: float = 0.002  # goodFeaturesToTrack's qualityLevel
+    min_distance_px: int = 2  # goodFeaturesToTrack's minDistance [px]
+    win_px: int = 11  # the pyramidal KLT window [px]
+    levels: int = 2  # the pyramidal KLT's pyramid levels
+    fb_max_px: float = 0.3  # largest forward-backward error kept [px]
+    min_pairs: int = 6  # fewest feature pairs for a measurement
+    min_pair_px: float = 6.0  # shortest pair distance used [px]
 
 
 @dataclass(frozen=True)
@@ -84,6 +83,8 @@ class ExpansionTracker:
 
 def _expansion(g0: np.ndarray, g1: np.ndarray, box: tuple[int, int, int, int], dt: float,
                cfg: FlowConfig) -> Expansion | None:
+    """The expansion of the features of ``box`` (u0, v0, u1, v1) in grey image g0 tracked into g1, dt [s] later;
+    None with too few features or pairs."""
     u0, v0, u1, v1 = box
     if dt <= 0 or u1 - u0 < 8 or v1 - v0 < 8:
         return None

@@ -24,26 +24,25 @@ from .quantiles import median
 
 @dataclass(frozen=True)
 class GroundConfig:
-    """band_m: points within this of the current plane are road [m]; min_range_m, max_range_m: the fit's range [m] (the
-    near band's, where the road's disparities are large and unbiased: the coarse far band's road heights are off by up
-    to 0.1 m); half_width_m: and lateral reach [m]; cell_px, cell_m, max_standing_m: image columns x range cells [px, m]
-    with a point up to max_standing_m above the band give no road points (they are an obstacle's low parts); bin_m:
-    range bins [m]; min_points: fewest points for a bin's median; smoothing: weight of each new fit (exponential
-    smoothing); every_frames: fit every this many frames; ref_range_m, deadband_m: the correction is applied while it
-    moves a height at ref_range_m by more than deadband_m [m] (0.2 m at 30 m: a 0.4 degree pitch; on the simulator's
-    exact rig the fit stayed within 0.11 m over 20 s runs by day, night and rain)."""
+    """Settings of the online road-plane fit: which points are road, how they are binned, how often and how much."""
 
-    band_m: float = 0.5
+    band_m: float = 0.5  # points within this of the current plane are road [m]
+    # image columns x range cells [px, m] with a point up to max_standing_m above the band give no road points (they
+    # are an obstacle's low parts)
     cell_px: int = 16
     cell_m: float = 3.0
     max_standing_m: float = 3.5
+    # the fit's range [m]: the near band's, where the road's disparities are large and unbiased (the coarse far band's
+    # road heights are off by up to 0.1 m)
     min_range_m: float = 4.0
     max_range_m: float = 16.0
-    half_width_m: float = 6.0
-    bin_m: float = 2.0
-    min_points: int = 200
-    smoothing: float = 0.25
-    every_frames: int = 3
+    half_width_m: float = 6.0  # the fit's lateral reach [m]
+    bin_m: float = 2.0  # range bins [m]
+    min_points: int = 200  # fewest points for a bin's median
+    smoothing: float = 0.25  # weight of each new fit (exponential smoothing)
+    every_frames: int = 3  # fit every this many frames
+    # the correction is applied while it moves a height at ref_range_m by more than deadband_m [m] (0.2 m at 30 m: a
+    # 0.4 degree pitch), so that a well calibrated rig does not follow the fit's noise
     ref_range_m: float = 30.0
     deadband_m: float = 0.2
 

@@ -1,10 +1,10 @@
 """The obstacle finder's search for the nearest group of standing pixels, compiled.
 
-Its numpy form (kept as the reference in tests/longitudinal/test_groups.py) spent ~0.3 ms a frame in a dozen small
-calls per range bin tried (a frame tries three on average): the sort, the sums, the grid of image cells and its
-connected components, the percentile. The arithmetic here is numpy's, operation for operation and type for type,
-so the group is the same pixel for pixel. Logarithms and exponentials stay in numpy (its own SIMD functions, which
-need not round as the C library's do).
+Compiled because a frame tries several range bins and each, in numpy, is a dozen small calls (the sort, the sums,
+the grid of image cells and its connected components, the percentile). The arithmetic is numpy's, operation for
+operation and type for type, so the group is the same pixel for pixel as the numpy form kept as the reference in
+tests/longitudinal/test_groups.py. Logarithms and exponentials stay in numpy (its own SIMD functions, which need not
+round as the C library's do).
 """
 
 from __future__ import annotations
@@ -46,12 +46,12 @@ def range_bins(k, area):  # pragma: no cover - compiled
 
 @kernel()
 def first_grounded_blob(cands, los, his, needs, order, u, v, h, area, cell, q, grounded):  # pragma: no cover
-    """The first candidate bin c (of ``cands``, indices into ``los``, ``his``, ``needs``) whose points ``order[los:his]``
-    (taken in index order) hold ``needs`` [px] of ``area``, and whose largest blob (by area) of image cells ``cell``
-    [px] square, 8-connected, holds it too with its ``q``-th height percentile below ``grounded`` [m]: (1, the blob's
-    point indices). (0, none) when no candidate has one; (-1 - c, none) when the largest blob at candidate c is not
-    unique (two of equal area: which one is first is cv2's labelling order's to say, so the caller takes it from
-    there)."""
+    """The first candidate bin c (of ``cands``, indices into ``los``, ``his``, ``needs``) whose points
+    ``order[los:his]`` (taken in index order) hold ``needs`` [px] of ``area``, and whose largest blob (by area) of
+    image cells ``cell`` [px] square, 8-connected, holds it too with its ``q``-th height percentile below
+    ``grounded`` [m]: (1, the blob's point indices). (0, none) when no candidate has one; (-1 - c, none) when the
+    largest blob at candidate c is not unique (two of equal area: which one is first is cv2's labelling order's to
+    say, so the caller takes it from there)."""
     empty = np.empty(0, np.int64)
     cellf = np.float32(cell)
     for c in range(cands.shape[0]):
@@ -61,63 +61,93 @@ def first_grounded_blob(cands, los, his, needs, order, u, v, h, area, cell, q, g
         a_near = area[near]
         if pairwise_sum(a_near, 0, a_near.shape[0]) < need:
             continue
-        # the cells of the points: (u / cell, v / cell) in float32, truncated
-        nn = near.shape[0]
-        cu, cv = np.empty(nn, np.int64), np.empty(nn, np.int64)
-        gw, gh = 0, 0
-        for j in range(nn):
-            cu[j], cv[j] = int(u[near[j]] / cellf), int(v[near[j]] / cellf)
-            gw, gh = max(gw, cu[j] + 2), max(gh, cv[j] + 2)
-        labels = np.zeros((gh, gw), np.int64)
-        for j in range(nn):
-            labels[cv[j], cu[j]] = -1
-        # connected components of the occupied cells (8-neighbours), by flood fill
-        stack = np.empty(gh * gw, np.int64)
-        count = 0
-        for r in range(gh):
-            for s in range(gw):
-                if labels[r, s] != -1:
-                    continue
-                count += 1
-                labels[r, s] = count
-                top = 0
-                stack[0] = r * gw + s
-                while top >= 0:
-                    p = stack[top]
-                    top -= 1
-                    pr, ps = p // gw, p % gw
-                    for dr in range(-1, 2):
-                        for ds in range(-1, 2):
-                            rr, ss = pr + dr, ps + ds
-                            if 0 <= rr < gh and 0 <= ss < gw and labels[rr, ss] == -1:
-                                labels[rr, ss] = count
-                                top += 1
-                                stack[top] = rr * gw + ss
-        # each blob's area, summed in the points' order in float64 (numpy's bincount with weights)
-        sums = np.zeros(count + 1)
-        for j in range(nn):
-            sums[labels[cv[j], cu[j]]] += np.float64(a_near[j])
-        best, ties = 1, 0
-        for b in range(2, count + 1):
-            if sums[b] > sums[best]:
-                best, ties = b, 0
-            elif sums[b] == sums[best]:
-                ties += 1
+        cu, cv, labels = _cells(near, u, v, cellf)
+        count = _label_components(labels)
+        best, ties = _largest_label(labels, cu, cv, a_near, count)
         if ties:
             return -1 - c, empty
-        size = 0
-        for j in range(nn):
-            if labels[cv[j], cu[j]] == best:
-                size += 1
-        blob = np.empty(size, np.int64)
-        size = 0
-        for j in range(nn):
-            if labels[cv[j], cu[j]] == best:
-                blob[size] = near[j]
-                size += 1
-        if pairwise_sum(area[blob], 0, size) >= need and _percentile(h[blob], q) < grounded:
+        blob = _label_points(labels, cu, cv, near, best)
+        if pairwise_sum(area[blob], 0, blob.shape[0]) >= need and _percentile(h[blob], q) < grounded:
             return 1, blob
     return 0, empty
+
+
+@njit(cache=True, error_model="numpy")
+def _cells(near, u, v, cellf):  # pragma: no cover - compiled
+    """The image cells of the points ``near`` (N,): their columns and rows cu, cv (N,) int64, (u / cell, v / cell) in
+    float32 truncated, and a grid (gh, gw) int64 holding -1 at each occupied cell and 0 elsewhere, with one free row
+    and column beyond the last occupied ones."""
+    nn = near.shape[0]
+    cu, cv = np.empty(nn, np.int64), np.empty(nn, np.int64)
+    gw, gh = 0, 0
+    for j in range(nn):
+        cu[j], cv[j] = int(u[near[j]] / cellf), int(v[near[j]] / cellf)
+        gw, gh = max(gw, cu[j] + 2), max(gh, cv[j] + 2)
+    labels = np.zeros((gh, gw), np.int64)
+    for j in range(nn):
+        labels[cv[j], cu[j]] = -1
+    return cu, cv, labels
+
+
+@njit(cache=True, error_model="numpy")
+def _label_components(labels):  # pragma: no cover - compiled
+    """The 8-connected components of the cells marked -1 in ``labels`` (gh, gw) int64 labelled 1, 2, ... in place,
+    in the row-major order of their first cell, by flood fill; their count."""
+    gh, gw = labels.shape
+    stack = np.empty(gh * gw, np.int64)
+    count = 0
+    for r in range(gh):
+        for s in range(gw):
+            if labels[r, s] != -1:
+                continue
+            count += 1
+            labels[r, s] = count
+            top = 0
+            stack[0] = r * gw + s
+            while top >= 0:
+                p = stack[top]
+                top -= 1
+                pr, ps = p // gw, p % gw
+                for dr in range(-1, 2):
+                    for ds in range(-1, 2):
+                        rr, ss = pr + dr, ps + ds
+                        if 0 <= rr < gh and 0 <= ss < gw and labels[rr, ss] == -1:
+                            labels[rr, ss] = count
+                            top += 1
+                            stack[top] = rr * gw + ss
+    return count
+
+
+@njit(cache=True)
+def _largest_label(labels, cu, cv, a_near, count):  # pragma: no cover - compiled
+    """The label of the largest of ``count`` blobs by area, each blob's area the points' ``a_near`` (N,) float32
+    summed in the points' order in float64 (numpy's bincount with weights), and how many other blobs have that area."""
+    sums = np.zeros(count + 1)
+    for j in range(cu.shape[0]):
+        sums[labels[cv[j], cu[j]]] += np.float64(a_near[j])
+    best, ties = 1, 0
+    for b in range(2, count + 1):
+        if sums[b] > sums[best]:
+            best, ties = b, 0
+        elif sums[b] == sums[best]:
+            ties += 1
+    return best, ties
+
+
+@njit(cache=True)
+def _label_points(labels, cu, cv, near, best):  # pragma: no cover - compiled
+    """The point indices of ``near`` (N,) whose cell carries the label ``best``, in order."""
+    size = 0
+    for j in range(near.shape[0]):
+        if labels[cv[j], cu[j]] == best:
+            size += 1
+    blob = np.empty(size, np.int64)
+    size = 0
+    for j in range(near.shape[0]):
+        if labels[cv[j], cu[j]] == best:
+            blob[size] = near[j]
+            size += 1
+    return blob
 
 
 @njit(cache=True)
@@ -156,7 +186,7 @@ def group_extent(u, v, z, area, blob):  # pragma: no cover - compiled
 
 def warm_up_groups() -> None:
     """The group search's compiled passes loaded now (compiled once after an install), on a frame's argument types:
-    one bin of three points at one pixel."""
+    one bin of three points at one pixel, so that no timed frame compiles them."""
     one, idx = np.ones(3, np.float32), np.arange(3, dtype=np.int64)
     order, run, bins, los, his = range_bins(idx * 0, one)
     first_grounded_blob(idx[:1], los, his, np.ones(1), order, one, one, np.zeros(3), one, 8, 5, 1.0)

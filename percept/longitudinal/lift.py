@@ -1,10 +1,10 @@
 """Matched stereo pixels lifted to the vehicle frame in one compiled pass over the bands' disparity maps (the
-finder's two bands into one set of arrays, which it used to concatenate).
+finder's two bands into one set of arrays).
 
-The numpy it replaces (kept as the reference in tests/longitudinal/test_lift.py) took five passes and as many
-temporaries over the ~7 000 matches of a frame: the mask of matched pixels, the gathers of their columns, rows and
-rays, the depth, the range cut and the lift. The arithmetic is numpy's, operation for operation and type for type,
-so the points are the same bit for bit.
+One pass instead of numpy's five passes and temporaries over a frame's matches (the mask of matched pixels, the
+gathers of their columns, rows and rays, the depth, the range cut and the lift). The arithmetic is numpy's,
+operation for operation and type for type, so the points are the same bit for bit as the numpy form kept as the
+reference in tests/longitudinal/test_lift.py.
 """
 
 from __future__ import annotations
@@ -54,6 +54,7 @@ def lift_bands(bands, z_min_m: float, z_max_m: float, origin: np.ndarray):
 @kernel()
 def _lift2(d16, c0, skip, u, v, rays, k, area, d16b, c0b, skipb, ub, vb, raysb, kb, areab, z_min, z_max,
            origin):  # pragma: no cover - compiled
+    """``lift_bands``' arrays from the two bands' arguments, each band's matches counted first to size them."""
     n = _matched(d16, skip) + _matched(d16b, skipb)
     uo, vo, zo = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
     po, ao = np.empty((n, 3), np.float64), np.empty(n, np.float32)

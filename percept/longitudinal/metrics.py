@@ -1,6 +1,6 @@
 """Scoring formulas for range and time to contact of the in-path lead: pure numpy.
 
-DESIGN, "Scoring definitions": for the in-path lead object, |estimate - truth| / truth, median
+docs/design.md, "Scoring definitions": for the in-path lead object, |estimate - truth| / truth, median
 overall and per range bin of the true range. The per-bin breakdown follows the usual way of
 reporting stereo range error against distance (error grows with range squared for a fixed
 disparity error; Hartley & Zisserman, "Multiple View Geometry", 2nd ed., ch. 12).

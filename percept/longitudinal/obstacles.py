@@ -30,32 +30,29 @@ GROUNDED_PERCENTILE = 5
 
 @dataclass(frozen=True)
 class ObstacleConfig:
-    """near_m: range splitting the two bands [m]: beyond it (the far band, rows above the road at near_m) only the
-    columns the path can reach are matched at ``far_scale``; nearer (the rows below) the whole width at ``near_scale``,
-    where obstacles are large; num_disparities / block_size: StereoBM's per band (far, near); min_range_m, max_range_m:
-    ranges searched [m]; half_width_m: corridor half-width about the path centre [m]; min_height_m, max_height_m: a
-    pixel between these heights above the road stands up [m]; min_area_m2: smallest frontal area that counts as an
-    obstacle [m²]; bin_rel: relative width of a range bin; grounded_m: a group's lowest pixels must be below this height
-    (obstacles stand on the road; a patch of sky or glare matched by chance floats) [m]; texture_threshold: StereoBM's
-    (flat regions are not matched); blob_cell_px: cells of the image grid in which a range group must form one connected
-    blob [px]; ground: the online road-plane fit (heights are measured from it)."""
+    """Settings of the obstacle finder: the two stereo bands, the corridor, what stands up and what makes a group."""
 
+    # range splitting the two bands [m]: beyond it (the far band, rows above the road at near_m) only the columns the
+    # path can reach are matched at far_scale; nearer (the rows below) the whole width at near_scale, where obstacles
+    # are large
     near_m: float = 15.0
     far_scale: float = 0.5
     near_scale: float = 0.25
-    num_disparities: tuple[int, int] = (48, 32)
-    block_size: tuple[int, int] = (9, 7)
-    min_range_m: float = 3.0
-    max_range_m: float = 100.0
-    half_width_m: float = 1.4
-    min_height_m: float = 0.3
-    max_height_m: float = 3.5
-    min_area_m2: float = 0.25
-    bin_rel: float = 0.04
+    num_disparities: tuple[int, int] = (48, 32)  # StereoBM's per band (far, near)
+    block_size: tuple[int, int] = (9, 7)  # StereoBM's per band (far, near)
+    min_range_m: float = 3.0  # nearest range searched [m]
+    max_range_m: float = 100.0  # farthest range searched [m]
+    half_width_m: float = 1.4  # corridor half-width about the path centre [m]
+    min_height_m: float = 0.3  # a pixel higher than this above the road stands up [m]
+    max_height_m: float = 3.5  # and lower than this [m]
+    min_area_m2: float = 0.25  # smallest frontal area that counts as an obstacle [m²]
+    bin_rel: float = 0.04  # relative width of a range bin
+    # a group's lowest pixels must be below this height [m]: obstacles stand on the road, a patch of sky or glare
+    # matched by chance floats
     grounded_m: float = 1.0
-    texture_threshold: int = 12
-    blob_cell_px: int = 8
-    ground: GroundConfig = GroundConfig()
+    texture_threshold: int = 12  # StereoBM's (flat regions are not matched)
+    blob_cell_px: int = 8  # cells of the image grid in which a range group must form one connected blob [px]
+    ground: GroundConfig = GroundConfig()  # the online road-plane fit (heights are measured from it)
 
     def __post_init__(self) -> None:
         for s in (self.far_scale, self.near_scale):
@@ -175,6 +172,8 @@ class ObstacleFinder:
         return self._nearest_group(u[stand], v[stand], z[stand], pv[stand], area[stand]), debug
 
     def _nearest_group(self, u, v, z, pv, area) -> Obstacle | None:
+        """The nearest range group of the standing points (columns, rows, depths, vehicle-frame points, areas) that
+        covers ``min_area_m2`` in one grounded blob, or None."""
         cfg, cam = self.cfg, self.rig.camera
         # range bins of relative width bin_rel: log(Z) in steps of log(1 + bin_rel); points sorted by bin, so that
         # bins b-1..b+1 are one slice and their area a difference of running sums

@@ -1,6 +1,6 @@
-"""Percentiles and medians of the small arrays of one frame, equal bit for bit to numpy's, at a fraction of the
-cost: ``np.percentile`` and ``np.median`` spend ~20 µs each on generic machinery (axes, NaN checks, dtype rules)
-that a 1-D array of a few hundred finite values does not need; a frame calls them a dozen times.
+"""Percentiles and medians of the small arrays of one frame, equal bit for bit to numpy's, without the generic
+machinery of ``np.percentile`` and ``np.median`` (axes, NaN checks, dtype rules), which costs more than the work on
+a 1-D array of a few hundred finite values.
 
 numpy's default ("linear", Hyndman & Fan's method 7): the value at virtual index i = (n - 1) q of the sorted
 array, interpolated between its neighbours (numpy.lib._function_base_impl._quantile and _lerp). A scalar q gives
@@ -13,6 +13,8 @@ import numpy as np
 
 
 def _linear(a: np.ndarray, q: float, weak: bool):
+    """numpy's linear q-th percentile of ``a`` (q in [0, 100]); ``weak``: in the array's dtype (a scalar q), else
+    float64 (a list of q)."""
     n = a.size
     # virtual index i = (n - 1) q, q in [0, 1]
     v = (n - 1) * np.true_divide(q, 100)
@@ -40,8 +42,8 @@ def percentiles(a: np.ndarray, qs: tuple[float, ...]) -> list[np.float64]:
 
 def median(a: np.ndarray):
     """``np.median(a)`` for a non-empty 1-D float array without NaN: the middle value, or the mean of the two.
-    numpy takes that mean with ``np.mean`` (~10 µs of machinery for two values); its sum starts from 0 (so a -0.0
-    comes out as 0.0) and the result keeps the array's dtype, which the scalar arithmetic below does as well."""
+    numpy takes that mean with ``np.mean``: its sum starts from 0 (so a -0.0 comes out as 0.0) and the result keeps
+    the array's dtype, which the scalar arithmetic below does as well."""
     n, h = a.size, a.size // 2
     if n % 2:
         # mean of one value x: (0 + x) / 1

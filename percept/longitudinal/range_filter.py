@@ -23,7 +23,7 @@ finite value)."""
 
 def _inverse_1x1(S: np.ndarray) -> np.ndarray:
     """The filter's ``inv`` for its (1, 1) innovation covariance: [[1 / s]], what ``np.linalg.inv``'s LU solve gives
-    bit for bit, without its ~10 µs of generic machinery on every update."""
+    bit for bit, without its generic machinery on every update."""
     return 1.0 / S
 
 

@@ -40,7 +40,7 @@ def surface_mask(left: np.ndarray, right: np.ndarray, box: tuple[int, int, int, 
     w = right.shape[1]
     lo = int(np.floor(d0)) - radius
     # the candidates d = lo .. lo + 2 radius + 1 read the right image's columns u0 - d .. u1 - d - 1, all of which
-    # must exist (a box nearer the left edge made a crop the costs could not be formed on)
+    # must exist for the costs to be formed
     if u0 - lo - 2 * radius - 1 < 0 or lo < 1 or u1 - lo + 1 > w:
         return None
     L = left[v0:v1, u0:u1]
@@ -142,7 +142,7 @@ class PatchAligner:
 def _weighted_sums(L, both, keep, huber):  # pragma: no cover - compiled
     """sum(w g^2), sum(w g r), sum(w r^2) over the patch, float32, for the residual r = L - R and Huber weights
     w = (1 if |r| <= huber else huber / max(|r|, 1e-6)) x keep, with R, g the two channels of ``both`` (h, w, 2): the
-    float32 arrays numpy made of those products, summed as numpy sums them (``pairwise_sum``), so equal bit for bit."""
+    float32 arrays numpy makes of those products, summed as numpy sums them (``pairwise_sum``), so equal bit for bit."""
     h, w = L.shape
     n = h * w
     wgg, wgr, wrr = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)

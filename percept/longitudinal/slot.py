@@ -36,34 +36,32 @@ MAX_OUTLINE_SHIFT_PX = 0.4
 
 @dataclass(frozen=True)
 class LeadConfig:
-    """face_m: heights above the road of the band whose disparity is refined (a vehicle's body faces the ego there)
-    [m]; sigma_d_px: floor on the disparity noise [px] (the refinement's own standard error is often far smaller; the
-    floor covers what it does not model: slanted faces, pixels at the outline); column_fill: a column of the band
-    belongs to the obstacle when this fraction of it matches the obstacle's disparity; huber: the refinement's Huber
-    threshold [grey levels]; jerk_sigma_mps3: white jerk noise of the range (the filter is constant-acceleration, so
-    that a lead braking hard is followed without lag) [m/s³]; gate_sigma: innovations beyond this many sigma are
-    outliers; two in a row are a new lead when its box overlaps the last one by less than same_object_iou (IoU), else
-    the same one manoeuvring: the filter's rate and acceleration variances grow by manoeuvre_rate_mps² and
-    manoeuvre_accel_mps2² and it takes the measurement; confirm: hits before a track is reported; hold_s: how long a
-    track is predicted without measurements [s]; reverse_mps: how fast a lead may come towards the ego, beyond the
-    ego's own speed (estimation noise: leads do not reverse on a road) [m/s]; obstacles, contact, flow: the cues' own
-    settings."""
+    """Settings of the vision longitudinal slot: the stereo refinement, the range filter, the track's life and the
+    cues' own settings."""
 
-    face_m: tuple[float, float] = (0.4, 0.9)
+    face_m: tuple[float, float] = (0.4, 0.9)  # heights above the road of the band whose disparity is refined [m]
+    # floor on the disparity noise [px]: the refinement's own standard error is often far smaller, and the floor
+    # covers what it does not model (slanted faces, pixels at the outline)
     sigma_d_px: float = 0.05
-    column_fill: float = 0.3
-    huber: float = 6.0
+    column_fill: float = 0.3  # a column of the band is the obstacle's when this fraction of it matches its disparity
+    huber: float = 6.0  # the refinement's Huber threshold [grey levels]
+    # white jerk noise of the range [m/s³] (the filter is constant-acceleration, so that a lead braking hard is
+    # followed without lag)
     jerk_sigma_mps3: float = 8.0
-    gate_sigma: float = 5.0
+    gate_sigma: float = 5.0  # innovations beyond this many sigma are outliers
+    # two outliers in a row are a new lead when its box overlaps the last one by less than this (IoU), else the same
+    # lead manoeuvring
     same_object_iou: float = 0.3
-    manoeuvre_rate_mps: float = 5.0
-    manoeuvre_accel_mps2: float = 6.0
-    confirm: int = 3
-    hold_s: float = 0.6
+    manoeuvre_rate_mps: float = 5.0  # a manoeuvre grows the filter's rate variance by this squared [m/s]
+    manoeuvre_accel_mps2: float = 6.0  # and its acceleration variance by this squared [m/s²]
+    confirm: int = 3  # hits before a track is reported
+    hold_s: float = 0.6  # how long a track is predicted without measurements [s]
+    # how fast a lead may come towards the ego beyond the ego's own speed [m/s] (estimation noise: leads do not
+    # reverse on a road)
     reverse_mps: float = 1.0
-    obstacles: ObstacleConfig = ObstacleConfig()
-    contact: ContactConfig = ContactConfig()
-    flow: FlowConfig = FlowConfig()
+    obstacles: ObstacleConfig = ObstacleConfig()  # the obstacle finder's settings
+    contact: ContactConfig = ContactConfig()  # the ground-contact range's settings
+    flow: FlowConfig = FlowConfig()  # the expansion measurement's settings
 
 
 @dataclass(frozen=True)
@@ -112,6 +110,7 @@ class LongitudinalSlot:
         self.flow.reset()
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Lead | None, LeadDebug]:
+        """One frame: the confirmed lead in the path (None without one) and what each cue measured."""
         motion = self.motion.update(frame)
         path = upstream.get(EgoPath) or EgoPath.straight(motion.speed_mps)
         # nothing in the path comes towards the ego faster than it drives: range rate >= -(v_ego + reverse_mps)
@@ -172,10 +171,9 @@ class LongitudinalSlot:
         if full is None:
             return None
         # then without their outline: a 5x5 block straddling it matches at the obstacle's disparity with half of it
-        # on what lies behind (foreground fattening), and the outline's strong gradients pull the fit (by up to
-        # ~0.3 px at 40 m). The inner pixels alone, started where all of them converged, correct that; a far
-        # obstacle's few inner pixels can also lock onto a wrong minimum further away, and then the fit with the
-        # outline stands
+        # on what lies behind (foreground fattening), and the outline's strong gradients pull the fit. The inner
+        # pixels alone, started where all of them converged, correct that; a far obstacle's few inner pixels can
+        # also lock onto a wrong minimum further away, and then the fit with the outline stands
         k = OUTLINE_COLS
         inner = m.copy()
         inner[:, :cols[0] + k] = False
@@ -264,6 +262,7 @@ class LongitudinalSlot:
         return self._gated_update(e.range_rate_mps(z), sigma, RATE)
 
     def _lead(self) -> Lead | None:
+        """The confirmed track as a Lead, its confidence falling while it is only predicted."""
         if self.track is None or self.hits < self.cfg.confirm:
             return None
         rng, rate = self.track.range_m, self.track.rate_mps
