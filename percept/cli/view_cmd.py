@@ -29,11 +29,12 @@ def rerun_executable() -> str | None:
     """The ``rerun`` viewer: the binary of the ``rerun_cli`` package (installed with rerun-sdk), else the ``rerun``
     script beside this Python or on PATH. The binary itself, not the script that starts it: stopping the script
     (Ctrl-C, a kill) would leave the viewer and its servers running."""
-    spec = importlib.util.find_spec("rerun_cli")
-    if spec is not None and spec.origin:
-        exe = Path(spec.origin).with_name("rerun.exe" if sys.platform.startswith("win") else "rerun")
-        if exe.is_file():
-            return str(exe)
+    from percept.review.recorder import rerun_cli
+
+    try:
+        return rerun_cli()
+    except OSError:
+        pass
     exe = Path(sys.executable).with_name("rerun")
     return str(exe) if exe.exists() else shutil.which("rerun")
 

@@ -34,9 +34,13 @@ from numba import njit
 
 from percept.compiled import kernel
 
+WINDOW_PX = (64, 128)
+"""Detection window (width, height) [px]."""
+CELL_PX = 8
+"""HOG cell side at the window's own scale [px] (Dalal & Triggs 2005)."""
 BINS = 9
 L2HYS_CLIP = 0.2
-"""OpenCV's default L2-Hys clipping threshold (that of its people detector, ``hog.hog_descriptor``'s)."""
+"""OpenCV's default L2-Hys clipping threshold (that of its people detector, ``hog_descriptor``'s)."""
 EPS_L2 = np.float32(np.float32(0.1) * np.float32(4 * BINS))
 """OpenCV's epsilon of the first L2 norm: 0.1 per value of the block, in float32."""
 
@@ -58,6 +62,16 @@ def axis_weights(cell_px: int) -> np.ndarray:
     return w
 
 
+def hog_descriptor(win_px: tuple[int, int] = WINDOW_PX, cell_px: int = CELL_PX) -> cv2.HOGDescriptor:
+    """OpenCV's HOG with Dalal & Triggs' parameters (those of its default people detector) for windows of
+    ``win_px`` (width, height) [px]: 8x8 cells, 16x16 blocks at an 8-pixel stride, 9 bins, L2-Hys at 0.2, gamma
+    correction, the block's Gaussian weighting. ``cell_px`` other than 8 scales cells, blocks and stride together
+    (a 4-pixel cell sees what an 8-pixel cell sees in the image enlarged twice)."""
+    c = int(cell_px)
+    return cv2.HOGDescriptor(win_px, (2 * c, 2 * c), (c, c), (c, c), BINS, 1, -1.0, cv2.HOGDescriptor_L2Hys,
+                             L2HYS_CLIP, True, 64, False)
+
+
 def gradients(image: np.ndarray, cell_px: int) -> tuple[np.ndarray, np.ndarray]:
     """OpenCV's HOG gradient of ``image`` (grey or BGR uint8): magnitudes (h, w, 2) float32 split between the two
     bins (h, w, 2) uint8 they vote into."""
@@ -67,8 +81,6 @@ def gradients(image: np.ndarray, cell_px: int) -> tuple[np.ndarray, np.ndarray]:
 @lru_cache(maxsize=8)
 def _gradient_descriptor(c: int) -> cv2.HOGDescriptor:
     """OpenCV's HOG with the people detector's parameters at cells of c px (its window does not matter here)."""
-    from .hog import hog_descriptor  # hog imports this module
-
     return hog_descriptor((2 * c, 2 * c), c)
 
 

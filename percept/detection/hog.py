@@ -27,11 +27,8 @@ import numpy as np
 
 from percept.compiled import kernel
 
-from .blocks import BINS, L2HYS_CLIP, hog_blocks
+from .blocks import BINS, CELL_PX, L2HYS_CLIP, WINDOW_PX, hog_blocks, hog_descriptor
 
-WINDOW_PX = (64, 128)
-"""Detection window (width, height) [px]."""
-CELL_PX = 8
 BLOCK_PX = 16
 BLOCKS = ((WINDOW_PX[0] - BLOCK_PX) // CELL_PX + 1, (WINDOW_PX[1] - BLOCK_PX) // CELL_PX + 1)
 """Blocks across and down one window: (7, 15)."""
@@ -39,16 +36,6 @@ BLOCK_LEN = 4 * BINS
 SIM_MODEL_PATH = Path(__file__).parent / "models" / "people_sim.npz"
 """The shipped sim-trained people model."""
 DESCRIPTOR_LEN = BLOCKS[0] * BLOCKS[1] * BLOCK_LEN
-
-
-def hog_descriptor(win_px: tuple[int, int] = WINDOW_PX, cell_px: int = CELL_PX) -> cv2.HOGDescriptor:
-    """OpenCV's HOG with Dalal & Triggs' parameters (those of its default people detector) for windows of
-    ``win_px`` (width, height) [px]: 8x8 cells, 16x16 blocks at an 8-pixel stride, 9 bins, L2-Hys at 0.2, gamma
-    correction, the block's Gaussian weighting. ``cell_px`` other than 8 scales cells, blocks and stride together
-    (a 4-pixel cell sees what an 8-pixel cell sees in the image enlarged twice)."""
-    c = int(cell_px)
-    return cv2.HOGDescriptor(win_px, (2 * c, 2 * c), (c, c), (c, c), BINS, 1, -1.0, cv2.HOGDescriptor_L2Hys,
-                             L2HYS_CLIP, True, 64, False)
 
 
 def block_grid(image: np.ndarray, cell_px: int = CELL_PX) -> np.ndarray:

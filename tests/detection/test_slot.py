@@ -246,15 +246,15 @@ def test_the_request_closes_at_the_ego_speed_whatever_the_tracks_own_x_speed():
 WARM_CHECK = """
 from percept.compiled import dispatchers
 from percept.detection import blocks, hog, pyramid, stereo_range
-from percept.bench import stages as B
+from percept.drive import SlotContext, TruthFeed
 from percept.drive.tasks import TASKS
 from percept.sensors import EgoPath
 from percept.sims import SimWorld, WorldConfig
 from percept.sims.coords import hw_pose
 kernels = dispatchers(blocks, hog, pyramid, stereo_range)
 world = SimWorld(WorldConfig("crossing", seed=1, autopilot=True))
-feed = B.TruthFeed()
-ctx = B.SlotContext(world.cfg.rig, world.dt, None, feed, start_pose=hw_pose(world.ego))
+feed = TruthFeed()
+ctx = SlotContext(world.cfg.rig, world.dt, None, feed, start_pose=hw_pose(world.ego))
 tasks = {t.name: t for t in TASKS}
 lateral, slot = tasks["lanes"].privileged(ctx), tasks["pedestrians"].vision(ctx)
 before = [len(k.signatures) for k in kernels]

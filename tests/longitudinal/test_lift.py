@@ -147,7 +147,7 @@ def test_mismatched_inputs_raise_instead_of_reading_past_the_arrays():
 
 WARM_CHECK = """
 from percept.compiled import dispatchers
-from percept.bench import stages as B
+from percept.drive import SlotContext, TruthFeed
 from percept.drive.tasks import TASKS
 from percept.lanes import evidence
 from percept.sensors import EgoPath, Lead
@@ -158,7 +158,7 @@ from percept.sims.coords import hw_pose
 modules = (evidence, contact, flow, ground, groups, lift, refine, features)
 kernels = dispatchers(*modules)
 world = SimWorld(WorldConfig("lead-brake", seed=1, autopilot=True))
-ctx = B.SlotContext(world.cfg.rig, world.dt, None, B.TruthFeed(), start_pose=hw_pose(world.ego))
+ctx = SlotContext(world.cfg.rig, world.dt, None, TruthFeed(), start_pose=hw_pose(world.ego))
 slots = {t.name: t.vision(ctx) for t in TASKS if t.name in ("lanes", "longitudinal", "odometry")}
 before = [len(k.signatures) for k in kernels]
 refined = 0
