@@ -50,7 +50,8 @@ def spans(scenario: str, seed: int, condition: str) -> list[tuple[np.ndarray, np
     try:
         # the task that provides the pose on vision, the others privileged
         vision = {t.name: "vision" for t in TASKS if t.provides is PoseEstimate}
-        run_drive(DriveConfig(WorldConfig(scenario, seed=seed, condition=condition), sources=vision))
+        run_drive(DriveConfig(WorldConfig(scenario, seed=seed, condition=condition), sources=vision,
+                              default="privileged"))
     finally:
         SimWorld.observe, fusion.PoseFilter.clone, fusion.PoseFilter.update_relative = observe, clone, relative
     out = []

@@ -19,9 +19,10 @@ class DriveConfig:
 
     world: WorldConfig = field(default_factory=WorldConfig)  # scenario, seed, condition, rig
     duration_s: float | None = None  # simulated length [s] (None: the scenario's own)
-    sources: dict = field(default_factory=dict)  # task name -> Source (a task not given: privileged)
+    sources: dict = field(default_factory=dict)  # task name -> Source, for the tasks not on ``default``
     tasks: tuple[Task, ...] = field(default_factory=lambda: tasks_module.TASKS)  # the slot table
     detector: str = "sim"  # people model of the vision pedestrian slot: "sim", "inria" or a model file
+    default: Source = Source.VISION  # the source of a task not in sources (privileged where it has no vision slot)
 
     def __post_init__(self) -> None:
         d = self.duration_s
@@ -39,7 +40,10 @@ class DriveConfig:
                 raise ValueError(f"--{name} must be vision or privileged, got '{src}'") from None
             if clean[name] is Source.VISION and names[name].vision is None:
                 raise ValueError(f"the {name} slot has no vision implementation yet; use --{name} privileged")
-        object.__setattr__(self, "sources", {t.name: clean.get(t.name, Source.PRIVILEGED) for t in self.tasks})
+        default = Source(self.default)
+        object.__setattr__(self, "default", default)
+        object.__setattr__(self, "sources", {t.name: clean.get(t.name, default if t.vision else Source.PRIVILEGED)
+                                             for t in self.tasks})
         from percept.detection import LinearModel
 
         path = LinearModel.file_of(self.detector)

@@ -8,6 +8,7 @@ from enum import Enum
 
 from percept.drive.config import DriveConfig
 from percept.drive.limits import MAX_SEED
+from percept.sensors import Source
 from percept.sims import WorldConfig
 
 MAX_SEEDS = 10_000
@@ -66,9 +67,10 @@ class EvalPlan:
     scenarios: tuple[str, ...]  # scenario names
     conditions: tuple[str, ...]  # condition names
     seeds: tuple[int, ...]  # the seeds of every (scenario, condition)
-    slots: dict = field(default_factory=dict)  # task name -> Source (a task not given: privileged)
+    slots: dict = field(default_factory=dict)  # task name -> Source, for the tasks not on ``default``
     duration_s: float | None = None  # simulated length of each run [s] (None: each scenario's own)
     detector: str = "sim"  # people model of the vision pedestrian slot
+    default: Source = Source.VISION  # the source of a task not in slots (as in DriveConfig)
 
     def __post_init__(self) -> None:
         if not self.scenarios or not self.conditions or not self.seeds:
@@ -81,7 +83,7 @@ class EvalPlan:
     def config(self, job: Job) -> DriveConfig:
         """The drive configuration of one job."""
         return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
-                           dict(self.slots), detector=self.detector)
+                           dict(self.slots), detector=self.detector, default=self.default)
 
     @property
     def tasks(self) -> tuple:

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 from typing import Callable
 
-from percept.sims import WorldConfig, check_condition
-
 from percept.drive.config import DriveConfig
 from percept.drive.loop import run_drive
+from percept.sensors import Source
+from percept.sims import WorldConfig, check_condition
 
 FrameFn = Callable[[int, object, object], None]
 """fn(seed, frame, ground_truth): called with each sampled ``Frame`` and its ``GroundTruth``."""
@@ -35,5 +35,6 @@ def for_each_frame(scenario: str, seeds, fn: FrameFn, every: int = 1, condition:
         raise ValueError(f"every must be a positive frame count, got {every}")
     cond = check_condition(condition)
     for seed in seeds:
-        cfg = DriveConfig(WorldConfig(scenario, seed=int(seed), condition=cond), duration_s=duration_s)
+        cfg = DriveConfig(WorldConfig(scenario, seed=int(seed), condition=cond), duration_s=duration_s,
+                          default=Source.PRIVILEGED)
         run_drive(cfg, recorder_factory=lambda world, s=int(seed): _Sampler(s, every, fn))

@@ -7,7 +7,8 @@ from percept.sims import WorldConfig
 
 
 def drive(scenario, seed, duration=None, **kw):
-    return run_drive(DriveConfig(WorldConfig(scenario, seed, scenery=False), duration_s=duration, sources=kw),
+    return run_drive(DriveConfig(WorldConfig(scenario, seed, scenery=False), duration_s=duration, sources=kw,
+                                 default="privileged"),
                      render=False)
 
 

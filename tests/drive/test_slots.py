@@ -59,7 +59,8 @@ FAKE = Task("counter", FrameCount, CountingSlot, CountingScorer, vision=Counting
 
 def test_a_fifth_task_added_through_the_table_alone_runs_is_timed_scored_and_recorded(tmp_path):
     tasks = TASKS + (FAKE,)
-    cfg = DriveConfig(WorldConfig("highway", 0, scenery=False), 1.0, {"counter": "vision"}, tasks=tasks)
+    cfg = DriveConfig(WorldConfig("highway", 0, scenery=False), 1.0, {"counter": "vision"}, tasks=tasks,
+                      default="privileged")
     rrd = tmp_path / "five.rrd"
 
     def recorder(world):
@@ -161,7 +162,7 @@ def test_drive_config_names_the_bad_task_or_source():
     ("crossing", 2, "pedestrians", "stops", [True, True, True]),
 ])
 def test_privileged_metrics_are_pinned(scenario, seed, group, key, value):
-    r = run_drive(DriveConfig(WorldConfig(scenario, seed)), render=False)
+    r = run_drive(DriveConfig(WorldConfig(scenario, seed), default="privileged"), render=False)
     # to a millionth: numpy picks its SIMD kernels by the CPU, so sums round differently on another machine (in the
     # 16th digit); a change of behaviour moves these figures by far more
     assert r[group][key] == (pytest.approx(value, rel=1e-6, abs=0) if isinstance(value, float) else value)

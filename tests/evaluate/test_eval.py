@@ -82,7 +82,7 @@ def seed_1_crashes(monkeypatch):
 
 
 def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, seed_1_crashes):
-    plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0)
+    plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0, default="privileged")
     s = ev.evaluate(plan, tmp_path)
     g = s["groups"][0]
     assert g["seeds"] == [0, 2]
@@ -92,7 +92,7 @@ def test_a_failing_run_is_reported_and_the_others_are_kept(tmp_path, seed_1_cras
 
 
 def test_a_resumed_batch_reports_only_the_runs_it_drives(tmp_path, seed_1_crashes):
-    plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0)
+    plan = EvalPlan(("lead-brake",), ("clear",), (0, 1, 2), duration_s=1.0, default="privileged")
     ev.evaluate(plan, tmp_path)
     seen = []
     ev.evaluate(plan, tmp_path, progress=seen.append)
@@ -123,7 +123,7 @@ def test_time_left_is_the_mean_pace_not_the_last_30_seconds():
 
 
 def test_parallel_workers_give_the_same_metrics_as_one(tmp_path):
-    plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0)
+    plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0, default="privileged")
     a = ev.evaluate(plan, tmp_path / "a", workers=1)
     b = ev.evaluate(plan, tmp_path / "b", workers=2)
     for s in (a, b):
@@ -156,7 +156,7 @@ def test_eval_bad_input_is_one_line_exit_2(tmp_path, args, message):
 def test_ray_engine_gives_the_local_engine_s_runs(tmp_path):
     import ray
 
-    plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0)
+    plan = EvalPlan(("cut-in",), ("clear",), (0, 1), duration_s=2.0, default="privileged")
     try:
         ray.init(num_cpus=2, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
         a = ev.evaluate(plan, tmp_path / "ray", engine=ev.Engine.RAY)
@@ -180,19 +180,21 @@ def test_ray_engine_without_ray_says_how_to_get_it(tmp_path, monkeypatch):
 
 
 def test_jobs_cover_the_plan():
-    plan = EvalPlan(("highway", "curves"), ("clear", "rain"), (0, 1, 2))
+    plan = EvalPlan(("highway", "curves"), ("clear", "rain"), (0, 1, 2), default="privileged")
     assert len(plan.jobs) == 12 and Job("curves", "rain", 2) in plan.jobs
 
 
 def test_the_people_model_is_a_setting_only_where_the_pedestrian_slot_sees():
     from percept.evaluate.resume import run_settings
 
-    sim = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"})
-    inria = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="inria")
+    sim = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, default="privileged")
+    inria = EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="inria",
+                     default="privileged")
     assert run_settings(sim)["detector"] == "sim" and run_settings(inria)["detector"] == "inria"
-    assert run_settings(EvalPlan(("crossing",), ("clear",), (0,)))["detector"] is None
+    assert run_settings(EvalPlan(("crossing",), ("clear",), (0,), default="privileged"))["detector"] is None
     with pytest.raises(ValueError, match="--detector must be"):
-        EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="missing.npz")
+        EvalPlan(("crossing",), ("clear",), (0,), {"pedestrians": "vision"}, detector="missing.npz",
+                 default="privileged")
 
 
 def _files(folder) -> dict:

@@ -44,7 +44,8 @@ def test_a_run_interrupted_midway_keeps_what_was_recorded(tmp_path):
         return holder["r"]
 
     with pytest.raises(KeyboardInterrupt):
-        run_drive(DriveConfig(WorldConfig("highway", 0), 1.0), recorder_factory=factory, render=True)
+        run_drive(DriveConfig(WorldConfig("highway", 0), 1.0, default="privileged"), recorder_factory=factory,
+                  render=True)
     kept = holder["r"].close(complete=False)
     verify(kept, footer=False)
     # the rows held as columns (trail, scalars) are sent when the recorder closes

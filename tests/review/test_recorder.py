@@ -68,7 +68,7 @@ def columns_by_entity(path: Path) -> dict[str, dict[str, int]]:
 
 def record(path: Path, sources: dict, options: RecordOptions = RecordOptions(), duration_s: float = 1.0,
            scenario: str = "highway") -> dict:
-    cfg = DriveConfig(WorldConfig(scenario, 0), duration_s, sources)
+    cfg = DriveConfig(WorldConfig(scenario, 0), duration_s, sources, default="privileged")
     holder = {}
 
     def factory(world):
