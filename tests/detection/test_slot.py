@@ -76,7 +76,7 @@ def test_the_far_fields_levels_are_searched_more_often_than_the_near_ones():
 
 def test_by_default_the_levels_where_crossing_people_are_first_found_are_searched_every_third_frame():
     """The defaults: the three smallest levels (people up to 34.6 px, the only ones that reach the 28.3 m and more
-    at which every crossing person of b02c612's evaluations was first found) every third frame, the others every
+    at which every crossing person of the evaluation seeds is first found) every third frame, the others every
     eighth."""
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     assert slot.periods == (3, 3, 3) + (8,) * (len(slot.search.scales) - 3)

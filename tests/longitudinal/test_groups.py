@@ -1,4 +1,4 @@
-"""The finder's compiled group search against the numpy it replaced: the same group, bit for bit, on synthetic
+"""The finder's compiled group search against numpy's formulas: the same group, bit for bit, on synthetic
 standing pixels (blobs at several ranges, scattered strays, blobs of equal area)."""
 
 import cv2

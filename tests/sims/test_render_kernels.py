@@ -49,6 +49,8 @@ def test_large_and_small_patch_paths_draw_the_same_picture(monkeypatch):
     fragments_ = draw(monkeypatch, np.inf)  # every patch small: fragments, all at once
     assert (one_by_one.ids > 0).sum() > 3000, "the scene should cover a good part of the image"
     assert len(np.unique(one_by_one.ids)) >= 10
+    # both paths are compiled kernels that test coverage and the z-buffer with the same float32 operations: the
+    # same picture to the bit on any CPU; the depth is divided out in different places (a relative tolerance)
     np.testing.assert_array_equal(one_by_one.ids, fragments_.ids)
     np.testing.assert_array_equal(one_by_one.image, fragments_.image)
     np.testing.assert_array_equal(one_by_one.emission, fragments_.emission)
@@ -232,7 +234,7 @@ def test_the_ground_colour_lookup_is_opencv_s_or_and_colour_map_to_the_byte():
     img = np.full((h, w, 3), 7, np.uint8)
     _colour_map(img, grain, mask, cmap, r0)
     expected = cv2.applyColorMap(cv2.bitwise_or(grain, mask[r0:]), cmap)
-    np.testing.assert_array_equal(img[r0:], expected)
+    np.testing.assert_array_equal(img[r0:], expected)  # integer operations: the same bytes on any CPU
     assert (img[:r0] == 7).all()
 
 
@@ -252,6 +254,7 @@ def test_the_depth_from_the_z_buffer_is_numpy_s_divide_to_the_bit():
     expected = background.copy()
     np.divide(np.float32(1.0), inv, out=expected, where=inv != base)
     assert out.dtype == np.float32
+    # IEEE division is correctly rounded: one quotient on any CPU
     np.testing.assert_array_equal(out.view(np.int32), expected.view(np.int32))
     assert np.isinf(out[:5][~won[:5]]).all()
 
