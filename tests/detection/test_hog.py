@@ -95,6 +95,7 @@ def test_a_model_saves_and_loads_and_bad_files_say_so(tmp_path):
 
 
 @pytest.mark.skipif(not VTEST.is_file(), reason=f"{VTEST} is absent (real data in ../shared/data)")
+@pytest.mark.slow
 def test_the_pyramid_finds_what_opencv_detect_multiscale_finds_on_real_video():
     cap = cv2.VideoCapture(str(VTEST))
     hog = cv2.HOGDescriptor()

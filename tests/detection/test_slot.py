@@ -20,6 +20,7 @@ def crossing_run():
                                  sources={"pedestrians": "vision"}))
 
 
+@pytest.mark.slow
 def test_the_car_stops_for_the_crossing_person_on_vision(crossing_run):
     r = crossing_run
     p = r["pedestrians"]
@@ -29,6 +30,7 @@ def test_the_car_stops_for_the_crossing_person_on_vision(crossing_run):
     assert p["detector"] == "sim" and r["timing_ms"]["pedestrians"] > 0
 
 
+@pytest.mark.slow
 def test_its_people_are_scored_against_the_truth(crossing_run):
     p = crossing_run["pedestrians"]
     assert p["recall"] >= 0.8 and p["precision"] >= 0.8 and p["fppi"] <= 0.1, p
@@ -84,6 +86,7 @@ def test_by_default_the_levels_where_crossing_people_are_first_found_are_searche
     assert all(slot.search._depths[k][1] > 28.3 for k in range(3))
 
 
+@pytest.mark.slow
 def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
     # rain, seed 10: the third person crosses 40-10 m ahead while the ego drives at 55 km/h; in rain the far field
     # often gives one window, which grouping drops: before lone windows were verified by stereo the person was
@@ -270,6 +273,7 @@ print(len(kernels), min(before), grouped, lone, stereo, [len(k.signatures) for k
 """
 
 
+@pytest.mark.slow
 def test_the_slot_loads_its_compiled_passes_when_built_not_in_a_frame():
     """The HOG blocks', the window sums', the grouping's and the stereo match's compiled passes, in a fresh
     process."""

@@ -38,6 +38,7 @@ def test_crops_are_the_search_window_and_mirroring_is_a_flip():
     assert not np.allclose(f, m)
 
 
+@pytest.mark.slow
 def test_train_detector_writes_a_model_that_detect_loads(tmp_path):
     out = tmp_path / "m.npz"
     r = runner.invoke(app, ["train-detector", "--seeds", "1000", "--duration", "10", "--every", "5",

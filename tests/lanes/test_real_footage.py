@@ -51,6 +51,7 @@ def on_marking_fraction(image: np.ndarray, points_px, half_px: int = 6, flank_px
 @needs_lanes
 @pytest.mark.parametrize("calibrated", [False, True], ids=["hfov60", "calib"])
 @pytest.mark.parametrize("name", ["straight_lines1.jpg", "straight_lines2.jpg"])
+@pytest.mark.slow
 def test_straight_lines_are_straight(name, calibrated, request):
     cal = CameraCalibration.load(request.getfixturevalue("calib_file")) if calibrated else None
     r = FootageLanes(RealLaneConfig(), cal).still(read_image(LANES / "test_images" / name))
@@ -65,6 +66,7 @@ def test_straight_lines_are_straight(name, calibrated, request):
 @needs_lanes
 @needs_p1
 @pytest.mark.parametrize("folder", [LANES / "test_images", P1 / "test_images"], ids=["udacity-lanes", "p1"])
+@pytest.mark.slow
 def test_every_test_image_gets_both_boundaries_on_the_markings(folder, tmp_path):
     js = tmp_path / "lanes.json"
     r = runner.invoke(app, ["lanes", str(folder), "--json", str(js), "--out", str(tmp_path)])
@@ -91,6 +93,7 @@ def test_every_test_image_gets_both_boundaries_on_the_markings(folder, tmp_path)
 
 
 @needs_lanes
+@pytest.mark.slow
 def test_calibrated_images_through_the_cli(calib_file, tmp_path):
     js = tmp_path / "lanes.json"
     r = runner.invoke(app, ["lanes", str(LANES / "test_images"), "--calib", str(calib_file), "--json", str(js)])
@@ -101,6 +104,7 @@ def test_calibrated_images_through_the_cli(calib_file, tmp_path):
 
 
 @needs_lanes
+@pytest.mark.slow
 def test_a_runner_for_prepared_images_fits_what_the_calibrated_runner_fits(calib_file):
     raw = read_image(LANES / "test_images" / "test2.jpg")
     lanes = FootageLanes(RealLaneConfig(), CameraCalibration.load(calib_file))
@@ -113,6 +117,7 @@ def test_a_runner_for_prepared_images_fits_what_the_calibrated_runner_fits(calib
 
 
 @pytest.mark.skipif(not VIDEO.is_file(), reason=f"{VIDEO} is absent (real data in ../shared/data)")
+@pytest.mark.slow
 def test_video_runs_end_to_end(tmp_path):
     js = tmp_path / "video.json"
     r = runner.invoke(app, ["lanes", str(VIDEO), "--json", str(js), "--out", str(tmp_path), "--max-frames", "60"])

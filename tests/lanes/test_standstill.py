@@ -84,6 +84,7 @@ def test_the_slot_tells_the_pace_from_the_wheel_speed(monkeypatch):
     assert calls == [D, D, C, C, S, S, S]
 
 
+@pytest.mark.slow
 def test_standing_behind_a_stopped_lead_in_rain_keeps_the_lane_and_the_lead():
     # lead-brake seed 0 in rain, every slot on vision: the ego stops ~6 m behind the braked lead at ~15 s and stands
     # ~220 frames; a tracker that restarts on those frames puts the lane 2.6 m off and steers 1.2 rad

@@ -12,7 +12,7 @@ from percept.sensors import StereoRig
 
 
 def _numpy_nearest_group(finder, u, v, z, pv, area):
-    """``ObstacleFinder._nearest_group`` before the kernels."""
+    """``ObstacleFinder._nearest_group`` in numpy's operations, without the kernels."""
     cfg, cam = finder.cfg, finder.rig.camera
     k = np.floor(np.log(z) / np.log1p(cfg.bin_rel)).astype(int)
     order = np.argsort(k, kind="stable")

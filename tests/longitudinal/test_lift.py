@@ -173,6 +173,7 @@ print(len(kernels), min(before), refined, [len(k.signatures) for k in kernels] =
 """
 
 
+@pytest.mark.slow
 def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
     """The lanes', longitudinal and odometry slots' compiled passes."""
     import subprocess

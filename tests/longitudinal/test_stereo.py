@@ -239,6 +239,7 @@ def test_real_unrectified_pair_is_measured():
 
 
 @needs_moto
+@pytest.mark.slow
 def test_middlebury_percept_is_no_worse_than_sgbm(tmp_path):
     args = [str(MOTO / "motorcycle_left.png"), str(MOTO / "motorcycle_right.png"), "--calib", str(MOTO / "calib.txt"),
             "--gt", str(MOTO / "motorcycle_disp.npz"), "--json", str(tmp_path / "m.json"), "--out", str(tmp_path)]

@@ -11,6 +11,8 @@ from percept.odometry import OdometrySlot
 from percept.sensors import Frame, ImuSample, Pose2D, StereoRig
 from percept.sims import WorldConfig
 
+pytestmark = pytest.mark.slow
+
 
 def test_vision_odometry_on_the_loop_keeps_within_its_bounds():
     # the first 40 s of `loop` seed 1 (about 900 m, the first bend included); the full runs (seeds 0-4 x clear,

@@ -106,6 +106,7 @@ def test_one_or_two_views_are_refused(tmp_path):
 
 
 @needs_cal
+@pytest.mark.slow
 def test_percept_calibrate_on_the_udacity_photos(tmp_path):
     out, js = tmp_path / "calib.json", tmp_path / "report.json"
     r = runner.invoke(app, ["calibrate", str(CAL_DIR), "--pattern", "9x6", "--out", str(out), "--json", str(js)])

@@ -90,6 +90,7 @@ def iou(a, b) -> float:
     return inter / ((a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter)
 
 
+@pytest.mark.slow
 def test_inria_people_detector_finds_rendered_pedestrians(road):
     rig = StereoRig()
     renderer = StereoRenderer(rig, road, seed=0)

@@ -49,8 +49,7 @@ def test_large_and_small_patch_paths_draw_the_same_picture(monkeypatch):
     fragments_ = draw(monkeypatch, np.inf)  # every patch small: fragments, all at once
     assert (one_by_one.ids > 0).sum() > 3000, "the scene should cover a good part of the image"
     assert len(np.unique(one_by_one.ids)) >= 10
-    # both paths are compiled kernels that test coverage and the z-buffer with the same float32 operations: the
-    # same picture to the bit on any CPU; the depth is divided out in different places (a relative tolerance)
+    # both paths test coverage and depth with the same float32 operations: the same picture to the bit on any CPU
     np.testing.assert_array_equal(one_by_one.ids, fragments_.ids)
     np.testing.assert_array_equal(one_by_one.image, fragments_.image)
     np.testing.assert_array_equal(one_by_one.emission, fragments_.emission)
@@ -128,6 +127,7 @@ print(len(kernels), min(before), [len(k.signatures) for k in kernels] == before)
 """
 
 
+@pytest.mark.slow
 def test_after_the_warm_up_rendering_a_world_compiles_nothing():
     # in a fresh process: this one has compiled kernels for the tests above already
     out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
@@ -159,6 +159,7 @@ print(m.hexdigest())
 """
 
 
+@pytest.mark.slow
 def test_the_compiled_figures_are_the_interpreted_ones():
     # the pedestrians' figures are built by compiled code; with numba's compiler off the same functions run as
     # Python, with Python's own arithmetic, math.hypot, min and max: the patches must be the same bytes
@@ -195,6 +196,7 @@ print(" ".join(seen))
 """
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_a_kernel_is_a_keyboard_interrupt():
     # numba boxes a kernel's arrays without checking for a pending signal; unwrapped, most of these would be
     # SystemError, which the commands' Ctrl-C handling (keep what is finished, exit 130) does not recognise
@@ -254,11 +256,11 @@ def test_the_depth_from_the_z_buffer_is_numpy_s_divide_to_the_bit():
     expected = background.copy()
     np.divide(np.float32(1.0), inv, out=expected, where=inv != base)
     assert out.dtype == np.float32
-    # IEEE division is correctly rounded: one quotient on any CPU
-    np.testing.assert_array_equal(out.view(np.int32), expected.view(np.int32))
+    np.testing.assert_array_equal(out.view(np.int32), expected.view(np.int32))  # IEEE division: one quotient
     assert np.isinf(out[:5][~won[:5]]).all()
 
 
+@pytest.mark.slow
 def test_the_columns_kept_for_a_patch_crossing_the_near_plane_hold_every_pixel_its_exact_test_passes():
     """``_near_columns`` skips only columns where the exact float32 test of a patch crossing the near plane fails:
     checked against the test itself on 20 000 random rows, steep, shallow and flat edges among them."""

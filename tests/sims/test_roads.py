@@ -143,6 +143,7 @@ def test_indexed_network_answers_like_highway_env():
         assert net.get_closest_lane_index(p, h) == RoadNetwork.get_closest_lane_index(net, p, h)
 
 
+@pytest.mark.slow
 def test_a_snapshot_builds_each_sign_once_and_every_vehicle_each_frame():
     from percept.sims.snapshot import object_state, scene_from_road
 
