@@ -1,13 +1,10 @@
 """Landmark sightings on rendered frames: the mapped sign found, measured by stereo within its stated error."""
 
 import numpy as np
-import pytest
 
 from percept.odometry import LandmarkFinder, SightingConfig
 from percept.odometry.landmarks import MIN_PERIMETER_RATE
 from percept.sensors import LandmarkMap, Pose2D
-
-pytestmark = pytest.mark.slow
 
 
 def test_signs_are_found_and_measured_within_their_stated_error(loop_run):
