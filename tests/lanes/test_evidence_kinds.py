@@ -100,6 +100,7 @@ def tusimple_0():
     return images[0], lanes.still(images[0])
 
 
+@pytest.mark.slow
 def test_raised_markers_on_a_real_freeway_carry_the_left_boundary(tusimple_0):
     _, r = tusimple_0
     # 0.jpg marks its left boundary with clusters of Botts' dots; one cluster spans (456, 404) to (404, 446) px
@@ -110,6 +111,7 @@ def test_raised_markers_on_a_real_freeway_carry_the_left_boundary(tusimple_0):
     assert np.abs(r.u_at_rows(rows)["left"] - np.interp(rows, [404, 446], [456, 404])).max() < 15
 
 
+@pytest.mark.slow
 def test_a_pale_strip_beside_a_seam_does_not_take_the_boundary_but_lowers_the_confidence(tusimple_0):
     image, r = tusimple_0
     # the right boundary is the solid white line; a strip of paler concrete along a seam ~1 m inside it looks like

@@ -48,6 +48,7 @@ def test_hood_on_synthetic_frames():
 @needs["lanes"]
 @needs["p1"]
 @needs["tusimple"]
+@pytest.mark.slow
 def test_hood_on_real_frames():
     # Udacity's car shows its hood at rows 665-677 of 720; P1's seam across the road at row ~480 of 540 and the
     # hood-less TuSimple frames show none
@@ -60,6 +61,7 @@ def test_hood_on_real_frames():
 @needs["lanes"]
 @needs["p1"]
 @pytest.mark.parametrize("folder", [LANES, P1], ids=["udacity-lanes", "p1"])
+@pytest.mark.slow
 def test_height_from_the_lane_width_over_a_folder(folder):
     images = [read_image(p) for p in sorted(folder.glob("*.jpg"))]
     lanes = FootageLanes(RealLaneConfig())
@@ -82,6 +84,7 @@ NEIGHBOUR_MARKERS_0 = np.array([[17.2, 432.2], [50.5, 420.0], [84.8, 409.4], [28
 
 
 @needs["tusimple"]
+@pytest.mark.slow
 def test_the_wide_lane_of_tusimple_0_is_the_lane_not_the_calibration():
     """0.jpg's lane reads over 4 m (its right line diverges towards an exit). With the same camera height and
     horizon, the lane to its left, from its markers to the ego lane's left boundary at the same rows, reads as a
@@ -104,6 +107,7 @@ def test_the_wide_lane_of_tusimple_0_is_the_lane_not_the_calibration():
 @needs["tusimple"]
 @needs["p1"]
 @pytest.mark.parametrize("folder", [TUSIMPLE, P1], ids=["tusimple", "p1"])
+@pytest.mark.slow
 def test_a_mirrored_still_gives_the_opposite_offset(folder):
     """The offset is the camera's (a dash camera on the car's centreline): a still mirrored left to right shows the
     car as far right of its lane's centre as it was left. (The fit's frame has its origin half a nominal baseline
@@ -131,6 +135,7 @@ def test_h_samples():
 
 
 @needs["tusimple"]
+@pytest.mark.slow
 def test_tusimple_format_on_the_samples(tmp_path):
     out = tmp_path / "pred.json"
     r = runner.invoke(app, ["lanes", str(TUSIMPLE), "--format", "tusimple", "--json", str(out)])
@@ -185,6 +190,7 @@ def test_tusimple_format_needs_images_and_a_json(tmp_path):
 
 
 @needs["video"]
+@pytest.mark.slow
 def test_the_p1_video_end_to_end_on_the_markings(tmp_path):
     js = tmp_path / "video.json"
     r = runner.invoke(app, ["lanes", str(VIDEO), "--json", str(js)])

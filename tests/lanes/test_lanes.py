@@ -162,6 +162,7 @@ def test_slot_holds_the_last_plausible_wheel_speed_and_yaw_rate():
     assert speeds == [20.0, 20.0, 20.0, 20.0, 21.0] and yaw_rates == [0.1, 0.1, 0.1, 0.0, 0.0]
 
 
+@pytest.mark.slow
 def test_tracking_on_the_simulated_highway():
     from percept.drive import TASKS, Agent, SlotContext, Source, TruthFeed
     from percept.sims import SimWorld, WorldConfig

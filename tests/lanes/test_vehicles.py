@@ -1,6 +1,6 @@
 """A vehicle over a marking masks it: its shade found on synthetic ground (a tree's shadow is not a vehicle), then on
 real frames (TuSimple 3.jpg's SUV; Udacity test5's tree shade), and TuSimple 2.jpg with that SUV pasted over its left
-line, where the vehicle's own edges used to pull the boundary 90 px off its markings."""
+line, where the vehicle's own edges, not masked, pull the boundary 90 px off its markings."""
 
 import sys
 from dataclasses import replace

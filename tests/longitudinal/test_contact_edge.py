@@ -1,4 +1,4 @@
-"""The contact search's compiled edge against the numpy it replaced: the same row and step, bit for bit."""
+"""The contact search's compiled edge against numpy's formulas: the same row and step, bit for bit."""
 
 import numpy as np
 

@@ -1,4 +1,4 @@
-"""The finder's compiled group search against the numpy it replaced: the same group, bit for bit, on synthetic
+"""The finder's compiled group search against numpy's formulas: the same group, bit for bit, on synthetic
 standing pixels (blobs at several ranges, scattered strays, blobs of equal area)."""
 
 import cv2
@@ -12,7 +12,7 @@ from percept.sensors import StereoRig
 
 
 def _numpy_nearest_group(finder, u, v, z, pv, area):
-    """``ObstacleFinder._nearest_group`` before the kernels."""
+    """``ObstacleFinder._nearest_group`` in numpy's operations, without the kernels."""
     cfg, cam = finder.cfg, finder.rig.camera
     k = np.floor(np.log(z) / np.log1p(cfg.bin_rel)).astype(int)
     order = np.argsort(k, kind="stable")

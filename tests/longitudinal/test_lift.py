@@ -1,4 +1,4 @@
-"""The compiled passes of the obstacle finder and the disparity refinement against the numpy they replaced: the same
+"""The compiled passes of the obstacle finder and the disparity refinement against numpy's formulas: the same
 results, bit for bit."""
 
 import numpy as np
@@ -173,6 +173,7 @@ print(len(kernels), min(before), refined, [len(k.signatures) for k in kernels] =
 """
 
 
+@pytest.mark.slow
 def test_the_slots_load_their_compiled_passes_when_built_not_in_a_frame():
     """The lanes', longitudinal and odometry slots' compiled passes."""
     import subprocess
@@ -215,11 +216,11 @@ def test_surface_mask_equals_numpys_and_refuses_a_box_without_room_for_its_candi
         box = (int(rng.integers(22, 30)), 0, w - int(rng.integers(1, 5)), h)
         d0 = shift + float(rng.uniform(-1.0, 1.0))
         got, ref = surface_mask(left, right, box, d0), _numpy_surface_mask(left, right, box, d0)
-        assert got.dtype == ref.dtype and np.array_equal(got, ref)
+        assert got.dtype == ref.dtype and np.array_equal(got, ref)  # the same float32 operations: the same mask
         kept += int(got.sum())
     assert kept > 1000
-    # at d0 = 8.5 the candidates run to d = 12, left of a box starting at column 10: the old check (room for
-    # d <= 9) let it through, and forming the costs failed on an empty slice; now there is no mask
+    # at d0 = 8.5 the candidates run to d = 12, left of a box starting at column 10: a check for room for d <= 9
+    # alone would let it through, and forming the costs would fail on an empty slice; there is no mask
     img = rng.uniform(0, 255, (10, 80)).astype(np.float32)
     assert surface_mask(img, img, (10, 0, 60, 10), 8.5) is None
     assert surface_mask(img, img, (12, 0, 60, 10), 8.5) is not None

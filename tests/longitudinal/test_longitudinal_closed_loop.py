@@ -10,6 +10,7 @@ from percept.sensors import EgoPath, Frame, ImuSample, StereoRig
 from percept.sims import WorldConfig
 
 
+@pytest.mark.slow
 def test_vision_longitudinal_follows_and_brakes_for_the_lead_without_collision():
     # lead-brake seed 1: the lead brakes at -6 m/s^2 to a stop; the full sweep (seeds 0-9 x clear, night, rain,
     # noise on highway, lead-brake and cut-in) is in the README

@@ -1,4 +1,4 @@
-"""The odometry's compiled noise estimate and corner selection against the numpy they replaced: the same values."""
+"""The odometry's compiled noise estimate and corner selection against numpy's formulas, made in the same operations: the same values."""
 
 import cv2
 import numpy as np

@@ -28,9 +28,9 @@ def curve(n=200):
 def test_as_matrices_planar_is_a_rotation_about_z():
     T = as_matrices([[1.0, 2.0, math.pi / 2]])
     assert T.shape == (1, 4, 4)
-    np.testing.assert_allclose(T[0], [[0, -1, 0, 1], [1, 0, 0, 2], [0, 0, 1, 0], [0, 0, 0, 1]], atol=1e-15)
+    np.testing.assert_allclose(T[0], [[0, -1, 0, 1], [1, 0, 0, 2], [0, 0, 1, 0], [0, 0, 0, 1]], atol=1e-9)
     kitti_rows = as_matrices(T[:, :3, :])
-    np.testing.assert_array_equal(kitti_rows, T)
+    np.testing.assert_array_equal(kitti_rows, T)  # the rows are copied as they are, the last one appended
 
 
 def test_bad_poses_raise():
@@ -61,8 +61,9 @@ def test_exact_trajectory_has_no_error():
     true = curve()
     d = kitti_drift(true, true)
     assert d["segments"] > 0
-    assert d["drift_pct"] == pytest.approx(0.0, abs=1e-12)
-    assert d["rot_drift_deg_per_100m"] == pytest.approx(0.0, abs=1e-12)
+    # drift is reported to a hundredth of a percent (a hundredth of a degree per 100 m): 1e-9 is rounding alone
+    assert d["drift_pct"] == pytest.approx(0.0, abs=1e-9)
+    assert d["rot_drift_deg_per_100m"] == pytest.approx(0.0, abs=1e-9)
     assert ate_rmse_m(true, true) == 0.0
     assert final_position_error_m(true, true) == 0.0
 
@@ -72,14 +73,14 @@ def test_one_percent_scale_about_the_start():
     est = true.copy()
     est[:, :2] *= 1.01
     d = kitti_drift(est, true)
-    assert d["drift_pct"] == pytest.approx(1.0, rel=1e-9)
-    assert d["rot_drift_deg_per_100m"] == pytest.approx(0.0, abs=1e-12)
+    assert d["drift_pct"] == pytest.approx(1.0, abs=1e-9)
+    assert d["rot_drift_deg_per_100m"] == pytest.approx(0.0, abs=1e-9)
     # lengths 10, 20, ..., 80 m from first frames 0, 10, ..., 100: (11 - k) segments of 10 k m
     assert d["segments"] == sum(11 - k for k in range(1, 9))
     # frame k is 0.01 k m off: ATE = 0.01 sqrt(sum k^2 / 101) = 0.01 sqrt(100 * 201 / 6)
-    assert ate_rmse_m(est, true) == pytest.approx(0.01 * math.sqrt(3350.0), rel=1e-12)
+    assert ate_rmse_m(est, true) == pytest.approx(0.01 * math.sqrt(3350.0), abs=1e-6)  # [m]
     assert final_position_error_m(est, true) == pytest.approx(1.0)
-    assert kitti_drift(est, true, lengths_m=[25.0], step=1)["drift_pct"] == pytest.approx(1.0, rel=1e-9)
+    assert kitti_drift(est, true, lengths_m=[25.0], step=1)["drift_pct"] == pytest.approx(1.0, abs=1e-9)
 
 
 def test_heading_bias_accumulating_along_a_straight_line():
@@ -126,4 +127,5 @@ def test_no_segment_or_no_pose_is_none():
 
 def test_rotation_angle_is_accurate_for_small_angles():
     T = as_matrices([[0.0, 0.0, 1e-7], [0.0, 0.0, -2.5]])
-    np.testing.assert_allclose(rotation_angle_rad(T[:, :3, :3]), [1e-7, 2.5], rtol=1e-9)
+    # arccos(trace) would be ~1e-8 rad (10 %) off at 1e-7 rad: 1e-6 of the angle tells the two apart
+    np.testing.assert_allclose(rotation_angle_rad(T[:, :3, :3]), [1e-7, 2.5], rtol=1e-6)

@@ -28,6 +28,7 @@ def kitti_run():
     return np.stack(poses), seq.poses, steps
 
 
+@pytest.mark.slow
 def test_kitti_final_position_within_3_percent_of_the_path(kitti_run):
     est, true, steps = kitti_run
     length = path_length_m(true)
@@ -38,6 +39,7 @@ def test_kitti_final_position_within_3_percent_of_the_path(kitti_run):
     assert path_length_m(est) == pytest.approx(length, rel=0.03)
 
 
+@pytest.mark.slow
 def test_kitti_steps_are_all_measured_after_the_first(kitti_run):
     _, _, steps = kitti_run
     assert not steps[0].ok and steps[0].reason == "first frame" and np.allclose(steps[0].T_prev_cur, np.eye(4))
@@ -112,6 +114,7 @@ def test_bad_arguments_raise():
 
 
 @pytest.mark.skipif(not KITTI.is_dir(), reason=f"{KITTI} is absent (real data in ../shared/data)")
+@pytest.mark.slow
 def test_hidden_road_keeps_the_last_scale_and_says_so_in_the_covariance():
     seq = load_kitti_folder(KITTI)
     vo = MonoVO(seq.K, 1.65)

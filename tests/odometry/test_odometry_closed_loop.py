@@ -12,6 +12,7 @@ from percept.sensors import Frame, ImuSample, Pose2D, StereoRig
 from percept.sims import WorldConfig
 
 
+@pytest.mark.slow
 def test_vision_odometry_on_the_loop_keeps_within_its_bounds():
     # the first 40 s of `loop` seed 1 (about 900 m, the first bend included); the full runs (seeds 0-4 x clear,
     # night, rain, dropout, 3.5 km each) are in the README
@@ -27,6 +28,7 @@ def test_vision_odometry_on_the_loop_keeps_within_its_bounds():
     assert r["timing_ms"]["odometry"] > 0
 
 
+@pytest.mark.slow
 def test_dropped_frames_widen_the_bounds_and_break_nothing():
     r = run_drive(DriveConfig(WorldConfig("loop", 2, "dropout"), 20.0, {"odometry": "vision"}))
     o = r["odometry"]

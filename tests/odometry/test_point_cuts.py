@@ -1,4 +1,4 @@
-"""The stereo VO's compiled point cuts against the numpy they replaced: the same points, bit for bit at the gate."""
+"""The stereo VO's compiled point cuts against numpy's formulas, made in the same operations: the same points, bit for bit at the gate."""
 
 import numpy as np
 
@@ -21,6 +21,7 @@ def test_within_equals_numpys_cut():
         keep = np.linalg.norm(seen - pixels, axis=1) < 0.7
         idx, kept_points, kept_pixels = within(seen, pixels, points, use, 0.7)
         for got, ref in ((idx, use[keep]), (kept_points, points[keep]), (kept_pixels, pixels[keep])):
+            # the kernel's cut makes numpy's operations in its order: the same points on any CPU
             assert got.dtype == ref.dtype and np.array_equal(got, ref)
 
 

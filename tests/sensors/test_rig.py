@@ -33,10 +33,11 @@ def test_the_rig_computes_its_frames_once_for_its_own_pitch_and_shares_them_read
         T = rig.cam_from_vehicle(side)
         assert T is rig.cam_from_vehicle(side.value)
         # p_c = R (p_v - c), with R the pitched axes swap
-        np.testing.assert_array_equal(T.R, rig.rotation_cam_from_vehicle())
-        np.testing.assert_allclose(T.apply(rig.camera_position(side)), 0.0, atol=1e-12)
+        np.testing.assert_array_equal(T.R, rig.rotation_cam_from_vehicle())  # the same function: the same bits
+        np.testing.assert_allclose(T.apply(rig.camera_position(side)), 0.0, atol=1e-6)  # [m]
+        # H H^-1 = I up to LAPACK's rounding on a matrix of ~1e3 px entries, whichever kernel the CPU takes
         np.testing.assert_allclose(rig.ground_homography(side) @ np.linalg.inv(rig.ground_homography(side)),
-                                   np.eye(3), atol=1e-12)
+                                   np.eye(3), atol=1e-9)
         for a in (T.R, T.t, rig.ground_homography(side)):
             with pytest.raises(ValueError, match="read-only"):
                 a[0] = 0.0
@@ -69,7 +70,7 @@ def test_pose_round_trip():
     p = np.array([[12.0, 3.0]])
     v = pose.to_vehicle_xy(p)
     w = pose.world_from_vehicle().apply(np.array([[v[0, 0], v[0, 1], 0.0]]))
-    np.testing.assert_allclose(w[0, :2], p[0], atol=1e-12)
+    np.testing.assert_allclose(w[0, :2], p[0], atol=1e-6)  # [m]
 
 
 def test_rig_save_load_round_trip(tmp_path):

@@ -1,8 +1,8 @@
 """The conditions' in-place and OpenCV arithmetic gives, bit for bit, what numpy's plain broadcast formulas give.
 
-The reference below is the conditions' first implementation (one numpy expression per step); the fast one keeps
-scratch buffers between frames and uses OpenCV's per-channel arithmetic. Frames rendered before the change must
-stay the same, and buffers reused from frame to frame must carry nothing over.
+The reference below writes each step as one numpy expression; the fast one keeps scratch buffers between frames
+and uses OpenCV's per-channel arithmetic in the same operations, so the frames are the same bytes on any CPU, and
+buffers reused from frame to frame must carry nothing over.
 """
 
 import cv2

@@ -1,8 +1,8 @@
-"""The road paint's compiled selection gives, bit for bit, what its first implementation (numpy) gave.
+"""The road paint's compiled selection gives, bit for bit, what the same operations in numpy give.
 
-The reference below is that implementation: the visible road surface outlined from the road's samples, and the
-lane paint pieces filtered for distance (dashes stretched into their period, thin lines widened, the alpha
-level). Frames rendered before the change must stay the same, so the polygons handed to OpenCV must too.
+The reference below is the numpy form: the visible road surface outlined from the road's samples, and the lane
+paint pieces filtered for distance (dashes stretched into their period, thin lines widened, the alpha level). The
+polygons handed to OpenCV must be the same, so that the frames are.
 """
 
 import math
@@ -83,6 +83,7 @@ def test_the_compiled_road_paint_is_the_numpy_one(network):
         c, s = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
         got = _surface_samples(index.left, index.right, index.strip, index.lo, index.hi, index.centre, index.radius,
                                pose.x_m, pose.y_m, c, s, near, SURFACE_FAR_M)
+        # the compiled culls and their numpy references make the same float64 tests: the same samples to the bit
         for a, b in zip(got, reference_surface(index, pose, near)):
             assert np.array_equal(a, b)
         got = _marking_pieces(index.quads, index.quad_centre, index.dashed, index.quad_color, pose.x_m, pose.y_m, c,

@@ -1,13 +1,7 @@
 """The renderer's compiled kernels (numba). The rasteriser's two paths (large patches one by one, small ones as
 fragments) draw the same picture: the same scene forced through one path and then the other gives the same image,
-ids, lamp map and silhouettes; a patch cut by the near plane is drawn where its rays land. A renderer, once built,
-compiles nothing in a world's frames; Ctrl-C during a kernel is a KeyboardInterrupt; the pedestrians' figures
-built by compiled code are the interpreted ones to the byte, and so are the ground's colour lookup (OpenCV's) and
-the depth read off the z-buffer (numpy's)."""
-
-import os
-import subprocess
-import sys
+ids, lamp map and silhouettes; a patch cut by the near plane is drawn where its rays land. The ground's colour
+lookup is OpenCV's to the byte, and the depth read off the z-buffer is numpy's."""
 
 import numpy as np
 import pytest
@@ -49,6 +43,7 @@ def test_large_and_small_patch_paths_draw_the_same_picture(monkeypatch):
     fragments_ = draw(monkeypatch, np.inf)  # every patch small: fragments, all at once
     assert (one_by_one.ids > 0).sum() > 3000, "the scene should cover a good part of the image"
     assert len(np.unique(one_by_one.ids)) >= 10
+    # both paths test coverage and depth with the same float32 operations: the same picture to the bit on any CPU
     np.testing.assert_array_equal(one_by_one.ids, fragments_.ids)
     np.testing.assert_array_equal(one_by_one.image, fragments_.image)
     np.testing.assert_array_equal(one_by_one.emission, fragments_.emission)
@@ -106,101 +101,6 @@ def test_a_floor_cut_by_the_near_plane_is_drawn_exactly_where_its_rays_land():
     np.testing.assert_allclose(target.depth[expected & (target.ids == 7)], z[expected & (target.ids == 7)], rtol=1e-5)
 
 
-WARM_CHECK = """
-from percept.compiled import dispatchers
-from percept.sims import SimWorld, WorldConfig, condition_passes, conditions, normals
-from percept.sims.render import cull, ground, paint, pedestrian, pixels, small_patches, spans
-modules = (pixels, small_patches, cull, spans, pedestrian, ground, paint, condition_passes, normals)
-kernels = dispatchers(*modules)
-# the world's renderer and its night effects warm their kernels up when they are built, and so do the other
-# conditions' effects
-world = SimWorld(WorldConfig("crossing", seed=1, condition="night", autopilot=True))
-others = [conditions.ConditionEffects(world.cfg.rig, c) for c in ("rain", "glare", "noise")]
-before = [len(k.signatures) for k in kernels]
-for _ in range(6):
-    world.step()
-    frame, _ = world.observe()
-    for fx in others:
-        fx.apply(frame.left, 1, world.frame_index, 0)
-print(len(kernels), min(before), [len(k.signatures) for k in kernels] == before)
-"""
-
-
-def test_after_the_warm_up_rendering_a_world_compiles_nothing():
-    # in a fresh process: this one has compiled kernels for the tests above already
-    out = subprocess.run([sys.executable, "-c", WARM_CHECK], capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr[-2000:]
-    count, least, unchanged = out.stdout.split()
-    # every kernel compiled (or loaded) by the warm-up; a frame compiling one for new argument types would pay
-    # seconds inside a timed step
-    assert int(count) >= 18 and int(least) >= 1 and unchanged == "True"
-
-
-FIGURES = """
-import hashlib, math
-import numpy as np
-from percept.sensors import Pose2D
-from percept.sims.render import ObjectKind, ObjectState
-from percept.sims.render.pedestrian import pedestrian_packed
-rng = np.random.default_rng(11)
-m = hashlib.sha256()
-for i in range(300):
-    x, y = rng.uniform(-40, 40, 2)
-    obj = ObjectState(i + 1, ObjectKind.PEDESTRIAN, Pose2D(x, y, rng.uniform(-math.pi, math.pi)), 0.5, 0.5,
-                      rng.uniform(1.0, 2.1), style=int(rng.integers(0, 2**40)), speed_mps=float(rng.choice([0, 1.4])),
-                      gait_phase=rng.uniform(0, 12))
-    m.update(pedestrian_packed(obj, (rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(0.5, 2.0))).tobytes())
-# seen from straight above its base: the horizontal direction to the viewer is degenerate
-m.update(pedestrian_packed(ObjectState(1, ObjectKind.PEDESTRIAN, Pose2D(1.0, 2.0, 0.3), 0.5, 0.5, 1.7),
-                           (1.0, 2.0, 1.0)).tobytes())
-print(m.hexdigest())
-"""
-
-
-def test_the_compiled_figures_are_the_interpreted_ones():
-    # the pedestrians' figures are built by compiled code; with numba's compiler off the same functions run as
-    # Python, with Python's own arithmetic, math.hypot, min and max: the patches must be the same bytes
-    digests = []
-    for jit_off in ("0", "1"):
-        env = {**os.environ, "NUMBA_DISABLE_JIT": jit_off}
-        out = subprocess.run([sys.executable, "-c", FIGURES], capture_output=True, text=True, timeout=300, env=env)
-        assert out.returncode == 0, out.stderr[-2000:]
-        digests.append(out.stdout.strip())
-    assert len(digests[0]) == 64 and digests[0] == digests[1]
-
-
-CTRL_C = """
-import os, signal, threading, time
-import numpy as np
-# Python's own handler, also when the test runs where SIGINT is ignored (a background job: nohup cmd &)
-signal.signal(signal.SIGINT, signal.default_int_handler)
-from percept.sims.render.cull import inverse_rows
-n = 5000
-o = np.random.default_rng(0).normal(size=(n, 3))
-e1, e2, ok = o.copy(), o + 1, np.ones(n, bool)
-inverse_rows(o, e1, e2, ok, 100.0, 100.0, 80.0, 60.0)
-seen = []
-for trial in range(12):
-    threading.Timer(0.01 + 0.003 * trial, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
-    t0 = time.time()
-    try:
-        while time.time() - t0 < 5:
-            inverse_rows(o, e1, e2, ok, 100.0, 100.0, 80.0, 60.0)
-        seen.append("none")
-    except BaseException as e:
-        seen.append(type(e).__name__)
-print(" ".join(seen))
-"""
-
-
-def test_ctrl_c_during_a_kernel_is_a_keyboard_interrupt():
-    # numba boxes a kernel's arrays without checking for a pending signal; unwrapped, most of these would be
-    # SystemError, which the commands' Ctrl-C handling (keep what is finished, exit 130) does not recognise
-    out = subprocess.run([sys.executable, "-c", CTRL_C], capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stdout.split() == ["KeyboardInterrupt"] * 12
-
-
 def test_a_silhouette_is_summarised_from_its_distinct_pixels():
     """Box, distinct pixel count and pixels showing the object, from pixel lists that repeat pixels (two patches
     of one object overlap) and are partly hidden (the id map shows another object there)."""
@@ -232,7 +132,7 @@ def test_the_ground_colour_lookup_is_opencv_s_or_and_colour_map_to_the_byte():
     img = np.full((h, w, 3), 7, np.uint8)
     _colour_map(img, grain, mask, cmap, r0)
     expected = cv2.applyColorMap(cv2.bitwise_or(grain, mask[r0:]), cmap)
-    np.testing.assert_array_equal(img[r0:], expected)
+    np.testing.assert_array_equal(img[r0:], expected)  # integer operations: the same bytes on any CPU
     assert (img[:r0] == 7).all()
 
 
@@ -252,10 +152,11 @@ def test_the_depth_from_the_z_buffer_is_numpy_s_divide_to_the_bit():
     expected = background.copy()
     np.divide(np.float32(1.0), inv, out=expected, where=inv != base)
     assert out.dtype == np.float32
-    np.testing.assert_array_equal(out.view(np.int32), expected.view(np.int32))
+    np.testing.assert_array_equal(out.view(np.int32), expected.view(np.int32))  # IEEE division: one quotient
     assert np.isinf(out[:5][~won[:5]]).all()
 
 
+@pytest.mark.slow
 def test_the_columns_kept_for_a_patch_crossing_the_near_plane_hold_every_pixel_its_exact_test_passes():
     """``_near_columns`` skips only columns where the exact float32 test of a patch crossing the near plane fails:
     checked against the test itself on 20 000 random rows, steep, shallow and flat edges among them."""

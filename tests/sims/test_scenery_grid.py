@@ -35,7 +35,7 @@ def test_the_renderer_keeps_the_same_scenery_as_testing_all_of_it(rig, road):
     assert len(r._scenery_centre) > 500
 
     def every(pose: Pose2D) -> np.ndarray:
-        # the view-cone test over all the scenery, as it was before the grid
+        # the view-cone test over all the scenery, without the grid
         d = pose.to_vehicle_xy(r._scenery_centre)
         rad, x = r._scenery_radius, d[:, 0] - rig.mount_x_m
         slope = math.tan(rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
@@ -47,6 +47,6 @@ def test_the_renderer_keeps_the_same_scenery_as_testing_all_of_it(rig, road):
     for x, y, yaw in zip(rng.uniform(-50, 450, 40), rng.uniform(-30, 30, 40), rng.uniform(-math.pi, math.pi, 40)):
         pose = Pose2D(float(x), float(y), float(yaw))
         got = r._scenery_in_view(Scene(pose, ()))
-        assert np.array_equal(got, every(pose))
+        assert np.array_equal(got, every(pose))  # the same float64 test on the same pieces: the same indices
         kept += len(got)
     assert kept > 0
