@@ -16,12 +16,3 @@ def snapshot():
 def temporaries():
     """``temporaries(folder)``: the atomic writers' temporaries left under ``folder``."""
     return lambda folder: [p for p in Path(folder).rglob(".*") if ".tmp" in p.name]
-
-
-@pytest.fixture
-def one_line_error():
-    """``one_line_error(result, message)``: a CliRunner result is exit code 2 with one line that says ``message``."""
-    def check(r, message: str) -> None:
-        assert r.exit_code == 2, r.output
-        assert message in r.output and len(r.output.strip().splitlines()) == 1, r.output
-    return check

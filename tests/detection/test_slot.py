@@ -17,7 +17,7 @@ from percept.sims import WorldConfig, check_condition
 def crossing_run():
     # seed 3: a person crosses in front of the ego within the first 32 s
     return run_drive(DriveConfig(WorldConfig("crossing", seed=3), duration_s=32.0,
-                                 sources={"pedestrians": "vision"}))
+                                 sources={"pedestrians": "vision"}, default="privileged"))
 
 
 @pytest.mark.slow
@@ -92,7 +92,7 @@ def test_in_rain_a_far_person_seen_in_lone_windows_is_stopped_for():
     # often gives one window, which grouping drops: without lone windows verified by stereo the person is first
     # detected at 10 m and hit (at 30.1 s); by 33 s the car has come to a stop before them
     r = run_drive(DriveConfig(WorldConfig("crossing", seed=10, condition=check_condition("rain")), duration_s=33.0,
-                              sources={"pedestrians": "vision"}))
+                              sources={"pedestrians": "vision"}, default="privileged"))
     p = r["pedestrians"]
     assert r["pedestrian_collisions"] == 0 and r["collisions"] == 0
     assert len(p["stops"]) == 3 and all(p["stops"]), p

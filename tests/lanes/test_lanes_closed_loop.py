@@ -12,7 +12,7 @@ def test_vision_lateral_keeps_the_lane_through_curves_and_spirals():
     # 30 s of `curves` seed 2: the lead-in, two arcs and their clothoids; scenery off (it only costs time here).
     # The full sweep (seeds 0-9 x clear, night, rain) is in the README.
     r = run_drive(DriveConfig(WorldConfig("curves", 2, scenery=False), duration_s=30.0,
-                              sources={"lanes": "vision"}))
+                              sources={"lanes": "vision"}, default="privileged"))
     assert r["lane_departures"] == 0 and r["collisions"] == 0
     lane = r["lanes"]
     assert lane["centering_max_m"] < 0.3

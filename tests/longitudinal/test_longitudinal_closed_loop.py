@@ -14,7 +14,8 @@ from percept.sims import WorldConfig
 def test_vision_longitudinal_follows_and_brakes_for_the_lead_without_collision():
     # lead-brake seed 1: the lead brakes at -6 m/s^2 to a stop; the full sweep (seeds 0-9 x clear, night, rain,
     # noise on highway, lead-brake and cut-in) is in the README
-    r = run_drive(DriveConfig(WorldConfig("lead-brake", 1, scenery=False), sources={"longitudinal": "vision"}))
+    r = run_drive(DriveConfig(WorldConfig("lead-brake", 1, scenery=False), sources={"longitudinal": "vision"},
+                              default="privileged"))
     assert r["collisions"] == 0 and r["lane_departures"] == 0
     lon = r["longitudinal"]
     assert lon["range_abs_rel_err"] < 0.03

@@ -16,7 +16,7 @@ from percept.sims import WorldConfig
 def test_vision_odometry_on_the_loop_keeps_within_its_bounds():
     # the first 40 s of `loop` seed 1 (about 900 m, the first bend included); the full runs (seeds 0-4 x clear,
     # night, rain, dropout, 3.5 km each) are in the README
-    r = run_drive(DriveConfig(WorldConfig("loop", 1), 40.0, {"odometry": "vision"}))
+    r = run_drive(DriveConfig(WorldConfig("loop", 1), 40.0, {"odometry": "vision"}, default="privileged"))
     o = r["odometry"]
     assert r["collisions"] == 0 and r["lane_departures"] == 0
     assert o["drift_pct_vo"] < 0.8 and o["rot_drift_deg_per_100m_vo"] < 0.3
@@ -30,7 +30,7 @@ def test_vision_odometry_on_the_loop_keeps_within_its_bounds():
 
 @pytest.mark.slow
 def test_dropped_frames_widen_the_bounds_and_break_nothing():
-    r = run_drive(DriveConfig(WorldConfig("loop", 2, "dropout"), 20.0, {"odometry": "vision"}))
+    r = run_drive(DriveConfig(WorldConfig("loop", 2, "dropout"), 20.0, {"odometry": "vision"}, default="privileged"))
     o = r["odometry"]
     assert o["vo_failed_frames"] > 10  # 10 % of 300 frames are dropped
     traj = o.pop("trajectory")
