@@ -224,12 +224,12 @@ def soak(minutes: float, scenario: str = "highway", progress: Callable[[], None]
     ``growth_mb``: the last sample less the first; ``mb_per_minute``: the least-squares slope of the samples taken
     while it drives from the first minute on (the first minute holds the slots' and renderer's first allocations),
     None for a drive under two minutes."""
-    from percept.sims.env import SIMULATION_HZ
+    from percept.sensors.frame import FRAME_RATE_HZ
 
     samples = []
 
     def sample(index: int) -> None:
-        if index % (60 * SIMULATION_HZ) == 0:
+        if index % (60 * FRAME_RATE_HZ) == 0:
             samples.append(_rss_mb())
 
     with tempfile.TemporaryDirectory() as tmp:

@@ -110,10 +110,10 @@ def _scenarios(names: list[str] | None) -> list[str]:
 def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: float) -> dict:
     """The whole stack per scenario, the render per condition and the soak, printed and as the JSON's groups."""
     from percept.bench.stack import CONDITIONS, PAIR_FRAMES, bench_stack, render_per_condition, soak
-    from percept.sims.env import SIMULATION_HZ
+    from percept.sensors.frame import FRAME_RATE_HZ
 
-    loop_frames = int(round(seconds * SIMULATION_HZ))
-    total = 2 * repeats * loop_frames * len(scenarios) + int(round(soak_minutes * 60 * SIMULATION_HZ))
+    loop_frames = int(round(seconds * FRAME_RATE_HZ))
+    total = 2 * repeats * loop_frames * len(scenarios) + int(round(soak_minutes * 60 * FRAME_RATE_HZ))
     with progress_bar() as bar:
         task = bar.add_task("the whole stack", total=total)
         tick = lambda: bar.advance(task)  # noqa: E731

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from percept.sensors.conflict import PERSON_STOP_MARGIN_M
+from percept.sensors.frame import FRAME_RATE_HZ
 from percept.sensors.vehicle import MAX_BRAKE_MPS2
 
 from .base import Controller, limiting
@@ -49,7 +50,7 @@ class EmergencyBraking(Controller):
         self.travelled_m = 0.0  # odometer: distance driven since the reset [m]
         self.stop_at_m: float | None = None  # odometer reading to stop at while yielding to a pedestrian
 
-    def update(self, target: Target | None, speed_mps: float, follow_mps2: float, dt: float = 1.0 / 15,
+    def update(self, target: Target | None, speed_mps: float, follow_mps2: float, dt: float = 1.0 / FRAME_RATE_HZ,
                withdrawn: bool = False) -> tuple[float, EmergencyBrakingDebug]:
         """The command [m/s²] and its debug record. target: the nearest target (None: nothing ahead); speed_mps:
         the ego's speed; follow_mps2: the following law's command; dt: the frame period [s]; withdrawn: the

@@ -8,6 +8,7 @@ from enum import Enum
 import numpy as np
 
 from percept.sensors import StereoRig
+from percept.sensors.frame import FRAME_RATE_HZ
 
 from .evidence import EvidenceConfig, MarkingExtractor
 from .fit import FitConfig, fit_lane
@@ -53,7 +54,7 @@ class LaneDetector:
         self.tracker.reset()
 
     def process(self, image: np.ndarray | None, speed_mps: float = 0.0, yaw_rate_rps: float = 0.0,
-                dt: float = 1.0 / 15, pace: Pace = Pace.DRIVING) -> tuple[LaneEstimate, LaneDebug]:
+                dt: float = 1.0 / FRAME_RATE_HZ, pace: Pace = Pace.DRIVING) -> tuple[LaneEstimate, LaneDebug]:
         """Track the lane through one frame; ``image`` None (dropped frame) only predicts.
 
         ``pace`` CRAWLING or STANDING: the lane moves relative to the car by the car's own motion alone (none when

@@ -8,6 +8,9 @@ from functools import cached_property
 import cv2
 import numpy as np
 
+FRAME_RATE_HZ = 15
+"""Frames a second the cameras deliver, and the simulator's steps a second (highway-env's own frequency) [Hz]."""
+
 
 def to_gray(image: np.ndarray) -> np.ndarray:
     """(H, W, 3) BGR or (H, W) grey uint8 -> (H, W) grey uint8 (OpenCV's BGR weights; other grey types clipped)."""

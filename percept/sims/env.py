@@ -13,6 +13,7 @@ from highway_env.envs.common.abstract import AbstractEnv
 from highway_env.envs.common.observation import ObservationType
 from highway_env.vehicle.behavior import IDMVehicle
 
+from percept.sensors.frame import FRAME_RATE_HZ
 from percept.sensors.vehicle import ACCEL_RANGE_MPS2, STEER_RANGE_RAD
 
 from .actors import Pedestrian, ScriptedVehicle
@@ -37,10 +38,6 @@ class AutopilotVehicle(IDMVehicle):
         self.speed = max(self.speed, 0.0)
 
 
-SIMULATION_HZ = 15
-"""Simulation steps (and camera frames) per second."""
-
-
 class PerceptEnv(AbstractEnv):
     """Config keys beyond highway-env's: ``scenario`` (a Scenario), ``scenario_seed`` (int), ``autopilot`` (bool)."""
 
@@ -51,8 +48,8 @@ class PerceptEnv(AbstractEnv):
             "observation": {"type": "Kinematics"},  # replaced by NoObservation in define_spaces
             "action": {"type": "ContinuousAction", "acceleration_range": ACCEL_RANGE_MPS2,
                        "steering_range": STEER_RANGE_RAD, "clip": True},
-            "simulation_frequency": SIMULATION_HZ,
-            "policy_frequency": SIMULATION_HZ,
+            "simulation_frequency": FRAME_RATE_HZ,
+            "policy_frequency": FRAME_RATE_HZ,
             "screen_width": 640,
             "screen_height": 480,
             "scenario": None,

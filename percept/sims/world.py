@@ -93,7 +93,7 @@ class SimWorld:
         return self.env.cruise_speed_mps
 
     def step(self, accel_mps2: float = 0.0, steering_rad: float = 0.0) -> None:
-        """Advance one frame (1/15 s) with a physical command, clipped to the allowed ranges.
+        """Advance one frame (1 / FRAME_RATE_HZ s) with a physical command, clipped to the allowed ranges.
 
         steering_rad is ISO 8855 (positive turns left); highway-env's positive steering turns towards its +y,
         which is to the right, so it is negated here.

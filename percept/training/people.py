@@ -157,11 +157,11 @@ def frames_to_sample(plan: TrainPlan) -> int:
     """How many frames the two passes sample in all (for a progress bar): the plan's scenario twice, then the
     traffic scenarios once."""
     from percept.sims import SCENARIOS
-    from percept.sims.env import SIMULATION_HZ
+    from percept.sensors.frame import FRAME_RATE_HZ
 
     def frames(scenario: str) -> int:
         duration = plan.duration_s if plan.duration_s is not None else SCENARIOS[scenario].duration_s
-        return len(range(0, max(int(round(duration * SIMULATION_HZ)), 1), plan.every))
+        return len(range(0, max(int(round(duration * FRAME_RATE_HZ)), 1), plan.every))
 
     return (2 * len(plan.seeds) * frames(plan.scenario)
             + len(plan.negative_seeds) * sum(frames(s) for s in plan.negative_scenarios))
