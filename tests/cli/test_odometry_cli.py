@@ -31,6 +31,7 @@ def kitti(tmp_path_factory):
     return r, out
 
 
+@pytest.mark.slow
 def test_kitti_mono_json_is_scored_within_3_percent(kitti):
     r, out = kitti
     assert r.exit_code == 0, r.output
@@ -42,6 +43,7 @@ def test_kitti_mono_json_is_scored_within_3_percent(kitti):
     assert "mono odometry on 51 frames" in r.output and "final error" in r.output
 
 
+@pytest.mark.slow
 def test_kitti_tum_output_parses_back_and_starts_at_the_true_first_pose(kitti):
     _, out = kitti
     rows = [line.split() for line in (out / "poses.tum").read_text().splitlines() if not line.startswith("#")]
@@ -53,6 +55,7 @@ def test_kitti_tum_output_parses_back_and_starts_at_the_true_first_pose(kitti):
     assert np.linalg.norm(poses[-1, :3, 3] - true[-1, :3, 3]) < 0.03 * 59.86
 
 
+@pytest.mark.slow
 def test_kitti_plot_is_written(kitti):
     _, out = kitti
     img = cv2.imread(str(out / "plots" / "trajectory.png"))

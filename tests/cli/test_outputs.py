@@ -22,14 +22,6 @@ from percept.sensors.chessboard import CameraCalibration
 runner = CliRunner()
 
 
-def one_error_line(result, message: str, code: int = 2) -> None:
-    assert result.exit_code == code, result.output
-    assert "Traceback" not in result.output
-    assert result.exception is None or isinstance(result.exception, SystemExit)
-    assert len([ln for ln in result.output.splitlines() if "error:" in ln]) == 1, result.output
-    assert message in result.output, result.output
-
-
 @pytest.fixture
 def disk_full(monkeypatch):
     """``disk_full(after=N, when=pred)``: the disk takes N more bytes (of files whose target path satisfies
@@ -135,35 +127,35 @@ def grey_image(tmp_path):
     return path
 
 
-def test_lanes_json_on_a_full_disk_keeps_the_old_json(tmp_path, grey_image, disk_full, snapshot):
+def test_lanes_json_on_a_full_disk_keeps_the_old_json(tmp_path, grey_image, disk_full, snapshot, one_line_error):
     js = tmp_path / "out" / "lanes.json"
     assert runner.invoke(app, ["lanes", str(grey_image), "--json", str(js)]).exit_code == 0
     before = snapshot(tmp_path / "out")
     disk_full(after=64)
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--json", str(js)]), "No space left on device")
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--json", str(js)]), "No space left on device")
     assert snapshot(tmp_path / "out") == before
 
 
-def test_lanes_overlay_on_a_full_disk_keeps_the_old_overlay(tmp_path, grey_image, disk_full, snapshot):
+def test_lanes_overlay_on_a_full_disk_keeps_the_old_overlay(tmp_path, grey_image, disk_full, snapshot, one_line_error):
     out = tmp_path / "ov"
     assert runner.invoke(app, ["lanes", str(grey_image), "--out", str(out)]).exit_code == 0
     before = snapshot(out)
     assert list(before) == [Path("grey.lanes.png")]
     disk_full(after=1000)
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--out", str(out)]), "cannot write")
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--out", str(out)]), "cannot write")
     assert snapshot(out) == before
 
 
-def test_lanes_bad_input_does_not_replace_a_good_json(tmp_path, grey_image):
+def test_lanes_bad_input_does_not_replace_a_good_json(tmp_path, grey_image, one_line_error):
     js = tmp_path / "lanes.json"
     assert runner.invoke(app, ["lanes", str(grey_image), "--json", str(js)]).exit_code == 0
     good = js.read_bytes()
     (tmp_path / "broken.jpg").write_text("not a jpeg")
-    one_error_line(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg"), "--json", str(js)]), "cannot read")
+    one_line_error(runner.invoke(app, ["lanes", str(tmp_path / "broken.jpg"), "--json", str(js)]), "cannot read")
     empty = tmp_path / "junk"
     empty.mkdir()
     (empty / "a.png").write_text("junk")
-    one_error_line(runner.invoke(app, ["lanes", str(empty), "--json", str(js)]), "could be read")
+    one_line_error(runner.invoke(app, ["lanes", str(empty), "--json", str(js)]), "could be read")
     assert js.read_bytes() == good
 
 
@@ -173,35 +165,35 @@ def test_lanes_bad_input_does_not_replace_a_good_json(tmp_path, grey_image):
     (["--mount-height", "-1"], "--mount-height must be a finite number between 0.2 and 10"),
     (["--max-frames", "0"], "--max-frames must be a finite number"),
 ])
-def test_lanes_bad_numbers_are_one_line(grey_image, args, message):
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), *args]), message)
+def test_lanes_bad_numbers_are_one_line(grey_image, args, message, one_line_error):
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), *args]), message)
 
 
-def test_outputs_are_checked_before_the_work(tmp_path, grey_image):
+def test_outputs_are_checked_before_the_work(tmp_path, grey_image, one_line_error):
     blocker = tmp_path / "afile"
     blocker.write_text("x")
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--json", str(grey_image)]), "also an input")
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--json", str(blocker / "r.json")]),
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--json", str(grey_image)]), "also an input")
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--json", str(blocker / "r.json")]),
                    "is a file, not a folder")
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--out", str(blocker)]), "is a file; give a folder")
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--out", str(blocker / "sub")]),
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--out", str(blocker)]), "is a file; give a folder")
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--out", str(blocker / "sub")]),
                    "is a file, not a folder")
     assert blocker.read_text() == "x" and grey_image.stat().st_size > 0
 
 
-def test_a_parent_that_is_a_file_is_named_as_given(tmp_path, grey_image, monkeypatch):
+def test_a_parent_that_is_a_file_is_named_as_given(tmp_path, grey_image, monkeypatch, one_line_error):
     monkeypatch.chdir(tmp_path)
     Path("afile").write_text("x")
-    one_error_line(runner.invoke(app, ["lanes", str(grey_image), "--json", "afile/deep/r.json"]),
+    one_line_error(runner.invoke(app, ["lanes", str(grey_image), "--json", "afile/deep/r.json"]),
                    "cannot write afile/deep/r.json: afile is a file, not a folder")
 
 
-def test_a_failed_command_leaves_its_error_as_the_last_line(tmp_path):
+def test_a_failed_command_leaves_its_error_as_the_last_line(tmp_path, one_line_error):
     """The progress bar was printed after the error (its final state); it now disappears when the command fails."""
     jpg = cv2.imencode(".jpg", np.full((120, 160, 3), 90, np.uint8))[1].tobytes()
     (tmp_path / "half.jpg").write_bytes(jpg[: len(jpg) // 2])
     r = runner.invoke(app, ["lanes", str(tmp_path / "half.jpg")])
-    one_error_line(r, "truncated")
+    one_line_error(r, "truncated")
     assert r.output.splitlines() == [ln for ln in r.output.splitlines() if ln.startswith("error:")], r.output
 
 
@@ -210,24 +202,24 @@ def test_a_failed_command_leaves_its_error_as_the_last_line(tmp_path):
     (["--square", "0"], "--square must be a finite number"),
     (["--pattern", "2x2"], "at least 3x3"),
 ])
-def test_calibrate_bad_numbers_are_one_line(tmp_path, grey_image, args, message):
-    one_error_line(runner.invoke(app, ["calibrate", str(grey_image.parent), *args]), message)
+def test_calibrate_bad_numbers_are_one_line(tmp_path, grey_image, args, message, one_line_error):
+    one_line_error(runner.invoke(app, ["calibrate", str(grey_image.parent), *args]), message)
 
 
-def test_calibrate_refuses_to_overwrite_a_photo(grey_image):
+def test_calibrate_refuses_to_overwrite_a_photo(grey_image, one_line_error):
     before = grey_image.read_bytes()
-    one_error_line(runner.invoke(app, ["calibrate", str(grey_image.parent), "--out", str(grey_image)]),
+    one_line_error(runner.invoke(app, ["calibrate", str(grey_image.parent), "--out", str(grey_image)]),
                    "also an input")
-    one_error_line(runner.invoke(app, ["calibrate", str(grey_image.parent), "--json", str(grey_image)]),
+    one_line_error(runner.invoke(app, ["calibrate", str(grey_image.parent), "--json", str(grey_image)]),
                    "also an input")
     assert grey_image.read_bytes() == before
 
 
-def test_render_on_a_full_disk_keeps_whole_frames_only(tmp_path, disk_full, temporaries):
+def test_render_on_a_full_disk_keeps_whole_frames_only(tmp_path, disk_full, temporaries, one_line_error):
     out = tmp_path / "r"
     disk_full(after=5000, when=lambda path: "000002_" in path)
     r = runner.invoke(app, ["render", "--frames", "4", "--out", str(out), "--no-scenery"])
-    one_error_line(r, "No space left on device")
+    one_line_error(r, "No space left on device")
     assert "2 complete frames kept" in r.output
     names = sorted(p.name for p in out.iterdir())
     assert names == ["000000_depth.npy", "000000_gt.json", "000000_left.png", "000000_right.png",
@@ -235,26 +227,27 @@ def test_render_on_a_full_disk_keeps_whole_frames_only(tmp_path, disk_full, temp
     assert temporaries(out) == []
 
 
-def test_render_refuses_a_used_folder_unless_forced(tmp_path, snapshot):
+def test_render_refuses_a_used_folder_unless_forced(tmp_path, snapshot, one_line_error):
     out = tmp_path / "r"
     assert runner.invoke(app, ["render", "--frames", "2", "--out", str(out), "--no-scenery"]).exit_code == 0
     before = snapshot(out)
-    one_error_line(runner.invoke(app, ["render", "--frames", "1", "--out", str(out)]), "already holds a render")
+    one_line_error(runner.invoke(app, ["render", "--frames", "1", "--out", str(out)]), "already holds a render")
     assert snapshot(out) == before
     r = runner.invoke(app, ["render", "--frames", "1", "--out", str(out), "--no-scenery", "--force"])
     assert r.exit_code == 0, r.output
     assert sorted(p.name for p in out.iterdir()) == ["000000_depth.npy", "000000_gt.json", "000000_left.png",
                                                     "000000_right.png", "camera.json"]
     (out / "notes.txt").write_text("mine")
-    one_error_line(runner.invoke(app, ["render", "--frames", "1", "--out", str(out), "--force"]),
+    one_line_error(runner.invoke(app, ["render", "--frames", "1", "--out", str(out), "--force"]),
                    "did not write (e.g. notes.txt)")
     assert (out / "notes.txt").read_text() == "mine" and (out / "000000_gt.json").exists()
 
 
-def test_eval_on_a_full_disk_keeps_the_finished_runs(tmp_path, disk_full, snapshot):
+@pytest.mark.slow
+def test_eval_on_a_full_disk_keeps_the_finished_runs(tmp_path, disk_full, snapshot, one_line_error):
     args = ["eval", "--scenario", "lead-brake", "--duration", "1", "--out", str(tmp_path)]
     assert runner.invoke(app, [*args, "--seeds", "0"]).exit_code == 0
     before = snapshot(tmp_path)
     disk_full(after=100)
-    one_error_line(runner.invoke(app, [*args, "--seeds", "0-1"]), "No space left on device")
+    one_line_error(runner.invoke(app, [*args, "--seeds", "0-1"]), "No space left on device")
     assert snapshot(tmp_path) == before

@@ -13,6 +13,7 @@ def drive(scenario, seed, duration=None, **kw):
 
 
 @pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.slow
 def test_highway_follows_at_the_set_time_gap(seed):
     r = drive("highway", seed, duration=40.0)
     assert r["collisions"] == 0 and r["lane_departures"] == 0
@@ -39,6 +40,7 @@ def test_crossing_stops_for_every_crossing_pedestrian_and_no_other(seed):
     assert r["pedestrians"]["false_stops"] == 0
 
 
+@pytest.mark.slow
 def test_curves_centering_with_privileged_lateral():
     # the clothoid transitions leave no curvature step to overshoot (0.109 m worst over seeds 0-9)
     r = drive("curves", 0, duration=30.0)

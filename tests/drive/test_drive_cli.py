@@ -18,6 +18,7 @@ def rerun_bin() -> str:
     return rerun_executable()
 
 
+@pytest.mark.slow
 def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
     rrd, js = tmp_path / "run.rrd", tmp_path / "run.json"
     r = runner.invoke(app, ["drive", "--duration", "1", "--record", str(rrd), "--json", str(js)])
@@ -69,35 +70,41 @@ def test_drive_default_recording_path(tmp_path, monkeypatch):
 @pytest.mark.parametrize("args, message", [
     (["--scenario", "motorway"], "unknown scenario 'motorway'"),
     (["--condition", "snow"], "unknown condition 'snow'"),
-    (["--lanes", "magic"], "Invalid value for '--lanes'"),
     (["--pedestrians", "vision", "--detector", "nope.npz"], "--detector must be sim, inria or a model file"),
     (["--duration", "-3"], "--duration must be a finite number"),
     (["--duration", "inf"], "--duration must be a finite number"),
     (["--duration", "1e308"], "--duration must be a finite number"),
     (["--seed", "-1"], "--seed must be a finite number between 0 and"),
 ])
-def test_drive_bad_input_is_one_line_exit_2(tmp_path, args, message):
+def test_drive_bad_input_is_one_line_exit_2(tmp_path, args, message, one_line_error):
     js, rrd = tmp_path / "r.json", tmp_path / "r.rrd"
-    r = runner.invoke(app, ["drive", *args, "--json", str(js), "--record", str(rrd)])
-    assert r.exit_code == 2
-    assert message in r.output and "Traceback" not in r.output
+    one_line_error(runner.invoke(app, ["drive", *args, "--json", str(js), "--record", str(rrd)]), message)
     assert not js.exists() and not rrd.exists()
 
 
-def test_drive_unwritable_output(tmp_path):
+def test_drive_unknown_slot_source_is_refused_before_the_run(tmp_path):
+    """typer's own usage error: a framed box under CliRunner, one line through the console script
+    (tests/cli/test_usage.py)."""
+    js, rrd = tmp_path / "r.json", tmp_path / "r.rrd"
+    r = runner.invoke(app, ["drive", "--lanes", "magic", "--json", str(js), "--record", str(rrd)])
+    assert r.exit_code == 2
+    assert "Invalid value for '--lanes'" in r.output and "Traceback" not in r.output
+    assert not js.exists() and not rrd.exists()
+
+
+def test_drive_unwritable_output(tmp_path, one_line_error):
     blocker = tmp_path / "file"
     blocker.write_text("x")
     r = runner.invoke(app, ["drive", "--duration", "0.2", "--no-record", "--json", str(blocker / "r.json")])
-    assert r.exit_code == 2
-    assert "cannot write" in r.output
+    one_line_error(r, "cannot write")
 
 
-def test_drive_checks_where_an_interrupted_recording_would_go(tmp_path):
+def test_drive_checks_where_an_interrupted_recording_would_go(tmp_path, one_line_error):
     """A folder at RUN.partial.rrd once made Ctrl-C end in a traceback and a left-over temporary; now it is
     refused before the run."""
     (tmp_path / "r.partial.rrd").mkdir()
     r = runner.invoke(app, ["drive", "--duration", "0.2", "--record", str(tmp_path / "r.rrd")])
-    assert r.exit_code == 2 and "r.partial.rrd is a folder" in r.output and "Traceback" not in r.output
+    one_line_error(r, "r.partial.rrd is a folder")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.partial.rrd"]
 
 
@@ -121,6 +128,6 @@ def test_drive_table_prints_no_python_values():
         assert word not in r.output, word
 
 
-def test_drive_seed_bound_is_written_in_full():
+def test_drive_seed_bound_is_written_in_full(one_line_error):
     r = runner.invoke(app, ["drive", "--seed", "99999999999", "--no-record"])
-    assert r.exit_code == 2 and "between 0 and 2147483647, got 99999999999" in r.output
+    one_line_error(r, "between 0 and 2147483647, got 99999999999")

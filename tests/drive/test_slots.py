@@ -78,6 +78,7 @@ def test_a_fifth_task_added_through_the_table_alone_runs_is_timed_scored_and_rec
     assert p.returncode == 0 and "counter/frames/estimate" in p.stdout
 
 
+@pytest.mark.slow
 def test_a_fifth_task_added_to_the_table_is_offered_on_the_cli_and_benchmarked(tmp_path, monkeypatch):
     import typer
     from typer.testing import CliRunner
@@ -158,7 +159,7 @@ def test_drive_config_names_the_bad_task_or_source():
     ("lead-brake", 0, "longitudinal", "time_gap_steady_s", 1.8062480963572944),
     ("cut-in", 1, "longitudinal", "time_gap_min_s", 0.4391419492821637),
     ("cut-in", 1, "longitudinal", "time_gap_steady_s", 1.7979412128531411),
-    ("curves", 0, "lanes", "centering_rms_m", 0.043385029252804304),
+    pytest.param("curves", 0, "lanes", "centering_rms_m", 0.043385029252804304, marks=pytest.mark.slow),
     ("crossing", 2, "pedestrians", "stops", [True, True, True]),
 ])
 def test_privileged_metrics_are_pinned(scenario, seed, group, key, value):

@@ -150,6 +150,7 @@ def test_the_vision_longitudinal_slot_records_each_cue_beside_the_fused_estimate
     assert cols["/longitudinal/range_m/stereo"]["Scalars:scalars"] >= 20
 
 
+@pytest.mark.slow
 def test_the_vision_pedestrian_slot_draws_its_detections_and_tracks(tmp_path):
     path = tmp_path / "crossing.rrd"
     record(path, {"pedestrians": "vision"}, duration_s=4.0, scenario="crossing")
