@@ -154,14 +154,15 @@ def _stack_tables(stacks, repeats: int) -> Group:
     for c in stacks:
         cost.add_row(c.scenario, *(fmt(c.timing_ms.get(k)) for k in keys))
     peers = " + ".join(t.name for t in TASKS if t.bench_peer is not None)
-    speed = Table(title=f"against the stock composition (the peers of {peers}, ms per frame); realtime: median "
-                        "[min-max]", box=box.SIMPLE_HEAD, title_justify="left")
-    for col in ("scenario", "stock", "faster", "top-down", "realtime", "recorded"):
+    speed = Table(title=f"against the stock composition (the peers of {peers}, ms per frame); times real time: "
+                        "the median drive, the median and the slowest recorded one", box=box.SIMPLE_HEAD,
+                  title_justify="left")
+    for col in ("scenario", "stock", "faster", "top-down", "realtime", "recorded", "slowest"):
         speed.add_column(col, justify="left" if col == "scenario" else "right", no_wrap=True)
     for c in stacks:
         speed.add_row(c.scenario, fmt(c.stock_ms), fmt(c.speedup), fmt(c.peers_ms["render"]),
-                      _spread(c.realtime_factor, c.realtime_factors),
-                      _spread(c.realtime_factor_recording, c.realtime_factors_recording))
+                      fmt(c.realtime_factor), fmt(c.realtime_factor_recording),
+                      fmt(min(c.realtime_factors_recording, default=None)))
     return Group(cost, speed)
 
 
@@ -174,8 +175,3 @@ def _stack_targets(stacks) -> str:
         kept = [c.met[key] for c in stacks if c.met[key] is not None]
         parts.append(f"{name}: {sum(kept)} of {len(kept)} scenarios")
     return "targets kept: " + "; ".join(parts)
-
-
-def _spread(median: float, values: tuple[float, ...]) -> str:
-    """``median [min-max]`` of several drives' figures, or the one figure."""
-    return fmt(median) if len(values) < 2 else f"{fmt(median)} [{fmt(min(values))}-{fmt(max(values))}]"
