@@ -102,7 +102,7 @@ class ConstrainedSearch:
         n = int(np.floor(np.log(s_max / s_min) / np.log(cfg.step))) + 1
         self.scales = s_min * cfg.step ** np.arange(n)
         self.cam_x = float(rig.camera_position()[0])
-        self._depths = tuple(self._depth_range(float(s)) for s in self.scales)
+        self.depths = tuple(self._depth_range(float(s)) for s in self.scales)
         # what a full pyramid over the same scales scores: every window at an 8-pixel stride, for the count
         self.full_windows = int(sum(max(int(cam.width / s - WINDOW_PX[0]) // CELL_PX + 1, 0)
                                     * max(int(cam.height / s - WINDOW_PX[1]) // CELL_PX + 1, 0) for s in self.scales))
@@ -133,11 +133,11 @@ class ConstrainedSearch:
         """(level, ``region``) of each of ``levels``; the corridor's corners of every level projected at once (the
         same values as one level at a time: every step is element by element)."""
         cfg, levels = self.cfg, tuple(levels)
-        ks = [k for k in levels if self._depths[k] is not None]
+        ks = [k for k in levels if self.depths[k] is not None]
         if not ks:
             return [(k, None) for k in levels]
         # the path's centre at the nearest and the farthest person's feet of every level
-        x = self.cam_x + np.array([z for k in ks for z in self._depths[k]])
+        x = self.cam_x + np.array([z for k in ks for z in self.depths[k]])
         centre, xs = path.centre_y(x).tolist(), x.tolist()
         pts = np.array([[xs[i], centre[i] + side * cfg.half_width_m, 0.0] for i in range(len(xs)) for side in (-1, 1)])
         uv = self.rig.project_vehicle_points(pts)[0].tolist()
@@ -149,10 +149,10 @@ class ConstrainedSearch:
             v_top = v_min - (WINDOW_PX[1] - FEET_MARGIN_PX) * scale
             v_bot = v_max + FEET_MARGIN_PX * scale
             u0, u1 = u_min - WINDOW_PX[0] * scale / 2, u_max + WINDOW_PX[0] * scale / 2
-            found[k] = self._clip((u0, v_top, u1, v_bot), scale)
+            found[k] = self.clip((u0, v_top, u1, v_bot), scale)
         return [(k, found.get(k)) for k in levels]
 
-    def _clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
+    def clip(self, box: Box, scale: float) -> tuple[int, int, int, int] | None:
         """``box`` clipped to the image in whole pixels, or None when a window at ``scale`` no longer fits in it."""
         cam = self.rig.camera
         # (clipped before rounding, which a corner at infinity could not be)
@@ -177,7 +177,7 @@ class ConstrainedSearch:
                 cu, cv = (r[0] + r[2]) / 2, (r[1] + r[3]) / 2
                 # the window at this scale, centred on the prediction, grown by half a window either way
                 half_w, half_h = WINDOW_PX[0] * s, 0.75 * WINDOW_PX[1] * s
-                box = self._clip((cu - half_w, cv - half_h, cu + half_w, cv + half_h), s)
+                box = self.clip((cu - half_w, cv - half_h, cu + half_w, cv + half_h), s)
                 if box is not None:
                     out.append((k, box))
         return out

@@ -137,7 +137,7 @@ class PedestrianSlot:
             # a lone window is a person only where the stereo pair agrees with its ground contact
             tracks = self.tracker.update(boxes, [d.score for d in dets], stereo=self._stereo(frame) if boxes else None,
                                          verify=[d.windows < 2 for d in dets])
-        request, rid = self._request(tracks, path, speed)
+        request, rid = self.request(tracks, path, speed)
         self.asked.update({t.track_id: t for t in tracks if t.track_id in self.asked or t.track_id == rid})
         if rid is None and speed <= STANDING_MPS:
             self.asked = {}
@@ -152,7 +152,7 @@ class PedestrianSlot:
             return None
         return lambda box, z_ground_m: box_depth(frame.left, frame.right, box, self.tracker.rig, z_ground_m)
 
-    def _request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
+    def request(self, tracks: list[PersonTrack], path: EgoPath, speed: float):
         """(the braking request, its track id) for the nearest track that may act and conflicts with the path, or
         (None, None)."""
         lane_w = path.lane.width_m if path.follows_lane else DEFAULT_LANE_WIDTH_M

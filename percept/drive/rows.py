@@ -7,6 +7,7 @@ view kept per frame holds its whole base array, which over a long drive grows th
 
 from __future__ import annotations
 
+import sys
 from array import array
 
 import numpy as np
@@ -23,6 +24,11 @@ class Rows:
         if len(row) != self.width:
             raise ValueError(f"a row of {len(row)} values where {self.width} are kept")
         self._data.extend(row)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes the rows hold in memory, spare room included."""
+        return sys.getsizeof(self._data)
 
     def __len__(self) -> int:
         return len(self._data) // self.width

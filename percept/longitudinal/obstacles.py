@@ -169,9 +169,9 @@ class ObstacleFinder:
         debug = {"matched": int(len(z)), "standing": int(len(stand))}
         if not len(stand):
             return None, debug
-        return self._nearest_group(u[stand], v[stand], z[stand], pv[stand], area[stand]), debug
+        return self.nearest_group(u[stand], v[stand], z[stand], pv[stand], area[stand]), debug
 
-    def _nearest_group(self, u, v, z, pv, area) -> Obstacle | None:
+    def nearest_group(self, u, v, z, pv, area) -> Obstacle | None:
         """The nearest range group of the standing points (columns, rows, depths, vehicle-frame points, areas) that
         covers ``min_area_m2`` in one grounded blob, or None."""
         cfg, cam = self.cfg, self.rig.camera

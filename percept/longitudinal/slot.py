@@ -115,17 +115,17 @@ class LongitudinalSlot:
         path = upstream.get(EgoPath) or EgoPath.straight(motion.speed_mps)
         # nothing in the path comes towards the ego faster than it drives: range rate >= -(v_ego + reverse_mps)
         self._rate_floor_mps = -(motion.speed_mps + self.cfg.reverse_mps) if motion.speed_ok else -np.inf
-        self._predict()
+        self.predict()
         ob = ref = z = contact = expansion = None
         used: tuple[str, ...] = ()
         if not frame.dropped:
             left, right = frame.left_gray, frame.right_gray
             ob, _ = self.finder.find(left, right, path)
             if ob is not None:
-                ref = self._refine(left, right, ob)
+                ref = self.refine(left, right, ob)
                 z = self.fb / ref.disparity_px if ref is not None and ref.disparity_px > 0.5 else ob.range_m
                 contact = self.contact.measure(left, ob.box_px, z)
-                used = self._update(z, ref, ob, contact)
+                used = self.update(z, ref, ob, contact)
                 expansion = self.flow.measure(left, ob.box_px, frame.timestamp_s) if used else None
                 if expansion is not None and self._update_rate(expansion):
                     used += ("flow",)
@@ -139,7 +139,7 @@ class LongitudinalSlot:
         state = None if self.track is None else (self.track.range_m, self.track.rate_mps)
         return self._lead(), LeadDebug(ob, ref, z, contact, expansion, used, state, self.hits, self.misses)
 
-    def _refine(self, left: np.ndarray, right: np.ndarray, ob: Obstacle) -> Refined | None:
+    def refine(self, left: np.ndarray, right: np.ndarray, ob: Obstacle) -> Refined | None:
         """Subpixel disparity over the band of the obstacle that faces the ego (its lower body)."""
         cam, h = self.rig.camera, self.rig.mount_height_m
         lo, hi = self.cfg.face_m
@@ -185,7 +185,7 @@ class LongitudinalSlot:
             return full
         return ref
 
-    def _predict(self) -> None:
+    def predict(self) -> None:
         """The track one frame ahead, then this frame's floor on its range rate."""
         if self.track is not None:
             self.track.predict(self._rate_floor_mps)
@@ -204,7 +204,7 @@ class LongitudinalSlot:
         """One measurement ``value`` of state ``i`` with noise ``sigma``, unless it is beyond the gate; True if used."""
         return self.track.gated_update(value, sigma, i, self.cfg.gate_sigma)
 
-    def _update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
+    def update(self, z: float, ref: Refined | None, ob: Obstacle, contact: Contact | None) -> tuple[str, ...]:
         """The range measurements: stereo (which also starts and replaces tracks), then ground contact."""
         if ref is None and (self.track is None or self.hits < self.cfg.confirm):
             # a group whose disparity does not refine (no surface with a clear match: chance matches on the dark,

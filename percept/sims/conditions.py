@@ -114,7 +114,7 @@ class ConditionEffects:
         passes.beam_gain(z, t)
         return t
 
-    def _night(self, img: np.ndarray, gain: np.ndarray, emission: np.ndarray) -> np.ndarray:
+    def night(self, img: np.ndarray, gain: np.ndarray, emission: np.ndarray) -> np.ndarray:
         """Lamps keep their light and glow; everything else is lit by ``gain``. Linear in each pixel's lamp
         fraction, so that a lamp's anti-aliased edge moves smoothly (a threshold would snap it to whole pixels).
         Where no lamp is (e = 0) the mix is f gain exactly (f: ``img`` in float32), so it is computed in full only
@@ -188,7 +188,7 @@ class ConditionEffects:
         if c is Condition.NIGHT:
             if emission is None:
                 emission = ((img[..., 2] > 180) & (img[..., 1] < 90)).astype(np.float32)
-            out = self._night(img, self._night_gain(inv_depth, camera), emission)
+            out = self.night(img, self._night_gain(inv_depth, camera), emission)
             n = standard_normal_f32(rng, self._scratch("noise"))
             # out + 3 n on every channel, clipped and truncated to uint8
             return passes.with_noise_uint8(out, n, np.float32(3.0))

@@ -59,7 +59,7 @@ def test_a_cascade_keeps_what_its_second_stage_confirms(crossing_frame):
 
 
 def test_a_region_is_clipped_to_the_same_whole_pixels_as_numpys_floor_and_ceil():
-    """``_clip`` (math.floor / math.ceil after clipping) gives the pixels of int(max(np.floor(u0), 0)), ...,
+    """``clip`` (math.floor / math.ceil after clipping) gives the pixels of int(max(np.floor(u0), 0)), ...,
     int(min(np.ceil(u1), width)), for corners inside, outside, on whole pixels and at infinity."""
     rig = StereoRig()
     search = ConstrainedSearch(rig, LinearModel.inria())
@@ -73,7 +73,7 @@ def test_a_region_is_clipped_to_the_same_whole_pixels_as_numpys_floor_and_ceil()
         box = (np.float64(u0), float(v0), np.float64(u1), float(v1))
         want = (int(max(np.floor(box[0]), 0)), int(max(np.floor(box[1]), 0)), int(min(np.ceil(box[2]), cam.width)),
                 int(min(np.ceil(box[3]), cam.height)))
-        got = search._clip(box, 0.5)
+        got = search.clip(box, 0.5)
         small = want[2] - want[0] < 32 or want[3] - want[1] < 64
         assert got == (None if small else want)
         assert got is None or all(type(c) is int for c in got)

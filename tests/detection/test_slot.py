@@ -82,8 +82,8 @@ def test_by_default_the_levels_where_crossing_people_are_first_found_are_searche
     eighth."""
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     assert slot.periods == (3, 3, 3) + (8,) * (len(slot.search.scales) - 3)
-    assert all(slot.search._depths[k][1] < 28.3 for k in range(3, len(slot.search.scales)))
-    assert all(slot.search._depths[k][1] > 28.3 for k in range(3))
+    assert all(slot.search.depths[k][1] < 28.3 for k in range(3, len(slot.search.scales)))
+    assert all(slot.search.depths[k][1] > 28.3 for k in range(3))
 
 
 @pytest.mark.slow
@@ -112,10 +112,10 @@ def track(tid: int, x: float, y: float, vy: float = 0.0, stereo_hits: int = 5, s
 def test_only_tracks_the_stereo_pair_has_placed_on_the_road_ask_for_braking():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(10.0)
-    request, rid = slot._request([track(1, 15.0, 0.5, stereo_hits=0), track(2, 25.0, -0.5)], path, 10.0)
+    request, rid = slot.request([track(1, 15.0, 0.5, stereo_hits=0), track(2, 25.0, -0.5)], path, 10.0)
     assert rid == 2 and request.reason == "pedestrian in the path"
     assert request.stop_before_m == pytest.approx(25.0 - slot.cam_x)
-    assert slot._request([track(1, 15.0, 0.5, stereo_hits=0)], path, 10.0) == (None, None)
+    assert slot.request([track(1, 15.0, 0.5, stereo_hits=0)], path, 10.0) == (None, None)
 
 
 def test_a_track_that_has_shown_a_vehicles_speed_asks_for_no_braking():
@@ -123,9 +123,9 @@ def test_a_track_that_has_shown_a_vehicles_speed_asks_for_no_braking():
     # at 21 m/s: the car braked from 26 m/s to a standstill for it
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(26.0)
-    assert slot._request([track(1, 36.0, 0.5, vx=1.9, too_fast=True)], path, 26.0) == (None, None)
+    assert slot.request([track(1, 36.0, 0.5, vx=1.9, too_fast=True)], path, 26.0) == (None, None)
     # a person running across at 3 m/s is still one
-    request, rid = slot._request([track(1, 17.8, 1.8, vx=0.5, vy=-3.0)], path, 20.0)
+    request, rid = slot.request([track(1, 17.8, 1.8, vx=0.5, vy=-3.0)], path, 20.0)
     assert rid == 1 and request.reason == "pedestrian stepping into the path"
 
 
@@ -136,10 +136,10 @@ def test_a_young_track_far_ahead_waits_for_its_motion_and_a_near_one_does_not():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(20.0)
     far = slot.cam_x + 40.0
-    assert slot._request([track(1, far, 0.3, hits=3)], path, 20.0) == (None, None)
-    assert slot._request([track(1, far, 0.3, hits=8)], path, 20.0)[1] == 1  # its motion known: a person
+    assert slot.request([track(1, far, 0.3, hits=3)], path, 20.0) == (None, None)
+    assert slot.request([track(1, far, 0.3, hits=8)], path, 20.0)[1] == 1  # its motion known: a person
     near = slot.cam_x + 30.0
-    assert slot._request([track(1, near, 0.3, hits=3)], path, 20.0)[1] == 1  # no room left to wait
+    assert slot.request([track(1, near, 0.3, hits=3)], path, 20.0)[1] == 1  # no room left to wait
 
 
 class _Tracks:
@@ -196,9 +196,9 @@ def test_a_young_track_whose_free_motion_reads_a_vehicles_speed_waits_longer():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(18.8)
     x = slot.cam_x + 32.5
-    assert slot._request([young(1, x, 16.4, 5.0)], path, 18.8) == (None, None)  # a stop at 7.5 m/s^2 still fits
-    assert slot._request([young(1, x, 3.0, 5.0)], path, 18.8)[1] == 1  # read as a walk: no longer
-    assert slot._request([young(1, x - 2.5, 16.4, 5.0)], path, 18.8)[1] == 1  # two frames on: no room left
+    assert slot.request([young(1, x, 16.4, 5.0)], path, 18.8) == (None, None)  # a stop at 7.5 m/s^2 still fits
+    assert slot.request([young(1, x, 3.0, 5.0)], path, 18.8)[1] == 1  # read as a walk: no longer
+    assert slot.request([young(1, x - 2.5, 16.4, 5.0)], path, 18.8)[1] == 1  # two frames on: no room left
 
 
 def test_a_young_track_asked_for_and_lost_is_withdrawn_only_if_it_moved_like_a_vehicle():
@@ -230,9 +230,9 @@ def test_a_track_not_walking_is_judged_where_it_was_last_seen():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(10.0)
     # carried into the corridor by a speed not yet trusted (5 detections), last seen on the verge: no braking
-    assert slot._request([track(1, 15.0, 1.0, vy=-1.2, hits=5, standing=(15.0, 3.5))], path, 10.0) == (None, None)
+    assert slot.request([track(1, 15.0, 1.0, vy=-1.2, hits=5, standing=(15.0, 3.5))], path, 10.0) == (None, None)
     # the same track once its walk is trusted: in the path
-    request, _ = slot._request([track(1, 15.0, 1.0, vy=-1.2, standing=(15.0, 3.5))], path, 10.0)
+    request, _ = slot.request([track(1, 15.0, 1.0, vy=-1.2, standing=(15.0, 3.5))], path, 10.0)
     assert request.reason == "pedestrian in the path"
 
 
@@ -243,7 +243,7 @@ def test_the_request_closes_at_the_ego_speed_whatever_the_tracks_own_x_speed():
     slot = PedestrianSlot(StereoRig(), 1 / 15)
     path = EgoPath.straight(12.6)
     for vx in (0.7, -0.5, 0.0):
-        request, _ = slot._request([track(1, 35.0, 0.5, vx=vx, vy=-1.2)], path, 12.6)
+        request, _ = slot.request([track(1, 35.0, 0.5, vx=vx, vy=-1.2)], path, 12.6)
         assert request.range_rate_mps == -12.6
 
 

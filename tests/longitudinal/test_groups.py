@@ -12,7 +12,7 @@ from percept.sensors import StereoRig
 
 
 def _numpy_nearest_group(finder, u, v, z, pv, area):
-    """``ObstacleFinder._nearest_group`` in numpy's operations, without the kernels."""
+    """``ObstacleFinder.nearest_group`` in numpy's operations, without the kernels."""
     cfg, cam = finder.cfg, finder.rig.camera
     k = np.floor(np.log(z) / np.log1p(cfg.bin_rel)).astype(int)
     order = np.argsort(k, kind="stable")
@@ -76,7 +76,7 @@ def finder():
 def test_nearest_group_equals_numpys(finder, seed):
     rng = np.random.default_rng(seed)
     scene = _scene(rng, blobs=int(rng.integers(1, 6)), strays=int(rng.integers(0, 400)), equal=seed % 5 == 0)
-    assert finder._nearest_group(*scene) == _numpy_nearest_group(finder, *scene)
+    assert finder.nearest_group(*scene) == _numpy_nearest_group(finder, *scene)
 
 
 def test_range_bins_equal_numpys():

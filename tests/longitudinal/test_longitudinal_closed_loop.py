@@ -71,18 +71,18 @@ def test_a_range_that_does_not_refine_neither_starts_a_track_nor_drags_one_away(
     ob = Obstacle(61.0, (309, 239, 316, 250), 28.0)
     # chance matches on the dark background at the road's far end: a coarse range without a refined disparity
     for _ in range(5):
-        assert slot._update(61.0, None, ob, None) == () and slot.track is None
+        assert slot.update(61.0, None, ob, None) == () and slot.track is None
     refined = Refined(slot.fb / 12.0, 0.02, 200, True)
     car = Obstacle(12.0, (290, 220, 350, 290), 2000.0)
     for _ in range(slot.cfg.confirm):
-        slot._predict()
-        assert slot._update(12.0, refined, car, None) == ("stereo",)
+        slot.predict()
+        assert slot.update(12.0, refined, car, None) == ("stereo",)
     # confirmed at 12 m: the far match's noise is taken at the track's range, so it is no measurement of it ...
-    slot._predict()
-    assert slot._update(61.0, None, ob, None) == () and slot.track.range_m == pytest.approx(12.0, abs=0.2)
+    slot.predict()
+    assert slot.update(61.0, None, ob, None) == () and slot.track.range_m == pytest.approx(12.0, abs=0.2)
     # ... while a coarse range near the track still updates it (a lead whose face did not refine this frame)
-    slot._predict()
-    assert slot._update(12.3, None, car, None) == ("stereo",)
+    slot.predict()
+    assert slot.update(12.3, None, car, None) == ("stereo",)
 
 
 class _Scripted:
@@ -91,7 +91,7 @@ class _Scripted:
     def __init__(self, slot, script):
         self.script, self.fb = iter(script), slot.fb
         slot.finder.find = self.find
-        slot._refine = lambda left, right, ob: self.refined
+        slot.refine = lambda left, right, ob: self.refined
         slot.contact.measure = lambda gray, box, z: None
         slot.flow.measure = lambda gray, box, t: None
 

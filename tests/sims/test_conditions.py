@@ -141,7 +141,7 @@ def test_a_lamp_keeps_its_light_in_proportion_to_the_pixel_it_covers(clear):
     sky = np.zeros(img.shape[:2], np.float32)
     lamp = np.zeros(img.shape[:2], np.float32)
     lamp[100, 100:103] = (1.0, 0.5, 0.25)
-    out = effects._night(img.astype(np.float32), effects.night_gain(sky, 0), lamp)
+    out = effects.night(img.astype(np.float32), effects.night_gain(sky, 0), lamp)
     # lamp fraction e: 200 e + 200 * 0.08 (1 - e), plus the glow around it
     base = 200 * 0.08
     lit = out[100, 100:103, 0] - base

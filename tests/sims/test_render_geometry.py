@@ -126,14 +126,14 @@ def test_the_reused_winner_map_is_left_clear_and_an_interrupted_frame_does_not_l
     r = StereoRenderer(rig, road, seed=11)
     first = r.render(scene)
     for side in (Side.LEFT, Side.RIGHT):
-        assert (r._winners[side].map == -1).all(), side
+        assert (r.winners[side].map == -1).all(), side
     # a rasterisation stopped half-way (Ctrl-C) leaves the map lent and dirty: the next frame fills it afresh
-    dirty = r._winners[Side.LEFT].take()
+    dirty = r.winners[Side.LEFT].take()
     dirty[200:400, 100:500] = 3
     again = r.render(scene)
     for name in ("left", "right", "depth_m", "ids"):
         assert getattr(first, name).tobytes() == getattr(again, name).tobytes(), name
-    assert (r._winners[Side.LEFT].map == -1).all()
+    assert (r.winners[Side.LEFT].map == -1).all()
 
 
 def test_without_the_lamp_map_the_frames_are_the_same(rig, road):
@@ -153,7 +153,7 @@ def test_prepare_takes_cameras_of_one_orientation_only(rig, bare):
 
     scene = Scene(EGO, (car(1, EGO.x_m + 15.0),))
     patches = bare.scene_patches(scene)
-    left, right = (bare._cam_from_world(scene, s) for s in (Side.LEFT, Side.RIGHT))
+    left, right = (bare.cam_from_world(scene, s) for s in (Side.LEFT, Side.RIGHT))
     # as np.allclose decides: a rotation 1e-9 off is the same orientation, one 1e-3 rad off is not
     nudged = Transform(left.R + 1e-9, right.t)
     assert all(p is not None for p in prepare(patches, rig.camera, [left, nudged], bare.atlas, SUN_DIR))

@@ -32,21 +32,21 @@ def test_the_grid_returns_every_point_inside_the_box_in_ascending_order():
 
 def test_the_renderer_keeps_the_same_scenery_as_testing_all_of_it(rig, road):
     r = StereoRenderer(rig, road, seed=5)
-    assert len(r._scenery_centre) > 500
+    assert len(r.scenery_centre) > 500
 
     def every(pose: Pose2D) -> np.ndarray:
         # the view-cone test over all the scenery, without the grid
-        d = pose.to_vehicle_xy(r._scenery_centre)
-        rad, x = r._scenery_radius, d[:, 0] - rig.mount_x_m
+        d = pose.to_vehicle_xy(r.scenery_centre)
+        rad, x = r.scenery_radius, d[:, 0] - rig.mount_x_m
         slope = math.tan(rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
-        return np.flatnonzero((x + rad > 0) & (x - rad < np.minimum(SCENERY_RANGE_M, r._scenery_reach))
+        return np.flatnonzero((x + rad > 0) & (x - rad < np.minimum(SCENERY_RANGE_M, r.scenery_reach))
                               & (np.abs(d[:, 1]) - rad < (x + rad) * slope + rig.baseline_m))
 
     rng = np.random.default_rng(1)
     kept = 0
     for x, y, yaw in zip(rng.uniform(-50, 450, 40), rng.uniform(-30, 30, 40), rng.uniform(-math.pi, math.pi, 40)):
         pose = Pose2D(float(x), float(y), float(yaw))
-        got = r._scenery_in_view(Scene(pose, ()))
+        got = r.scenery_in_view(Scene(pose, ()))
         assert np.array_equal(got, every(pose))  # the same float64 test on the same pieces: the same indices
         kept += len(got)
     assert kept > 0

@@ -70,7 +70,8 @@ class StereoRenderer:
         self.rig = rig
         self.road = road
         self.layers = {s: GroundLayer(rig, s, seed, palette) for s in (Side.LEFT, Side.RIGHT)}
-        self._winners = {s: WinnerMap((rig.camera.height, rig.camera.width)) for s in (Side.LEFT, Side.RIGHT)}
+        # per camera, which patch won each pixel (reused from frame to frame)
+        self.winners = {s: WinnerMap((rig.camera.height, rig.camera.width)) for s in (Side.LEFT, Side.RIGHT)}
         self.road_index = self.layers[Side.LEFT].road_index(road)
         self.layers[Side.RIGHT]._index = (road, self.road_index)  # one road index for both cameras
         self.textures: list[np.ndarray] = [panel_texture(seed + 1), foliage_texture(seed + 2)]
@@ -84,17 +85,18 @@ class StereoRenderer:
         self.scenery = build_scenery(road, seed, self.tex, signs_xy) if scenery else PatchBatch.empty()
         s = self.scenery
         self._scenery_packed = s.pack()
-        # bounding circle of each scenery patch on the ground, for the per-frame view-cone test
-        self._scenery_centre = (s.origin + (s.e1 + s.e2) / 2)[:, :2]
+        # bounding circle of each scenery patch on the ground (centre [m], radius [m]), for the per-frame view-cone
+        # test, and the range its level of detail reaches [m]
+        self.scenery_centre = (s.origin + (s.e1 + s.e2) / 2)[:, :2]
         l1, l2 = np.linalg.norm(s.e1, axis=1), np.linalg.norm(s.e2, axis=1)
-        self._scenery_radius = (l1 + l2) / 2
+        self.scenery_radius = (l1 + l2) / 2
         # beyond f min(|e1|, |e2|) / LOD_PX a patch is narrower than LOD_PX on screen, so the rasteriser skips it
-        self._scenery_reach = rig.camera.fx * np.minimum(l1, l2) / LOD_PX
-        self._scenery_grid = GroundGrid(self._scenery_centre, SCENERY_CELL_M)
-        # the view-cone test (``_scenery_in_view``) passes only patches with -r < x < RANGE + r (x = d_x - mount_x)
+        self.scenery_reach = rig.camera.fx * np.minimum(l1, l2) / LOD_PX
+        self._scenery_grid = GroundGrid(self.scenery_centre, SCENERY_CELL_M)
+        # the view-cone test (``scenery_in_view``) passes only patches with -r < x < RANGE + r (x = d_x - mount_x)
         # and |d_y| < (x + r) slope + r + b, r at most the largest radius: a box in the vehicle frame (1 m wider)
         self._cone_slope = slope = math.tan(rig.camera.hfov_rad / 2 + VIEW_MARGIN_RAD)
-        r_max = float(self._scenery_radius.max()) if len(self._scenery_radius) else 0.0
+        r_max = float(self.scenery_radius.max()) if len(self.scenery_radius) else 0.0
         y_max = ((SCENERY_RANGE_M + 2 * r_max) * slope + r_max + rig.baseline_m + 1.0 if 0 < slope < math.inf
                  else math.inf)
         self._cone_box = np.array([[rig.mount_x_m - r_max - 1.0, -y_max], [rig.mount_x_m - r_max - 1.0, y_max],
@@ -179,26 +181,27 @@ class StereoRenderer:
         parts = self._object_packed(scene)
         return PatchBatch.unpack(np.concatenate(parts)) if parts else PatchBatch.empty()
 
-    def _scenery_in_view(self, scene: Scene) -> np.ndarray:
+    def scenery_in_view(self, scene: Scene) -> np.ndarray:
         """Indices (ascending) of scenery whose bounding circle meets the rig's horizontal view cone, within range
         and within its level-of-detail reach; only the scenery in the grid's cells near the car is tested."""
         box = scene.ego.world_from_vehicle().apply(np.column_stack([self._cone_box, np.zeros(4)]))
         near = self._scenery_grid.within(*box[:, :2].min(axis=0), *box[:, :2].max(axis=0))
-        d = scene.ego.to_vehicle_xy(self._scenery_centre[near])
-        r = self._scenery_radius[near]
+        d = scene.ego.to_vehicle_xy(self.scenery_centre[near])
+        r = self.scenery_radius[near]
         x = d[:, 0] - self.rig.mount_x_m
         # |y| <= (x + r) tan(hfov/2 + margin) + r + baseline
-        return near[(x + r > 0) & (x - r < np.minimum(SCENERY_RANGE_M, self._scenery_reach[near]))
+        return near[(x + r > 0) & (x - r < np.minimum(SCENERY_RANGE_M, self.scenery_reach[near]))
                     & (np.abs(d[:, 1]) - r < (x + r) * self._cone_slope + self.rig.baseline_m)]
 
     def scene_patches(self, scene: Scene) -> PatchBatch:
         """Scenery in view and every object, as one batch for both cameras."""
         parts = self._object_packed(scene)
         if len(self.scenery):
-            parts.insert(0, self._scenery_packed[self._scenery_in_view(scene)])
+            parts.insert(0, self._scenery_packed[self.scenery_in_view(scene)])
         return PatchBatch.unpack(np.concatenate(parts)) if parts else PatchBatch.empty()
 
-    def _cam_from_world(self, scene: Scene, side: Side):
+    def cam_from_world(self, scene: Scene, side: Side):
+        """The transform from the world frame to ``side``'s camera frame in ``scene``."""
         return self.rig.cam_from_vehicle(side).compose(scene.ego.vehicle_from_world())
 
     def render_side(self, scene: Scene, side: Side, patches: PatchBatch | None = None,
@@ -211,10 +214,10 @@ class StereoRenderer:
         img = layer.paint(scene.ego, self.road, prepared_ground)
         target = RenderTarget(img, None, layer.ground_ids() if ids else None, layer.ground_inv_depth.copy(),
                               layer.ground_inv_depth, np.zeros(img.shape[:2], np.float32) if emission else None,
-                              winner=self._winners[side])
+                              winner=self.winners[side])
         if prepared is None:
             patches = self.scene_patches(scene) if patches is None else patches
-            prepared = prepare(patches, self.rig.camera, [self._cam_from_world(scene, side)], self.atlas, SUN_DIR)[0]
+            prepared = prepare(patches, self.rig.camera, [self.cam_from_world(scene, side)], self.atlas, SUN_DIR)[0]
         if prepared is not None:
             rasterize_prepared(target, prepared, self.atlas, ids)
         if depth:
@@ -228,7 +231,7 @@ class StereoRenderer:
         patches = self.scene_patches(scene)
         ground = ground_paint(self.road_index, scene.ego, self.rig, self.layers[Side.LEFT].palette)
         sides = (Side.LEFT, Side.RIGHT)
-        prep = prepare(patches, self.rig.camera, [self._cam_from_world(scene, s) for s in sides], self.atlas, SUN_DIR)
+        prep = prepare(patches, self.rig.camera, [self.cam_from_world(scene, s) for s in sides], self.atlas, SUN_DIR)
         left = self.render_side(scene, Side.LEFT, prepared_ground=ground, prepared=prep[0], emission=emission)
         right = self.render_side(scene, Side.RIGHT, prepared_ground=ground, ids=False, prepared=prep[1], depth=False,
                                  emission=emission)
