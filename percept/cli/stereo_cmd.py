@@ -51,7 +51,7 @@ def stereo(
     truncated, not an image), a search range too wide for the images and a calibration without a baseline. Every output is written complete or not at all.
     """
     from percept.cli.common import check_outputs, fail, on_interrupt
-    from percept.longitudinal.dense import DenseConfig, default_num_disparities
+    from percept.longitudinal.dense import DenseConfig
     from percept.sensors.stereo_io import RectifiedStereo
 
     opt.check_number("--scale", scale, 0.05, 1.0)
@@ -70,12 +70,8 @@ def stereo(
         fail(str(e))
     left_img, right_img, truth, rig, s = _inputs(left, right, gt, rig, scale)
     h, w = left_img.shape[:2]
-    n_max = max_num_disparities(w, block_size)
-    if num_disparities is not None and num_disparities > n_max:
-        fail(f"--num-disparities must be a multiple of 16 from 16 to {n_max} for these {w}x{h} px images at scale "
-             f"{s:g} with --block-size {block_size}, got {num_disparities}; lower it or raise --scale")
-    n = num_disparities if num_disparities is not None else min(default_num_disparities(w, rig.ndisp), n_max)
-    cfg = DenseConfig(num_disparities=n, block_size=block_size)
+    cfg = DenseConfig(num_disparities=_search_range(num_disparities, w, h, s, block_size, rig.ndisp),
+                      block_size=block_size)
     rows = _check_rectified(left_img, right_img)
     results = _run(left_img, right_img, truth, rig, cfg)
     _print_table(results, s, w, h, cfg.num_disparities, truth is not None)
@@ -94,6 +90,20 @@ def max_num_disparities(width: int, block_size: int) -> int:
 
     # n + b // 2 < w, n a multiple of 16
     return min(MAX_DISPARITIES, (width - block_size // 2 - 1) // 16 * 16)
+
+
+def _search_range(num_disparities: Optional[int], w: int, h: int, s: float, block_size: int,
+                  ndisp: Optional[int]) -> int:
+    """The search range [px] for the pair (w x h px at the working scale ``s``): --num-disparities when it is within
+    ``max_num_disparities``, a one-line error when it is wider, else the default cut to that bound."""
+    from percept.cli.common import fail
+    from percept.longitudinal.dense import default_num_disparities
+
+    n_max = max_num_disparities(w, block_size)
+    if num_disparities is not None and num_disparities > n_max:
+        fail(f"--num-disparities must be a multiple of 16 from 16 to {n_max} for these {w}x{h} px images at scale "
+             f"{s:g} with --block-size {block_size}, got {num_disparities}; lower it or raise --scale")
+    return num_disparities if num_disparities is not None else min(default_num_disparities(w, ndisp), n_max)
 
 
 def _note(s: float, with_gt: bool) -> str:
