@@ -43,34 +43,29 @@ def register(app: typer.Typer) -> None:
         One camera: the file is what `percept lanes --calib` reads. Stereo: both cameras, the right camera's
         rotation and translation in the left one's frame (baseline in metres with --square), the rectified
         projections, and the mean epipolar error as a check. The files are written complete or not at all.
+
+        A photo that cannot be read (empty, truncated, not an image), a stereo pair of two sizes and, with --stereo,
+        a photo without its left/right partner are left out with a warning line naming them.
         """
-        from percept.cli.common import check_outputs, console, fail, on_interrupt, progress_bar, write_error, write_json
+        from percept.cli.common import check_outputs, console, fail, on_interrupt, write_error, write_json
         from percept.cli.options import check_number
-        from percept.sensors.chessboard import calibrate_chessboards, chessboard_images, parse_pattern
-        from percept.sensors.stereo_calibration import calibrate_stereo, stereo_pairs
+        from percept.sensors.chessboard import chessboard_images, parse_pattern
+        from percept.sensors.stereo_calibration import stereo_photos
 
         check_number("--square", square, 1e-4, 10.0)
+        unpaired = []
         try:
             size = parse_pattern(pattern)
-            items = stereo_pairs(folder) if stereo else chessboard_images(folder)
+            items, unpaired = stereo_photos(folder) if stereo else (chessboard_images(folder), [])
         except ValueError as e:
             fail(str(e))
+        for p in unpaired:
+            _warn(_unpaired(p))
         target = out if out is not None else folder / ("stereo_calib.json" if stereo else "calib.json")
         photos = [p for item in items for p in (item if stereo else (item,))]
         check_outputs([target, json_path], photos)
         on_interrupt(f"nothing was written; {target} keeps what it held" if target.exists() else None)
-        problem = None
-        with progress_bar() as bar:
-            what = "pairs" if stereo else "photos"
-            task = bar.add_task(f"finding {size[0]}x{size[1]} chessboards in {len(items)} {what}", total=len(items))
-            tick = lambda p, ok: bar.advance(task)  # noqa: E731
-            try:
-                cal = calibrate_stereo(items, size, square, tick) if stereo else calibrate_chessboards(
-                    items, size, square, tick)
-            except ValueError as e:
-                problem = str(e)
-        if problem is not None:
-            fail(problem)
+        cal = _calibrate(items, size, square, stereo)
         try:
             target.parent.mkdir(parents=True, exist_ok=True)
             cal.save(target)
@@ -79,6 +74,50 @@ def register(app: typer.Typer) -> None:
         console.print(_table(cal, stereo, square, folder))
         console.print(f"wrote {target}")
         write_json(json_path, {**cal.to_dict(), "file": str(target), "folder": str(folder)})
+
+
+def _calibrate(items: list, size: tuple[int, int], square: float, stereo: bool):
+    """The camera (or, with ``stereo``, rig) calibration from ``items`` (photos, or (left, right) pairs) behind a
+    progress bar; a warning line for each photo or pair left out, a one-line error when it cannot be done."""
+    from percept.cli.common import fail, progress_bar
+    from percept.sensors.chessboard import calibrate_chessboards
+    from percept.sensors.stereo_calibration import calibrate_stereo
+
+    problem, skipped, cal = None, [], None
+    with progress_bar() as bar:
+        what = "pairs" if stereo else "photos"
+        task = bar.add_task(f"finding {size[0]}x{size[1]} chessboards in {len(items)} {what}", total=len(items))
+        tick = lambda p, ok: bar.advance(task)  # noqa: E731
+        skip = lambda p, why: skipped.append(why)  # noqa: E731
+        try:
+            cal = calibrate_stereo(items, size, square, tick, skip) if stereo else calibrate_chessboards(
+                items, size, square, tick, skip)
+        except ValueError as e:
+            problem = str(e)
+    for why in skipped:
+        _warn(f"{why}; {'its pair' if stereo else 'the photo'} is left out")
+    if problem is not None:
+        fail(problem)
+    return cal
+
+
+def _warn(message: str) -> None:
+    """One ``warning:`` line on the terminal (stderr)."""
+    from rich.markup import escape
+
+    from percept.cli.common import err
+
+    err.print(f"[yellow]warning:[/] {escape(message)}", highlight=False, soft_wrap=True)
+
+
+def _unpaired(path: Path) -> str:
+    """Why a photo of a --stereo folder is in no pair: its partner (right<X> for left<X> and back) is missing, or
+    it is named neither way."""
+    name, low = path.name, path.name.lower()
+    if low.startswith("left") or low.startswith("right"):
+        partner = "right" + name[4:] if low.startswith("left") else "left" + name[5:]
+        return f"{path} has no partner {partner}; it is left out"
+    return f"{path} is named neither left<N> nor right<N>; it is left out"
 
 
 def _table(cal, stereo: bool, square: float, folder: Path):

@@ -37,8 +37,10 @@ def register(app: typer.Typer) -> None:
         """Find people with a HOG sliding window over every scale of the image (64x128 windows, 8-pixel stride),
         features computed once per scale and shared by all its windows.
 
-        The JSON has, per image or frame, `file`, `frame` and `detections` [{`box_px` [u0, v0, u1, v1], `score`}].
-        The JSON and every overlay are written complete or not at all.
+        The JSON has, per image or frame, `file`, `frame` and `detections` [{`box_px` \\[u0, v0, u1, v1], `score`}].
+        The JSON and every overlay are written complete or not at all. A single image that cannot be read
+        (empty, truncated, not an image) is refused; in a folder it is skipped with a warning line naming it and
+        listed in the JSON with its error.
         """
         from percept.cli.common import check_outputs, fail
         from percept.cli.footage_out import overlay_path

@@ -61,6 +61,8 @@ def register(app: typer.Typer) -> None:
 
         The JSON and every overlay are written complete or not at all: an error, a full disk or Ctrl-C leaves the
         files that were there untouched. Overlays of a folder are written one by one as each image is done.
+        A single image that cannot be read (empty, truncated, not an image) is refused; in a folder it is skipped
+        with a warning line naming it and listed in the JSON with its error.
         """
         _lanes(source, json_path, out, calib, mount_height, lane_width, hfov, speed, max_frames, fmt)
 

@@ -37,24 +37,26 @@ def stereo(
                                                                    "(default: halve until at most 1000 px "
                                                                    "wide).")] = None,
     num_disparities: Annotated[Optional[int], typer.Option("--num-disparities", help="Search range in px at the "
-                                                           "working scale, a multiple of 16 up to 1024 (default: "
-                                                           "the calibration's ndisp, else width/6).")] = None,
+                                                           "working scale, a multiple of 16 from 16 to 1024 and "
+                                                           "below the working width less half the block (default: "
+                                                           "the calibration's ndisp, else width/6, within that "
+                                                           "bound).")] = None,
     block_size: Annotated[int, typer.Option("--block-size", help="Matching block in px, odd, 1 to 11.")] = 3,
 ):
     """Dense disparity and depth of a rectified pair: percept's dense mode against OpenCV's StereoSGBM.
 
     percept's dense mode: SGBM both ways, WLS filter with left-right confidence, hole filling, sub-pixel steps.
     Both run with the same range and block in one run. With --gt: bad 2.0 px %, mean error, depth error.
-    Refuses (exit code 2) images of different sizes, a pair whose rows do not match, unreadable files and a
-    calibration without a baseline. Every output is written complete or not at all.
+    Refuses (exit code 2) images of different sizes, a pair whose rows do not match, unreadable files (empty,
+    truncated, not an image), a search range too wide for the images and a calibration without a baseline. Every output is written complete or not at all.
     """
     from percept.cli.common import check_outputs, fail, on_interrupt
-    from percept.longitudinal.dense import DenseConfig, default_num_disparities
+    from percept.longitudinal.dense import DenseConfig
     from percept.sensors.stereo_io import RectifiedStereo
 
     opt.check_number("--scale", scale, 0.05, 1.0)
-    try:  # the matcher's own checks, before any work (the default search range needs the image width)
-        DenseConfig(num_disparities=num_disparities or 16, block_size=block_size)
+    try:  # the matcher's own checks, before any work; the bound set by the width is checked once the pair is read
+        DenseConfig(num_disparities=16 if num_disparities is None else num_disparities, block_size=block_size)
     except ValueError as e:
         fail(f"--{str(e).replace('_', '-')}")
     if out is not None and out.exists() and not out.is_dir():
@@ -68,7 +70,8 @@ def stereo(
         fail(str(e))
     left_img, right_img, truth, rig, s = _inputs(left, right, gt, rig, scale)
     h, w = left_img.shape[:2]
-    cfg = DenseConfig(num_disparities=num_disparities or default_num_disparities(w, rig.ndisp), block_size=block_size)
+    cfg = DenseConfig(num_disparities=_search_range(num_disparities, w, h, s, block_size, rig.ndisp),
+                      block_size=block_size)
     rows = _check_rectified(left_img, right_img)
     results = _run(left_img, right_img, truth, rig, cfg)
     _print_table(results, s, w, h, cfg.num_disparities, truth is not None)
@@ -78,6 +81,29 @@ def stereo(
               "row_matches": rows[1], "note": _note(s, gt is not None)}
     _write(out, json_path, results, {**header, **results["percept"]["metrics"], "outputs": [str(p) for p in outputs],
                                      "methods": {k: {**v["metrics"], "ms": v["ms"]} for k, v in results.items()}})
+
+
+def max_num_disparities(width: int, block_size: int) -> int:
+    """The widest search range [px] OpenCV's StereoSGBM accepts on images ``width`` px wide: the largest multiple
+    of 16, at most 1024, that leaves more than half a block of columns to match, n + block_size // 2 < width."""
+    from percept.longitudinal.dense import MAX_DISPARITIES
+
+    # n + b // 2 < w, n a multiple of 16
+    return min(MAX_DISPARITIES, (width - block_size // 2 - 1) // 16 * 16)
+
+
+def _search_range(num_disparities: Optional[int], w: int, h: int, s: float, block_size: int,
+                  ndisp: Optional[int]) -> int:
+    """The search range [px] for the pair (w x h px at the working scale ``s``): --num-disparities when it is within
+    ``max_num_disparities``, a one-line error when it is wider, else the default cut to that bound."""
+    from percept.cli.common import fail
+    from percept.longitudinal.dense import default_num_disparities
+
+    n_max = max_num_disparities(w, block_size)
+    if num_disparities is not None and num_disparities > n_max:
+        fail(f"--num-disparities must be a multiple of 16 from 16 to {n_max} for these {w}x{h} px images at scale "
+             f"{s:g} with --block-size {block_size}, got {num_disparities}; lower it or raise --scale")
+    return num_disparities if num_disparities is not None else min(default_num_disparities(w, ndisp), n_max)
 
 
 def _note(s: float, with_gt: bool) -> str:

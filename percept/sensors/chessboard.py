@@ -121,11 +121,14 @@ def chessboard_images(folder: Path) -> list[Path]:
     return list_images(folder)
 
 
-def read_gray(path: Path) -> np.ndarray | None:
-    """The photo as a grey image, or None when it cannot be read (missing, not an image, truncated)."""
+def read_gray(path: Path, skipped: Callable[[Path, str], None] | None = None) -> np.ndarray | None:
+    """The photo as a grey image, or None when it cannot be read (missing, empty, truncated, not an image), after
+    telling ``skipped(path, why)`` why."""
     try:
         return read_image(path, gray=True)
-    except ValueError:
+    except ValueError as e:
+        if skipped is not None:
+            skipped(Path(path), str(e))
         return None
 
 
@@ -160,19 +163,21 @@ def calibrate_points(corners: list[np.ndarray], size: tuple[int, int], pattern: 
 
 
 def calibrate_chessboards(paths: Sequence[Path], pattern: tuple[int, int], square_m: float = 1.0,
-                          progress: Callable[[Path, bool], None] | None = None) -> CameraCalibration:
+                          progress: Callable[[Path, bool], None] | None = None,
+                          skipped: Callable[[Path, str], None] | None = None) -> CameraCalibration:
     """Zhang (2000) calibration from photos of a chessboard with ``pattern`` inner corners (cols, rows).
 
     square_m scales the board (it changes no intrinsic). Only photos of the most common size are used: a photo of
     another size (e.g. 1281x721 among 1280x720) is a resized or cropped copy whose pixels do not share the
     intrinsics, and keeping such photos raises the RMS error.
+    ``skipped(path, why)`` hears of each photo that cannot be read (it is left out).
     Raises ValueError when no photo is readable or the board is found in none.
     """
     cols, rows = pattern
     found: list[tuple[tuple[int, int], np.ndarray]] = []
     readable = 0
     for p in paths:
-        img = read_gray(p)
+        img = read_gray(p, skipped)
         corners = None
         if img is not None:
             readable += 1

@@ -134,9 +134,10 @@ def truncation(data: bytes) -> str | None:
     return None
 
 
-def read_image(path: Path, gray: bool = False) -> np.ndarray:
-    """A BGR (H, W, 3) or, with ``gray``, a (H, W) uint8 image (EXIF orientation applied, as cv2.imread does).
-    ValueError when the file is missing, cannot be read or decoded, or is a truncated JPEG or PNG."""
+def decode_image(path: Path, flags: int) -> np.ndarray:
+    """The image in ``path`` decoded with the ``cv2.IMREAD_*`` ``flags`` (EXIF orientation applied, as
+    cv2.imread does); ValueError "cannot read PATH as an image ..." when the file is missing, empty, unreadable,
+    a truncated JPEG or PNG, or anything OpenCV cannot decode."""
     path = Path(path)
     if not path.exists():
         raise ValueError(f"{path} does not exist")
@@ -146,13 +147,23 @@ def read_image(path: Path, gray: bool = False) -> np.ndarray:
         data = path.read_bytes()
     except OSError as e:
         raise ValueError(f"cannot read {path} ({e.strerror or e})") from None
+    if not data:
+        raise ValueError(f"cannot read {path} as an image: the file is empty (0 bytes); copy it again")
     why = truncation(data)
     if why is not None:
         raise ValueError(f"cannot read {path} as an image: the file is truncated ({why}); copy it again")
-    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE if gray else cv2.IMREAD_COLOR)
-    if img is None:
+    try:
+        img = cv2.imdecode(np.frombuffer(data, np.uint8), flags)
+    except cv2.error:
+        img = None
+    if img is None or img.size == 0:
         raise ValueError(f"cannot read {path} as an image (not an image file, or a format this OpenCV cannot decode)")
     return img
+
+
+def read_image(path: Path, gray: bool = False) -> np.ndarray:
+    """A BGR (H, W, 3) or, with ``gray``, a (H, W) uint8 image; ValueError as ``decode_image``."""
+    return decode_image(path, cv2.IMREAD_GRAYSCALE if gray else cv2.IMREAD_COLOR)
 
 
 class VideoReader:

@@ -29,15 +29,22 @@ from .chessboard import (MIN_VIEWS, CameraCalibration, board_points, calibrate_p
                          find_corners, read_gray)
 
 
-def stereo_pairs(folder: Path) -> list[tuple[Path, Path]]:
-    """(left, right) photo pairs in ``folder``: files named left<X> and right<X> with the same <X> (e.g.
-    left01.jpg, right01.jpg); ValueError when there are none."""
+def stereo_photos(folder: Path) -> tuple[list[tuple[Path, Path]], list[Path]]:
+    """(pairs, unpaired) of the photos in ``folder``: (left, right) pairs are files named left<X> and right<X>
+    with the same <X> (e.g. left01.jpg, right01.jpg); unpaired are the other photos, sorted by name.
+    ValueError when there is no pair."""
     files = {p.name.lower(): p for p in chessboard_images(folder)}
     pairs = [(p, files["right" + name[4:]]) for name, p in sorted(files.items())
              if name.startswith("left") and "right" + name[4:] in files]
     if not pairs:
         raise ValueError(f"{folder} holds no stereo pairs: name them left<N>.<ext> and right<N>.<ext>")
-    return pairs
+    paired = {p for pair in pairs for p in pair}
+    return pairs, [p for _, p in sorted(files.items()) if p not in paired]
+
+
+def stereo_pairs(folder: Path) -> list[tuple[Path, Path]]:
+    """The (left, right) photo pairs of ``stereo_photos``; ValueError when there are none."""
+    return stereo_photos(folder)[0]
 
 
 @dataclass(frozen=True)
@@ -85,14 +92,20 @@ def _epipolar_error(pl: np.ndarray, pr: np.ndarray, left: CameraCalibration, rig
 
 
 def calibrate_stereo(pairs: list[tuple[Path, Path]], pattern: tuple[int, int], square_m: float = 1.0,
-                     progress: Callable[[Path, bool], None] | None = None) -> StereoCalibration:
+                     progress: Callable[[Path, bool], None] | None = None,
+                     skipped: Callable[[Path, str], None] | None = None) -> StereoCalibration:
     """Calibrate a stereo rig from (left, right) chessboard photos; only pairs with the board found in both
-    images, of the most common size (as for one camera), are used. ValueError when fewer than MIN_VIEWS remain."""
+    images, of the most common size (as for one camera), are used; ``skipped(path, why)`` hears of each pair left
+    out for an unreadable photo or two sizes. ValueError when fewer than MIN_VIEWS remain."""
     obj = board_points(pattern, square_m)
     found: list[tuple[tuple[int, int], np.ndarray, np.ndarray]] = []
     for lp, rp in pairs:
-        imgs = [read_gray(p) for p in (lp, rp)]
-        ok = all(im is not None for im in imgs) and imgs[0].shape == imgs[1].shape
+        imgs = [read_gray(p, skipped) for p in (lp, rp)]
+        readable = all(im is not None for im in imgs)
+        ok = readable and imgs[0].shape == imgs[1].shape
+        if readable and not ok and skipped is not None:
+            skipped(lp, f"{lp} is {imgs[0].shape[1]}x{imgs[0].shape[0]} px but {rp.name} is "
+                        f"{imgs[1].shape[1]}x{imgs[1].shape[0]} px")
         corners = [find_corners(im, pattern) for im in imgs] if ok else [None, None]
         ok = ok and all(c is not None for c in corners)
         if ok:

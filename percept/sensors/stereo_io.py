@@ -31,6 +31,8 @@ from typing import Optional
 import cv2
 import numpy as np
 
+from .footage import decode_image
+
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
 
@@ -221,9 +223,10 @@ def read_disparity(path: Path | str) -> np.ndarray:
         elif suffix == ".npy":
             d = np.load(path, allow_pickle=False)
         elif suffix == ".pfm":
-            d = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-            if d is None:
-                raise ValueError("not a PFM image this OpenCV can decode")
+            try:
+                d = decode_image(path, cv2.IMREAD_UNCHANGED)
+            except ValueError:
+                raise ValueError("not a whole PFM image this OpenCV can decode") from None
         else:
             raise ValueError("unknown kind; give a .npz, .npy or .pfm disparity map")
     except ValueError as e:
