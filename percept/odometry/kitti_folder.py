@@ -24,7 +24,7 @@ from typing import Optional
 import cv2
 import numpy as np
 
-from percept.sensors.footage import list_images
+from percept.sensors.footage import decode_image, list_images
 
 from .trajectory_io import read_kitti_poses
 
@@ -96,9 +96,7 @@ def _image_size(path: Path) -> tuple[int, int]:
         head = f.read(24)
     if head[:8] == _PNG and head[12:16] == b"IHDR":
         return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
-    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise ValueError(f"cannot read {path} as an image")
+    img = decode_image(path, cv2.IMREAD_UNCHANGED)
     return img.shape[1], img.shape[0]
 
 

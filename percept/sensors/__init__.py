@@ -3,8 +3,8 @@
 from .boxes import check_boxes, iou, iou_matrix
 from .camera import PinholeCamera
 from .chessboard import CameraCalibration, calibrate_chessboards, chessboard_images, parse_pattern
-from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, VideoReader, list_footage,
-                      list_images, open_video, read_image)
+from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, VideoReader, decode_image,
+                      list_footage, list_images, open_video, read_image)
 from .ego_motion import (MAX_ACCEL_MPS2, MAX_SPEED_MPS, MAX_YAW_RATE_RPS, MIN_SPEED_MPS, EgoMotion, EgoMotionGate,
                          as_sample, plausible_accel, plausible_speed, plausible_yaw_rate)
 from .frame import FRAME_RATE_HZ, Frame, ImuSample, to_gray
@@ -13,9 +13,10 @@ from .poses import Pose2D, Transform, rot_z, rotate_to_vehicle, wrap_angle
 from .rig import Side, StereoRig
 
 __all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "ObjectKind", "PoseEstimate", "Source",
-           "IMAGE_SUFFIXES", "VIDEO_SUFFIXES", "FootageKind", "Undistorter", "VideoReader", "list_footage",
-           "list_images", "open_video", "read_image",
-           "CameraCalibration", "FRAME_RATE_HZ", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig", "Transform",
+           "IMAGE_SUFFIXES", "VIDEO_SUFFIXES", "FootageKind", "Undistorter", "VideoReader", "decode_image",
+           "list_footage", "list_images", "open_video", "read_image",
+           "CameraCalibration", "FRAME_RATE_HZ", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig",
+           "Transform",
            "calibrate_chessboards", "check_boxes", "chessboard_images", "iou", "iou_matrix", "parse_pattern", "rot_z",
            "rotate_to_vehicle", "to_gray", "wrap_angle",
            "MAX_ACCEL_MPS2", "MAX_SPEED_MPS", "MAX_YAW_RATE_RPS", "MIN_SPEED_MPS", "EgoMotion", "EgoMotionGate",
