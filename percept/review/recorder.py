@@ -247,8 +247,8 @@ class RunRecorder:
             self._watched_at = time.monotonic()
             free = free_bytes(self.tmp.parent)
             if free < RESERVE_BYTES:
-                self.failed = no_space(self.path, f"its disk is full ({size_text(free)} free); the recording was "
-                                                  f"not kept")
+                self.failed = no_space(self.path, f"its disk has filled up ({size_text(free)} free); the "
+                                                  f"recording was not kept")
                 self._drop()
         if self.failed is not None:
             raise self.failed
