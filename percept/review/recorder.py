@@ -67,6 +67,8 @@ MARGIN_BYTES = 16 << 20
 RESERVE_BYTES = 4 << 20
 """Free space below which a run stops recording: Rerun's file writer must never meet a full disk, since after a
 failed write its calls can block the process beyond the reach of Ctrl-C [bytes]."""
+FLUSH_TIMEOUT_S = 30.0
+"""Longest wait for the stream's last chunks to reach the disk when the run ends [s]."""
 WATCH_S = 1.0
 """Wall time between two looks at the free space of the recording's disk [s]."""
 
@@ -310,7 +312,9 @@ class RunRecorder:
         try:
             try:
                 self.buffer.flush(self.rec)
-                self.rec.flush()
+                self.rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
+            except RuntimeError as e:  # the writer met a full disk between two looks, or hangs
+                raise OSError(f"Rerun could not write the end of the stream ({e})") from None
             finally:
                 self.rec.disconnect()
             if complete:
