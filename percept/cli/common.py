@@ -3,6 +3,7 @@ and the start-up of the console script (quiet libraries, Ctrl-C as one line and 
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import signal
@@ -156,12 +157,36 @@ def reflow(text: str | None) -> str | None:
     return "\n\n".join(out)
 
 
+DISK_FULL = (errno.ENOSPC, errno.EDQUOT)
+"""The errors of a disk that holds no more: a one-line error wherever a command meets one."""
+
+
+def disk_full_line(e: OSError) -> str:
+    """The one line for a full disk met during a command: what failed, then what the command's interrupt note
+    (``on_interrupt``) says is kept."""
+    what = e.strerror if e.filename and str(e.filename) in str(e.strerror) else write_error(e.filename, e)
+    try:
+        note = _interrupt["note"]() if callable(_interrupt["note"]) else _interrupt["note"]
+    except Exception:  # noqa: BLE001 - the note must never hide the error itself
+        note = None
+    return f"{what}; {note}" if note else what
+
+
 class Command(_HelpWithoutType, TyperCommand):
-    """The class of every percept command (``app.command(NAME, cls=Command)``); its help reflowed (``reflow``)."""
+    """The class of every percept command (``app.command(NAME, cls=Command)``); its help reflowed (``reflow``); a
+    full disk met while it runs ends it with one line (``disk_full_line``) and exit code 2."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self.help = reflow(self.help)
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except OSError as e:
+            if e.errno not in DISK_FULL:
+                raise
+            fail(disk_full_line(e))
 
 
 class Group(_HelpWithoutType, TyperGroup):

@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from typing import Annotated
 
@@ -81,6 +82,36 @@ def _has_chunks(exe: str, recording: Path) -> bool:
     return found
 
 
+def has_display() -> bool:
+    """Whether a window can be opened: on Linux and the BSDs, an X11 or Wayland display is named in the
+    environment; elsewhere always."""
+    if not sys.platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
+        return True
+    return any(os.environ.get(v) for v in ("DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"))
+
+
+def run_window_viewer(cmd: list[str]) -> tuple[int, str]:
+    """Run the native viewer ``cmd`` with its output (start-up logs, a failure's ``Error:`` line) kept from the
+    terminal: (exit code, its last ``Error:`` line without the prefix, or "")."""
+    with tempfile.TemporaryFile() as log:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        saved = os.dup(1), os.dup(2)
+        try:
+            os.dup2(log.fileno(), 1)
+            os.dup2(log.fileno(), 2)
+            code = subprocess.run(cmd, env=rerun_env()).returncode
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            os.close(saved[0])
+            os.close(saved[1])
+        log.seek(0)
+        lines = log.read().decode("utf-8", "replace").splitlines()
+    why = next((ln.strip().removeprefix("Error: ") for ln in reversed(lines) if ln.startswith("Error: ")), "")
+    return code, why
+
+
 def check_bind(bind: str) -> str:
     """The bind address as given, if it is an IP address (what the rerun CLI's --bind takes)."""
     try:
@@ -120,9 +151,14 @@ def register(app: typer.Typer) -> None:
         cmd = [exe, "--bind", bind, *(["--web-viewer"] if web else []), str(recording)]
         on_interrupt(f"the viewer was closed; {recording} is unchanged")
         try:
-            code = subprocess.run(cmd, env=rerun_env()).returncode
+            # the web viewer prints the address to open: its output stays on the terminal
+            code, why = (subprocess.run(cmd, env=rerun_env()).returncode, "") if web else run_window_viewer(cmd)
         except OSError as e:
             fail(f"cannot start the Rerun viewer ({e.strerror or e})")
+        if code != 0 and not web and not has_display():
+            fail(f"no display to open the viewer's window on (DISPLAY and WAYLAND_DISPLAY are not set); try "
+                 f"`percept view --web {recording}` and open the address it prints")
         if code != 0:
-            fail(f"the Rerun viewer stopped with exit code {code}; without a display, try `percept view --web "
+            why = f" ({why if len(why) <= 120 else why[:119] + '…'})" if why else ""
+            fail(f"the Rerun viewer stopped with exit code {code}{why}; without a display, try `percept view --web "
                  f"{recording}`")

@@ -5,8 +5,9 @@ import os
 # The recorder streams a drive without an RRD footer and adds the footer when the run finishes (``recorder.py``: the
 # footer's manifest would grow in memory through a long drive), and Rerun warns of the missing footer once per file.
 # Its logging reads RUST_LOG when rerun is first imported, here: that one warning is silenced unless the user set
-# RUST_LOG.
-os.environ.setdefault("RUST_LOG", "warn,re_log_encoding::rrd::file_sink=error")
+# RUST_LOG, and so are the file writer's and the stream's reports of a failed write, which the recorder reports
+# itself as one line (``RunRecorder``: the free space is watched).
+os.environ.setdefault("RUST_LOG", "warn,re_log_encoding::rrd::file_sink=off,re_sdk::recording_stream=off")
 
 from .blueprint import blueprint
 from .context import Part, PartContext, Plot, RecordOptions

@@ -17,12 +17,15 @@ replaced by a truncated one.
 
 from __future__ import annotations
 
+import errno
 import importlib
 import importlib.util
 import math
 import os
+import shutil
 import subprocess
 import sys
+import time
 from dataclasses import replace
 from datetime import timedelta
 from pathlib import Path
@@ -53,6 +56,58 @@ entity every 200 ms of wall time) would repeat thousands of times in a file."""
 COLUMNS_FLUSH_S = 10.0
 """Simulated time the per-frame rows (scalars, clears, the ego's transform, trail points, what the parts draw around
 the car) are held before they are sent as columns (``series.ColumnBuffer``: a chunk per entity)."""
+
+
+BASE_BYTES_PER_S = 43e3
+"""What a recording holds each simulated second besides the camera images (scalars, boxes, drawings) [bytes/s]."""
+IMAGE_BYTES = 26e3
+"""One stored JPEG image at the camera's full size and quality 70 or less [bytes]; it scales with the area."""
+MARGIN_BYTES = 16 << 20
+"""Free space asked for beyond the recording itself: two of the batcher's largest chunks [bytes]."""
+RESERVE_BYTES = 4 << 20
+"""Free space below which a run stops recording: Rerun's file writer must never meet a full disk, since after a
+failed write its calls can block the process beyond the reach of Ctrl-C [bytes]."""
+FLUSH_TIMEOUT_S = 30.0
+"""Longest wait for the stream's last chunks to reach the disk when the run ends [s]."""
+WATCH_S = 1.0
+"""Wall time between two looks at the free space of the recording's disk [s]."""
+
+
+def free_bytes(folder: Path) -> int:
+    """Free space for an unprivileged writer on the file system that holds ``folder`` [bytes]."""
+    return shutil.disk_usage(folder).free
+
+
+def expected_bytes(duration_s: float, options: RecordOptions) -> float:
+    """Size of a ``duration_s`` [s] recording with ``options`` [bytes]: near 7 MB a simulated minute at the
+    defaults; JPEG size grows with the image's area, and up to threefold from quality 70 to 100."""
+    quality = 1.0 + 2.0 * max(options.jpeg_quality - 70, 0) / 30
+    # bytes = T * (base + f_img * A_rel * I * quality)
+    return duration_s * (BASE_BYTES_PER_S + options.camera_hz * options.image_scale ** 2 * IMAGE_BYTES * quality)
+
+
+def size_text(n: float) -> str:
+    """A byte count for a message: 56 KB, 2.6 MB, 1.2 GB."""
+    for unit, scale in (("GB", 1e9), ("MB", 1e6)):
+        if n >= scale:
+            return f"{n / scale:.1f} {unit}"
+    return f"{n / 1e3:.0f} KB"
+
+
+def no_space(path: Path, why: str) -> OSError:
+    """The OSError (ENOSPC) of a recording its disk cannot hold; ``why`` (one line) is its text."""
+    return OSError(errno.ENOSPC, f"cannot record to {path}: {why}", str(path))
+
+
+def check_space(path: Path, duration_s: float | None, options: RecordOptions) -> None:
+    """Refuse (``no_space``) before anything is written when the disk of ``path`` cannot hold a ``duration_s`` [s]
+    run's recording twice (the stream, then its compacted copy written beside it by ``finish``) plus a margin."""
+    need = 2 * expected_bytes(duration_s or 0.0, options) + MARGIN_BYTES
+    free = free_bytes(path.parent)
+    if free < need:
+        run = f"a {duration_s:g} s run " if duration_s else "a run "
+        raise no_space(path, f"{size_text(free)} free on its disk, {run}needs about {size_text(need)}; free some "
+                             f"space, store fewer or smaller images (--camera-hz, --camera-scale) or use --no-record")
 
 
 def resolve_part(spec):
@@ -106,14 +161,18 @@ class RunRecorder:
 
     path: the recording (RUN.rrd); rig: the stereo rig; lane_lines: (N, 2) world polylines of the road's lane
     lines [m]; tasks: the slot table entries to draw (each with a ``recorder`` part, or None for none);
-    options: what is stored of the camera. Also a context manager (an exception closes it as partial).
+    options: what is stored of the camera; duration_s: the run's simulated length [s] if known, for the free space
+    checked before anything is written (``check_space``). The free space is watched through the run: below
+    ``RESERVE_BYTES`` the stream is dropped and ``log_step`` raises ``no_space``. Also a context manager (an
+    exception closes it as partial).
     """
 
     def __init__(self, path: Path, rig: StereoRig, lane_lines: list[np.ndarray], tasks,
-                 options: RecordOptions = RecordOptions(), app_id: str = "percept"):
+                 options: RecordOptions = RecordOptions(), app_id: str = "percept", duration_s: float | None = None):
         self.path = Path(path)
         if not self.path.parent.is_dir():
             raise ValueError(f"cannot record to {self.path}: the folder {self.path.parent} does not exist")
+        check_space(self.path, duration_s, options)
         self.tmp = self.path.with_name(f".{self.path.name}.part")
         self.options = options
         self.parts = [(t.name, resolve_part(t.recorder)) for t in tasks if t.recorder is not None]
@@ -126,6 +185,8 @@ class RunRecorder:
         self.rig = rig
         self.closed_as: Path | None = None
         self._bucket: int | None = None
+        self.failed: OSError | None = None
+        self._watched_at = time.monotonic()
         self.tmp.unlink(missing_ok=True)  # left over from a run that was killed
         self.rec = rr.RecordingStream(app_id, batcher_config=rr.ChunkBatcherConfig(**BATCHING))
         # no footer (see the module's docstring)
@@ -161,6 +222,7 @@ class RunRecorder:
 
     def log_step(self, frame, truth, step) -> None:
         """One frame: ``frame`` (Frame), ``truth`` (StepTruth), ``step`` (AgentStep)."""
+        self._watch()
         rec = self.rec
         rec.set_time(TIMELINE, duration=frame.timestamp_s)
         self.buffer.set_time(frame.timestamp_s)
@@ -179,6 +241,24 @@ class RunRecorder:
                 part(rec, ctx, step, step.control, truth)
             else:
                 part(rec, ctx, step.estimates.get(name), step.debug.get(name), truth)
+
+    def _watch(self) -> None:
+        """Every ``WATCH_S``: stop recording (``_drop``) and raise ``no_space`` when the disk is nearly full; after
+        that, every call raises the same error."""
+        if self.failed is None and time.monotonic() - self._watched_at >= WATCH_S:
+            self._watched_at = time.monotonic()
+            free = free_bytes(self.tmp.parent)
+            if free < RESERVE_BYTES:
+                self.failed = no_space(self.path, f"its disk has filled up ({size_text(free)} free); the "
+                                                  f"recording was not kept")
+                self._drop()
+        if self.failed is not None:
+            raise self.failed
+
+    def _drop(self) -> None:
+        """Abandon the stream without flushing or disconnecting it (either, into a full disk, can block for good):
+        the part file is removed, and its space comes back once Rerun's writer lets go of it."""
+        self.tmp.unlink(missing_ok=True)
 
     def _log_image(self, frame) -> bool:
         """Store the left image if this frame starts a new 1 / camera_hz interval; whether it was stored."""
@@ -225,11 +305,16 @@ class RunRecorder:
         written; a finished ``RUN.rrd`` is never touched). Returns where it went; a second call does nothing."""
         if self.closed_as is not None:
             return self.closed_as
+        if self.failed is not None:  # dropped by ``_watch``: nothing to keep, nothing to flush
+            self.tmp.unlink(missing_ok=True)
+            raise self.failed
         target = partial_path(self.path)
         try:
             try:
                 self.buffer.flush(self.rec)
-                self.rec.flush()
+                self.rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
+            except RuntimeError as e:  # the writer met a full disk between two looks, or hangs
+                raise OSError(f"Rerun could not write the end of the stream ({e})") from None
             finally:
                 self.rec.disconnect()
             if complete:

@@ -70,8 +70,8 @@ def test_ctrl_c_while_flushing_never_replaces_a_finished_recording(tmp_path):
     rec = RunRecorder(final, StereoRig(), [], TASKS)
     real_flush = rec.rec.flush
 
-    def interrupted():
-        real_flush()
+    def interrupted(**kw):
+        real_flush(**kw)
         raise KeyboardInterrupt
 
     rec.rec.flush = interrupted
