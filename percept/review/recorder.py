@@ -17,12 +17,10 @@ replaced by a truncated one.
 
 from __future__ import annotations
 
-import errno
 import importlib
 import importlib.util
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
@@ -38,7 +36,7 @@ from percept.outputs import atomic_path
 from percept.sensors import ObjectKind, Side, StereoRig
 from percept.sensors.vehicle import EGO_LENGTH_M, EGO_WIDTH_M
 
-from . import parts
+from . import parts, space
 from .blueprint import TRAJECTORY, blueprint
 from .context import CAMERA, EGO, TIMELINE, Part, PartContext, RecordOptions
 from .series import ColumnBuffer
@@ -58,56 +56,10 @@ COLUMNS_FLUSH_S = 10.0
 the car) are held before they are sent as columns (``series.ColumnBuffer``: a chunk per entity)."""
 
 
-BASE_BYTES_PER_S = 43e3
-"""What a recording holds each simulated second besides the camera images (scalars, boxes, drawings) [bytes/s]."""
-IMAGE_BYTES = 26e3
-"""One stored JPEG image at the camera's full size and quality 70 or less [bytes]; it scales with the area."""
-MARGIN_BYTES = 16 << 20
-"""Free space asked for beyond the recording itself: two of the batcher's largest chunks [bytes]."""
-RESERVE_BYTES = 4 << 20
-"""Free space below which a run stops recording: Rerun's file writer must never meet a full disk, since after a
-failed write its calls can block the process beyond the reach of Ctrl-C [bytes]."""
 FLUSH_TIMEOUT_S = 30.0
 """Longest wait for the stream's last chunks to reach the disk when the run ends [s]."""
 WATCH_S = 1.0
 """Wall time between two looks at the free space of the recording's disk [s]."""
-
-
-def free_bytes(folder: Path) -> int:
-    """Free space for an unprivileged writer on the file system that holds ``folder`` [bytes]."""
-    return shutil.disk_usage(folder).free
-
-
-def expected_bytes(duration_s: float, options: RecordOptions) -> float:
-    """Size of a ``duration_s`` [s] recording with ``options`` [bytes]: near 7 MB a simulated minute at the
-    defaults; JPEG size grows with the image's area, and up to threefold from quality 70 to 100."""
-    quality = 1.0 + 2.0 * max(options.jpeg_quality - 70, 0) / 30
-    # bytes = T * (base + f_img * A_rel * I * quality)
-    return duration_s * (BASE_BYTES_PER_S + options.camera_hz * options.image_scale ** 2 * IMAGE_BYTES * quality)
-
-
-def size_text(n: float) -> str:
-    """A byte count for a message: 56 KB, 2.6 MB, 1.2 GB."""
-    for unit, scale in (("GB", 1e9), ("MB", 1e6)):
-        if n >= scale:
-            return f"{n / scale:.1f} {unit}"
-    return f"{n / 1e3:.0f} KB"
-
-
-def no_space(path: Path, why: str) -> OSError:
-    """The OSError (ENOSPC) of a recording its disk cannot hold; ``why`` (one line) is its text."""
-    return OSError(errno.ENOSPC, f"cannot record to {path}: {why}", str(path))
-
-
-def check_space(path: Path, duration_s: float | None, options: RecordOptions) -> None:
-    """Refuse (``no_space``) before anything is written when the disk of ``path`` cannot hold a ``duration_s`` [s]
-    run's recording twice (the stream, then its compacted copy written beside it by ``finish``) plus a margin."""
-    need = 2 * expected_bytes(duration_s or 0.0, options) + MARGIN_BYTES
-    free = free_bytes(path.parent)
-    if free < need:
-        run = f"a {duration_s:g} s run " if duration_s else "a run "
-        raise no_space(path, f"{size_text(free)} free on its disk, {run}needs about {size_text(need)}; free some "
-                             f"space, store fewer or smaller images (--camera-hz, --camera-scale) or use --no-record")
 
 
 def resolve_part(spec):
@@ -162,8 +114,8 @@ class RunRecorder:
     path: the recording (RUN.rrd); rig: the stereo rig; lane_lines: (N, 2) world polylines of the road's lane
     lines [m]; tasks: the slot table entries to draw (each with a ``recorder`` part, or None for none);
     options: what is stored of the camera; duration_s: the run's simulated length [s] if known, for the free space
-    checked before anything is written (``check_space``). The free space is watched through the run: below
-    ``RESERVE_BYTES`` the stream is dropped and ``log_step`` raises ``no_space``. Also a context manager (an
+    checked before anything is written (``space.check_space``). The free space is watched through the run: below
+    ``space.RESERVE_BYTES`` the stream is dropped and ``log_step`` raises ``space.no_space``. Also a context manager (an
     exception closes it as partial).
     """
 
@@ -172,7 +124,7 @@ class RunRecorder:
         self.path = Path(path)
         if not self.path.parent.is_dir():
             raise ValueError(f"cannot record to {self.path}: the folder {self.path.parent} does not exist")
-        check_space(self.path, duration_s, options)
+        space.check_space(self.path, duration_s, options)
         self.tmp = self.path.with_name(f".{self.path.name}.part")
         self.options = options
         self.parts = [(t.name, resolve_part(t.recorder)) for t in tasks if t.recorder is not None]
@@ -247,9 +199,9 @@ class RunRecorder:
         that, every call raises the same error."""
         if self.failed is None and time.monotonic() - self._watched_at >= WATCH_S:
             self._watched_at = time.monotonic()
-            free = free_bytes(self.tmp.parent)
-            if free < RESERVE_BYTES:
-                self.failed = no_space(self.path, f"its disk has filled up ({size_text(free)} free); the "
+            free = space.free_bytes(self.tmp.parent)
+            if free < space.RESERVE_BYTES:
+                self.failed = space.no_space(self.path, f"its disk has filled up ({space.size_text(free)} free); the "
                                                   f"recording was not kept")
                 self._drop()
         if self.failed is not None:

@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 from percept.cli import app
 from percept.review import RecordOptions
 from percept.review import recorder as rec_mod
+from percept.review import space as space_mod
 
 runner = CliRunner()
 END_S = 10.0
@@ -36,21 +37,21 @@ def assert_untouched(folder: Path, old: dict[Path, bytes], extra: tuple[str, ...
 
 
 def test_a_recording_needs_about_7_mb_a_simulated_minute_at_the_defaults():
-    assert 6e6 < rec_mod.expected_bytes(60.0, RecordOptions()) < 8e6
-    assert 20e6 < rec_mod.expected_bytes(60.0, RecordOptions(15.0, 70, 1.0)) < 30e6
+    assert 6e6 < space_mod.expected_bytes(60.0, RecordOptions()) < 8e6
+    assert 20e6 < space_mod.expected_bytes(60.0, RecordOptions(15.0, 70, 1.0)) < 30e6
 
 
 def test_the_space_check_names_the_free_space_and_the_need(tmp_path, monkeypatch):
-    monkeypatch.setattr(rec_mod, "free_bytes", lambda folder: 3_000_000)
+    monkeypatch.setattr(space_mod, "free_bytes", lambda folder: 3_000_000)
     with pytest.raises(OSError) as e:
-        rec_mod.check_space(tmp_path / "x.rrd", 600.0, RecordOptions())
+        space_mod.check_space(tmp_path / "x.rrd", 600.0, RecordOptions())
     assert "3.0 MB free" in str(e.value) and "a 600 s run needs about 156.1 MB" in str(e.value)
 
 
 @pytest.mark.slow
 def test_drive_refuses_a_disk_without_room_in_one_line(tmp_path, monkeypatch, one_line_error):
     old = old_outputs(tmp_path)
-    monkeypatch.setattr(rec_mod, "free_bytes", lambda folder: 56_000)
+    monkeypatch.setattr(space_mod, "free_bytes", lambda folder: 56_000)
     r = runner.invoke(app, [*DRIVE, "--duration", "2", "--record", str(tmp_path / "x.rrd"),
                             "--json", str(tmp_path / "x.json")])
     one_line_error(r, "56 KB free on its disk")
@@ -70,7 +71,7 @@ def test_a_disk_that_fills_mid_drive_ends_it_in_one_line_leaving_nothing(tmp_pat
             full_at.append(time.monotonic())
         return 1 << 40 if not full_at else 0
 
-    monkeypatch.setattr(rec_mod, "free_bytes", free)
+    monkeypatch.setattr(space_mod, "free_bytes", free)
     monkeypatch.setattr(rec_mod, "WATCH_S", 0.5)
     r = runner.invoke(app, [*DRIVE, "--duration", "120", "--record", str(tmp_path / "x.rrd"),
                             "--json", str(tmp_path / "x.json")])
