@@ -11,6 +11,7 @@ exception propagates; whatever the target held before is left untouched.
 - ``atomic_path``: a context manager yielding a temporary path (same suffix as the target, so libraries that pick
   a format by extension work) for writers that need a file name (``cv2.VideoWriter``); renamed into place only
   when the block completes without an exception.
+- ``folder_lock``: a context manager that makes one process the only writer of a folder for as long as it runs.
 
 A leaf module: it imports nothing from percept, so every package may use it.
 """
@@ -21,10 +22,13 @@ import contextlib
 import json
 import os
 import signal
+import socket
+import sys
 import tempfile
 import threading
+import time
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Any, Callable, Iterator, Mapping
 
 _CHUNK = 1 << 20
 _os_write = os.write
@@ -195,3 +199,128 @@ def npy_bytes(array) -> bytes:
     buf = io.BytesIO()
     np.save(buf, array)
     return buf.getvalue()
+
+
+LOCK_NAME = ".percept-lock"
+"""The owner file of a folder that a command is writing (``folder_lock``)."""
+
+
+class FolderBusy(ValueError):
+    """Another live process is writing the folder; the message names it."""
+
+
+@contextlib.contextmanager
+def folder_lock(folder: Path | str, command: str, warn: Callable[[str], None] = lambda line: None) -> Iterator[Path]:
+    """Be the only writer of ``folder`` (created if missing) for the block: ``folder/.percept-lock`` holds the pid,
+    host, start time and ``command``, and its file lock is held while the block runs. FolderBusy when a process
+    that still runs (or one on another host) owns the folder; a lock left by a process that no longer runs on this
+    host is taken over, saying so through ``warn``. The owner file is removed however the block ends."""
+    folder = Path(folder)
+    made = not folder.exists()
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = folder / LOCK_NAME
+    me = {"pid": os.getpid(), "host": socket.gethostname(), "command": command, "argv": sys.argv,
+          "started": time.strftime("%Y-%m-%d %H:%M:%S")}
+    with _stop_signals_held():
+        fd = _take_lock(lock, me, folder, warn)
+    try:
+        yield lock
+    finally:
+        with _stop_signals_held():
+            try:
+                if _same_file(fd, lock):
+                    lock.unlink()
+            finally:
+                os.close(fd)
+            if made:
+                with contextlib.suppress(OSError):
+                    folder.rmdir()  # only when the command left it empty
+
+
+def _take_lock(lock: Path, me: dict, folder: Path, warn: Callable[[str], None]) -> int:
+    """The open, file-locked owner file of ``folder``, written with ``me``: made new (written, locked, then linked
+    into place so that no one reads it half-written) or taken over from a process that no longer runs."""
+    import fcntl
+
+    for _ in range(50):  # another process may take or drop the lock between the steps below
+        fd, tmp = _temporary(lock)
+        try:
+            _write_all(fd, json.dumps(me).encode())
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            os.link(tmp, lock)
+            return fd
+        except FileExistsError:
+            os.close(fd)
+        finally:
+            tmp.unlink(missing_ok=True)
+        owner = _read_owner(lock)
+        if owner is None:
+            continue
+        if owner.get("host") != me["host"] or _running(owner.get("pid")):
+            raise FolderBusy(f"{folder} is being written by {_describe(owner)}; wait for it or choose another --out")
+        fd = _take_over(lock, owner, me)
+        if fd is not None:
+            warn(f"{lock} was left by {_describe(owner)}, which no longer runs; taking the folder over")
+            return fd
+    raise FolderBusy(f"{folder} is being locked and unlocked by other processes; try again or choose another --out")
+
+
+def _take_over(lock: Path, owner: dict, me: dict) -> int | None:
+    """The stale owner file, locked and rewritten with ``me``; None when another process got there first."""
+    import fcntl
+
+    try:
+        fd = os.open(lock, os.O_RDWR)
+    except FileNotFoundError:
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        if not _same_file(fd, lock) or _read_owner(lock) != owner:
+            raise BlockingIOError
+        os.ftruncate(fd, 0)
+        os.lseek(fd, 0, os.SEEK_SET)
+        _write_all(fd, json.dumps(me).encode())
+        return fd
+    except BlockingIOError:
+        os.close(fd)
+        return None
+
+
+def _read_owner(lock: Path) -> dict | None:
+    """The owner written in ``lock``; None when it is gone. A file that is not an owner record counts as one from
+    a process that no longer runs."""
+    try:
+        owner = json.loads(lock.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        owner = None
+    return owner if isinstance(owner, dict) else {"pid": None, "host": socket.gethostname(), "command": "?"}
+
+
+def _running(pid) -> bool:
+    """Whether process ``pid`` runs on this host."""
+    if not isinstance(pid, int) or pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def _same_file(fd: int, path: Path) -> bool:
+    """Whether ``path`` is still the file open as ``fd``."""
+    try:
+        st, ours = os.stat(path), os.fstat(fd)
+    except OSError:
+        return False
+    return (st.st_dev, st.st_ino) == (ours.st_dev, ours.st_ino)
+
+
+def _describe(owner: dict) -> str:
+    """'percept eval (pid 12, started 2026-01-02 03:04:05 on host)' from an owner record."""
+    return (f"{owner.get('command', '?')} (pid {owner.get('pid', '?')}, started {owner.get('started', '?')} on "
+            f"{owner.get('host', '?')})")
