@@ -111,6 +111,9 @@ class LinearModel:
                     raise ValueError(f"model file {path} is not a percept HOG model (not an .npz archive"
                                      f"{', it is empty' if f.tell() == 0 else ''})")
             with np.load(path, allow_pickle=False) as z:
+                if missing := [k for k in ("weights", "bias") if k not in z]:
+                    raise ValueError(f"model file {path} is not a percept HOG model (it has no "
+                                     f"{' and no '.join(missing)} array)")
                 name = "sim" if path == SIM_MODEL_PATH else str(path)
                 second = (cls(np.asarray(z["second_weights"], np.float32), float(z["second_bias"]), f"{name} (second)")
                           if "second_weights" in z else None)
