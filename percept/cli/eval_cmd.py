@@ -56,8 +56,8 @@ def eval_(
     plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector, opt.slot_sources(sources,
                                                                                                        privileged))
     with only_writer(out, "percept eval"):
-        check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
         files = _scan(plan, out, redo)
+        check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
         for path, why in files.damaged:
             err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
         summary = _run(plan, out, workers, eng, address, redo, files)

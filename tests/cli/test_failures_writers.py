@@ -117,7 +117,7 @@ def test_the_lock_is_gone_after_a_failure_and_an_exception(tmp_path, monkeypatch
 @pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="needs signals")
 def test_a_real_second_eval_is_refused_while_the_first_runs_and_ctrl_c_removes_the_lock(tmp_path, one_line_error):
     out = tmp_path / "ev"
-    first = subprocess.Popen([sys.executable, "-m", "percept", "eval", "--scenario", "lead-brake", "--seeds", "0-3",
+    first = subprocess.Popen([sys.executable, "-m", "percept", "eval", "--scenario", "lead-brake", "--seeds", "0-99",
                               "--duration", "1", "--out", str(out)], cwd=tmp_path, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
     try:
