@@ -201,8 +201,7 @@ def npy_bytes(array) -> bytes:
     return buf.getvalue()
 
 
-LOCK_NAME = ".percept-lock"
-"""The owner file of a folder that a command is writing (``folder_lock``)."""
+LOCK_NAME = ".percept-lock"  # the owner file of a folder that a command is writing (``folder_lock``)
 
 
 class FolderBusy(ValueError):
@@ -212,115 +211,88 @@ class FolderBusy(ValueError):
 @contextlib.contextmanager
 def folder_lock(folder: Path | str, command: str, warn: Callable[[str], None] = lambda line: None) -> Iterator[Path]:
     """Be the only writer of ``folder`` (created if missing) for the block: ``folder/.percept-lock`` holds the pid,
-    host, start time and ``command``, and its file lock is held while the block runs. FolderBusy when a process
-    that still runs (or one on another host) owns the folder; a lock left by a process that no longer runs on this
-    host is taken over, saying so through ``warn``. The owner file is removed however the block ends."""
+    host, start time and ``command`` and is file-locked meanwhile. FolderBusy when a live process (or one on another
+    host) owns it; one left by a process that no longer runs here is taken over, said through ``warn``. The owner
+    file is removed however the block ends."""
     folder = Path(folder)
-    made = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
     lock = folder / LOCK_NAME
-    me = {"pid": os.getpid(), "host": socket.gethostname(), "command": command, "argv": sys.argv,
-          "started": time.strftime("%Y-%m-%d %H:%M:%S")}
+    me = json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "command": command, "argv": sys.argv,
+                     "started": time.strftime("%Y-%m-%d %H:%M:%S")}).encode()
     with _stop_signals_held():
-        fd = _take_lock(lock, me, folder, warn)
+        fd = _take_lock(lock, me, warn)
     try:
         yield lock
     finally:
         with _stop_signals_held():
-            try:
-                if _same_file(fd, lock):
-                    lock.unlink()
-            finally:
-                os.close(fd)
-            if made:
-                with contextlib.suppress(OSError):
-                    folder.rmdir()  # only when the command left it empty
+            if _same_file(fd, lock):
+                lock.unlink(missing_ok=True)
+            os.close(fd)
 
 
-def _take_lock(lock: Path, me: dict, folder: Path, warn: Callable[[str], None]) -> int:
-    """The open, file-locked owner file of ``folder``, written with ``me``: made new (written, locked, then linked
-    into place so that no one reads it half-written) or taken over from a process that no longer runs."""
+def _take_lock(lock: Path, me: bytes, warn: Callable[[str], None]) -> int:
+    """The open, file-locked owner file ``lock`` holding ``me``: made (linked into place once written) or taken over."""
     import fcntl
 
     for _ in range(50):  # another process may take or drop the lock between the steps below
         fd, tmp = _temporary(lock)
         try:
-            _write_all(fd, json.dumps(me).encode())
+            _write_all(fd, me)
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             os.link(tmp, lock)
             return fd
-        except FileExistsError:
+        except BaseException as e:
             os.close(fd)
+            if not isinstance(e, FileExistsError):
+                raise
         finally:
             tmp.unlink(missing_ok=True)
-        owner = _read_owner(lock)
-        if owner is None:
+        if (owner := _read_owner(lock)) is None:
             continue
-        if owner.get("host") != me["host"] or _running(owner.get("pid")):
-            raise FolderBusy(f"{folder} is being written by {_describe(owner)}; wait for it or choose another --out")
-        fd = _take_over(lock, owner, me)
-        if fd is not None:
-            warn(f"{lock} was left by {_describe(owner)}, which no longer runs; taking the folder over")
-            return fd
-    raise FolderBusy(f"{folder} is being locked and unlocked by other processes; try again or choose another --out")
-
-
-def _take_over(lock: Path, owner: dict, me: dict) -> int | None:
-    """The stale owner file, locked and rewritten with ``me``; None when another process got there first."""
-    import fcntl
-
-    try:
-        fd = os.open(lock, os.O_RDWR)
-    except FileNotFoundError:
-        return None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        if not _same_file(fd, lock) or _read_owner(lock) != owner:
-            raise BlockingIOError
-        os.ftruncate(fd, 0)
-        os.lseek(fd, 0, os.SEEK_SET)
-        _write_all(fd, json.dumps(me).encode())
-        return fd
-    except BlockingIOError:
-        os.close(fd)
-        return None
+        who = (f"{owner.get('command', '?')} (pid {owner.get('pid', '?')}, started {owner.get('started', '?')} on "
+               f"{owner.get('host', '?')})")
+        if owner.get("host") != socket.gethostname() or _running(owner.get("pid")):
+            raise FolderBusy(f"{lock.parent} is being written by {who}; wait for it or choose another --out")
+        with contextlib.suppress(FileNotFoundError):
+            fd = os.open(lock, os.O_RDWR)
+            try:
+                # a live owner holds the file lock: getting it, on the same file and owner, proves the owner gone
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                if _same_file(fd, lock) and _read_owner(lock) == owner:
+                    os.ftruncate(fd, 0)
+                    os.pwrite(fd, me, 0)
+                    warn(f"{lock} was left by {who}, which no longer runs; taking the folder over")
+                    return fd
+            except BlockingIOError:
+                pass
+            os.close(fd)
+    raise FolderBusy(f"{lock.parent} is being locked and unlocked by other processes; choose another --out")
 
 
 def _read_owner(lock: Path) -> dict | None:
-    """The owner written in ``lock``; None when it is gone. A file that is not an owner record counts as one from
-    a process that no longer runs."""
+    """The owner record in ``lock``; None when it is gone. Any other content counts as a stopped process's."""
     try:
         owner = json.loads(lock.read_text(encoding="utf-8"))
     except FileNotFoundError:
         return None
     except (OSError, ValueError):
         owner = None
-    return owner if isinstance(owner, dict) else {"pid": None, "host": socket.gethostname(), "command": "?"}
+    return owner if isinstance(owner, dict) else {"pid": "?", "host": socket.gethostname(), "command": "unknown"}
 
 
 def _running(pid) -> bool:
-    """Whether process ``pid`` runs on this host."""
-    if not isinstance(pid, int) or pid <= 0:
-        return False
+    """Whether process ``pid`` runs on this host (another user's process counts)."""
     try:
         os.kill(pid, 0)
-    except ProcessLookupError:
+    except (ProcessLookupError, OverflowError, TypeError):
         return False
-    except PermissionError:  # another user's process
-        return True
-    return True
+    except PermissionError:
+        pass
+    return isinstance(pid, int) and pid > 0
 
 
 def _same_file(fd: int, path: Path) -> bool:
     """Whether ``path`` is still the file open as ``fd``."""
-    try:
-        st, ours = os.stat(path), os.fstat(fd)
-    except OSError:
-        return False
-    return (st.st_dev, st.st_ino) == (ours.st_dev, ours.st_ino)
-
-
-def _describe(owner: dict) -> str:
-    """'percept eval (pid 12, started 2026-01-02 03:04:05 on host)' from an owner record."""
-    return (f"{owner.get('command', '?')} (pid {owner.get('pid', '?')}, started {owner.get('started', '?')} on "
-            f"{owner.get('host', '?')})")
+    with contextlib.suppress(OSError):
+        return os.path.samestat(os.stat(path), os.fstat(fd))
+    return False

@@ -149,7 +149,7 @@ def test_folder_lock_refuses_a_second_holder_in_the_same_process_and_releases(tm
             with folder_lock(tmp_path / "d", "percept eval"):
                 pass
         assert lock.exists()
-    assert not (tmp_path / "d").exists()  # made for the lock and left empty: removed with it
+    assert list((tmp_path / "d").iterdir()) == []
 
 
 def test_folder_lock_takes_over_an_unreadable_owner_file(tmp_path):
