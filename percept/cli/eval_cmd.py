@@ -51,7 +51,8 @@ def eval_(
     Each finished run is written at once (complete or absent), so an interrupted batch keeps its runs and the
     same command resumes it. A run is reused only if it was made with the same settings (slots, duration, percept
     version); a damaged run file is listed and driven again. A run that fails is listed with its error, the others
-    go on, and the exit code is 1.
+    go on, and the exit code is 1. While it runs, --out holds .percept-lock (its pid, host and command line): a
+    second command writing there is refused at once, and a lock left by a process that no longer runs is taken over.
     """
     plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector, opt.slot_sources(sources,
                                                                                                        privileged))
