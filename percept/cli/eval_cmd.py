@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
-from typing import Annotated, List, Optional
+from typing import Annotated, Iterator, List, Optional
 
 import typer
 from rich import box
@@ -50,27 +51,48 @@ def eval_(
     Each finished run is written at once (complete or absent), so an interrupted batch keeps its runs and the
     same command resumes it. A run is reused only if it was made with the same settings (slots, duration, percept
     version); a damaged run file is listed and driven again. A run that fails is listed with its error, the others
-    go on, and the exit code is 1.
+    go on, and the exit code is 1. While it runs, --out holds .percept-lock (its pid, host and command line): a
+    second command writing there is refused at once, and a lock left by a process that no longer runs is taken over.
     """
-    plan, eng, files = _plan(scenario, condition, seeds, workers, engine, duration, detector, out, redo,
-                             opt.slot_sources(sources, privileged))
-    check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
-    for path, why in files.damaged:
-        err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
-    summary = _run(plan, out, workers, eng, address, redo, files)
-    console.print(summary_tables(summary, plan.tasks))
-    console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
-                  f"{out / 'summary.md'}; plots in {out / 'plots'}")
-    write_json(json_path, summary)
-    _report_failures(summary, len(plan.jobs), out)
-    if strict:
-        _strict(summary)
+    plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector, opt.slot_sources(sources,
+                                                                                                       privileged))
+    with only_writer(out, "percept eval"):
+        files = _scan(plan, out, redo)
+        check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
+        for path, why in files.damaged:
+            err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
+        summary = _run(plan, out, workers, eng, address, redo, files)
+        console.print(summary_tables(summary, plan.tasks))
+        console.print(f"every metric per scenario and condition: {out / 'summary.csv'}; the report: "
+                      f"{out / 'summary.md'}; plots in {out / 'plots'}")
+        write_json(json_path, summary)
+        _report_failures(summary, len(plan.jobs), out)
+        if strict:
+            _strict(summary)
 
 
-def _plan(scenario, condition, seeds, workers, engine, duration, detector, out: Path, redo: bool, sources):
-    """The checked options as (EvalPlan, Engine, the run files already in --out); one-line exit 2 otherwise."""
+@contextlib.contextmanager
+def only_writer(folder: Path, command: str) -> Iterator[None]:
+    """Hold ``folder``'s lock (``percept.outputs.folder_lock``) for the block: a one-line exit 2 naming the process
+    that writes it already, a warning line when a lock left by a stopped process is taken over."""
+    from percept.outputs import FolderBusy, folder_lock
+
+    def warn(line: str) -> None:
+        err.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True)
+
+    with contextlib.ExitStack() as stack:
+        try:
+            stack.enter_context(folder_lock(folder, command, warn))
+        except FolderBusy as e:
+            fail(str(e))
+        except OSError as e:
+            fail(f"cannot write into {folder}: {e.strerror or e}; choose a folder you can write to")
+        yield
+
+
+def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources):
+    """The checked options as (EvalPlan, Engine), the model file included; one-line exit 2 otherwise."""
     from percept.evaluate.plan import Engine, EvalPlan, parse_seeds
-    from percept.evaluate.resume import refuse_other_settings, scan_runs
     from percept.sims import SCENARIOS
 
     opt.check_number("--workers", workers, 1, 256)
@@ -85,12 +107,23 @@ def _plan(scenario, condition, seeds, workers, engine, duration, detector, out: 
     try:
         plan = EvalPlan(tuple(dict.fromkeys(names)), tuple(dict.fromkeys(condition)), tuple(parse_seeds(seeds)),
                         sources, duration, detector)
+    except ValueError as e:
+        fail(str(e))
+    return plan, eng
+
+
+def _scan(plan, out: Path, redo: bool):
+    """The run files of ``plan`` already in ``out``, read once the folder is this command's; one-line exit 2 when
+    some were made with other settings (and not ``redo``) or a folder is in the way."""
+    from percept.evaluate.resume import refuse_other_settings, scan_runs
+
+    try:
         files = scan_runs(plan, out)
         if not redo:
             refuse_other_settings(files, out)
     except ValueError as e:
         fail(str(e))
-    return plan, eng, files
+    return files
 
 
 def _strict(summary: dict) -> None:

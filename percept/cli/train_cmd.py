@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from . import options as opt
-from .common import check_outputs, console, fail, on_interrupt, progress_bar, write_json
+from .common import check_outputs, console, fail, on_interrupt, progress_bar, write_error, write_json
 
 
 def train_detector(
@@ -53,6 +53,11 @@ def train_detector(
     opt.check_number("--second-threshold", second_threshold, -5.0, 5.0)
     try:
         first = None if first_stage is None else replace(LinearModel.named(first_stage), second=None)
+    except ValueError as e:
+        fail(f"--first-stage: {e}")
+    # the first stage's record is read with its model, not after the training
+    first_record = None if first_stage is None else _first_stage_record(first_stage)
+    try:
         plan = _plan(seeds, every, duration, c, condition, negatives_from, negative_seeds)
     except ValueError as e:
         fail(str(e))
@@ -65,7 +70,8 @@ def train_detector(
             model, record = train_people_model(plan, tick=lambda: bar.advance(task))
         except ValueError as e:
             fail(str(e))
-    _save(model, record, plan, out, record_path, seeds, negative_seeds, first, first_stage, second_threshold)
+    _save(model, record, plan, out, record_path, seeds, negative_seeds, first, first_stage, second_threshold,
+          first_record)
 
 
 def _plan(seeds: str, every: int, duration, c: float, condition, negatives_from, negative_seeds: str):
@@ -81,9 +87,9 @@ def _plan(seeds: str, every: int, duration, c: float, condition, negatives_from,
 
 
 def _save(model, record: dict, plan, out: Path, record_path: Path, seeds: str, negative_seeds: str, first,
-          first_stage: str | None, second_threshold: float) -> None:
-    """Write the model (as a cascade's second stage behind ``first`` when given) and its training record; say
-    what was trained."""
+          first_stage: str | None, second_threshold: float, first_record: dict | None) -> None:
+    """Write the model (as a cascade's second stage behind ``first`` when given, ``first_record`` the first stage's
+    training record) and its training record; say what was trained."""
     traffic = (f"; hard negatives also from {', '.join(plan.negative_scenarios)} seeds {negative_seeds}"
                if plan.negative_scenarios else "")
     meta = {"trained_on": f"{plan.scenario} seeds {seeds}, conditions {', '.join(plan.conditions)}, every "
@@ -91,8 +97,11 @@ def _save(model, record: dict, plan, out: Path, record_path: Path, seeds: str, n
     if first is not None:
         meta["cascade"] = f"second stage of {first_stage} (its first stage), at a score of {second_threshold:g}"
         model = replace(first, second=model, second_threshold=second_threshold)
-        record["first_stage_record"] = _first_stage_record(first_stage)
-    model.save(out, **meta)
+        record["first_stage_record"] = first_record
+    try:
+        model.save(out, **meta)
+    except OSError as e:
+        fail(write_error(out, e))
     write_json(record_path, {**record, **meta, "model": str(out)})
     others = f" ({record['hard_negatives_traffic']} from {', '.join(plan.negative_scenarios)})" if traffic else ""
     console.print(f"{record['positives']} positives, {record['random_negatives']} random and "

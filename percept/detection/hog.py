@@ -18,6 +18,7 @@ windows tall (the constrained search's) has most of its blocks in fewer than 15 
 
 from __future__ import annotations
 
+import zipfile
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -105,7 +106,14 @@ class LinearModel:
         """A model saved by ``save`` (an .npz with ``weights`` and ``bias``); ValueError when missing or corrupt."""
         path = Path(path)
         try:
+            with open(path, "rb") as f:
+                if f.read(4) != b"PK\x03\x04":  # every .npz is a zip archive
+                    raise ValueError(f"model file {path} is not a percept HOG model (not an .npz archive"
+                                     f"{', it is empty' if f.tell() == 0 else ''})")
             with np.load(path, allow_pickle=False) as z:
+                if missing := [k for k in ("weights", "bias") if k not in z]:
+                    raise ValueError(f"model file {path} is not a percept HOG model (it has no "
+                                     f"{' and no '.join(missing)} array)")
                 name = "sim" if path == SIM_MODEL_PATH else str(path)
                 second = (cls(np.asarray(z["second_weights"], np.float32), float(z["second_bias"]), f"{name} (second)")
                           if "second_weights" in z else None)
@@ -113,7 +121,11 @@ class LinearModel:
                            float(z["second_threshold"]) if second is not None else 0.0)
         except FileNotFoundError:
             raise ValueError(f"model file {path} does not exist") from None
-        except (OSError, KeyError, ValueError, EOFError) as e:
+        except IsADirectoryError:
+            raise ValueError(f"model file {path} is a folder") from None
+        except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as e:
+            if str(e).startswith(f"model file {path} "):
+                raise
             raise ValueError(f"model file {path} is not a percept HOG model ({type(e).__name__}: {e})") from None
 
     def save(self, path: Path, **meta: str) -> None:

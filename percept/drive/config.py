@@ -49,6 +49,11 @@ class DriveConfig:
         path = LinearModel.file_of(self.detector)
         if path is not None and not path.is_file():
             raise ValueError(f"--detector must be sim, inria or a model file, got '{self.detector}'")
+        if path is not None:
+            try:  # the whole model is read now, so that a bad file stops the command before any run
+                LinearModel.load(path)
+            except ValueError as e:
+                raise ValueError(f"--detector: {e}") from None
 
     def source(self, task: str) -> Source:
         """Where ``task``'s estimate comes from."""
