@@ -253,9 +253,10 @@ def run_cli(app: Callable[..., None]) -> None:
     except KeyboardInterrupt:
         code = 130
     finally:
+        # the command is over: a signal now must not interrupt the last line or the exit
+        for sig in STOP_SIGNALS:
+            signal.signal(sig, signal.SIG_IGN)
         if _interrupt["signal"] is not None:
-            for sig in STOP_SIGNALS:  # the line and the exit are not interrupted in turn
-                signal.signal(sig, signal.SIG_IGN)
             err.print(escape(_interrupt_line()), style="yellow", highlight=False, soft_wrap=True)
             code = 128 + int(_interrupt["signal"])
         restore()

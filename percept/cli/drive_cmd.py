@@ -47,7 +47,7 @@ def drive(
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
     check_outputs([rec_path, rec_path and partial_path(rec_path), json_path])
-    recording = Recording(rec_path, cfg.tasks, camera_hz, camera_quality, camera_scale)
+    recording = Recording(rec_path, cfg, camera_hz, camera_quality, camera_scale)
     with progress_bar() as bar:
         task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)
         try:
@@ -69,13 +69,14 @@ class Recording:
     """The run's recording: options checked before the run, the recorder made once the world exists
     (``open``), closed complete or partial; says what Ctrl-C keeps."""
 
-    def __init__(self, path: Optional[Path], tasks, camera_hz: float, quality: int, scale: float):
+    def __init__(self, path: Optional[Path], cfg, camera_hz: float, quality: int, scale: float):
         from percept.review import RecordOptions
 
         opt.check_number("--camera-hz", camera_hz, 0.01, 1000)
         opt.check_number("--camera-quality", quality, 1, 100)
         opt.check_number("--camera-scale", scale, 0.1, 1)
-        self.path, self.tasks, self.options, self.recorder = path, tasks, RecordOptions(camera_hz, quality, scale), None
+        self.path, self.cfg, self.recorder = path, cfg, None
+        self.options = RecordOptions(camera_hz, quality, scale)
         on_interrupt(self.kept)
 
     def kept(self) -> str:
@@ -90,7 +91,10 @@ class Recording:
         """The recorder of ``world``'s run (``run_drive``'s recorder factory)."""
         from percept.review import RunRecorder
 
-        self.recorder = RunRecorder(self.path, world.cfg.rig, world.road_geometry.lane_lines, self.tasks, self.options)
+        # the run's length, so that the recorder can check its disk holds it before anything is written
+        duration_s = self.cfg.duration_s if self.cfg.duration_s is not None else world.scenario.duration_s
+        self.recorder = RunRecorder(self.path, world.cfg.rig, world.road_geometry.lane_lines, self.cfg.tasks,
+                                    self.options, duration_s=duration_s)
         return self.recorder
 
     def close(self, complete: bool = True) -> None:

@@ -116,13 +116,13 @@ def test_drive_on_a_full_tmpfs_is_refused_in_one_line(tmpfs, tmp_path, one_line_
     p = percept([*DRIVE, "--duration", "20", "--record", str(disk / "x.rrd"), "--json", str(disk / "x.json")],
                 tmp_path)
     out, err = p.communicate(timeout=120)
-    one_line_error(subprocess.CompletedProcess(p.args, p.returncode, out, err), "free on its disk, a run needs")
+    one_line_error(subprocess.CompletedProcess(p.args, p.returncode, out, err), "free on its disk, a 20 s run needs")
     assert_untouched(disk, old)
 
 
 @pytest.mark.slow
 def test_a_tmpfs_that_fills_mid_drive_ends_it_within_the_limit(tmpfs, tmp_path, one_line_error):
-    disk = tmpfs("24m")
+    disk = tmpfs("64m")  # room for the up-front check of a 120 s run, then filled
     old = old_outputs(disk)
     p = percept([*DRIVE, "--duration", "120", "--record", str(disk / "x.rrd"), "--json", str(disk / "x.json")],
                 tmp_path)

@@ -110,9 +110,9 @@ def test_drive_checks_where_an_interrupted_recording_would_go(tmp_path, one_line
 
 def test_drive_says_what_ctrl_c_keeps_at_each_stage(tmp_path):
     from percept.cli.drive_cmd import Recording
-    from percept.drive import TASKS
+    from percept.drive import DriveConfig
 
-    rec = Recording(tmp_path / "r.rrd", TASKS, 5.0, 70, 0.75)
+    rec = Recording(tmp_path / "r.rrd", DriveConfig(), 5.0, 70, 0.75)
     assert rec.kept() == "nothing was written or replaced"  # before the world (and the recorder) exists
     rec.recorder = type("Closed", (), {"closed_as": tmp_path / "r.partial.rrd"})()
     assert rec.kept() == f"the recording so far is kept as {tmp_path / 'r.partial.rrd'}; no JSON was written or " \
