@@ -24,6 +24,7 @@ class Case:
     expect: int = 2  # the exit code the contract asks for
     interrupt_s: float | None = None  # send Ctrl-C this long after the start [s]
     timeout_s: float = 90.0  # a case still running this long is a hang [s]
+    lock_host: str | None = None  # before the run, a writer on this host ("" = this one) owns the folder --out names
 
 
 BAD_IMAGES = ("empty.png", "text.png", "truncated.png", "missing.png", "mixed")
@@ -130,4 +131,11 @@ def interrupt_cases() -> list[Case]:
         (["train-detector", "--out", "m.npz", "--seeds", "1000-1001"], 6.0))]
 
 
-CASES = file_cases() + number_cases() + output_cases() + interrupt_cases()
+def concurrent_cases() -> list[Case]:
+    """A second writer into a folder another process is writing (a live owner here, or one on another host)."""
+    out = ["--scenario", "highway", "--seeds", "0", "--duration", "0.5", "--out", "ev"]
+    return [Case("concurrent", ["eval", *out], lock_host=""), Case("concurrent", ["eval", *out], lock_host="far"),
+            Case("concurrent", ["eval", *out, "--privileged"], lock_host="")]
+
+
+CASES = file_cases() + number_cases() + output_cases() + interrupt_cases() + concurrent_cases()

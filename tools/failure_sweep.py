@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import json
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -74,8 +76,18 @@ def digest(root: Path) -> dict:
             for p in sorted(root.rglob("*")) if p.is_file()}
 
 
+def own_folder(folder: Path, host: str) -> None:
+    """Make ``folder`` look written by a live process: this sweep on this host, or one on ``host``."""
+    folder.mkdir(exist_ok=True)
+    owner = {"pid": os.getpid(), "host": host or socket.gethostname(), "command": "percept eval",
+             "started": "now"}
+    (folder / ".percept-lock").write_text(json.dumps(owner))
+
+
 def run_case(case: Case, root: Path) -> Outcome:
     """Run ``case`` in ``root``; interrupt it after ``case.interrupt_s`` when it names one."""
+    if case.lock_host is not None:
+        own_folder(root / case.args[case.args.index("--out") + 1], case.lock_host)
     before = digest(root)
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "COLUMNS": "100", "RERUN_ANALYTICS": "0"}
     t0 = time.perf_counter()
