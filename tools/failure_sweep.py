@@ -30,7 +30,8 @@ import numpy as np
 from failure_cases import CASES, Case
 
 EXE = [sys.executable, "-m", "percept"]
-TEMPORARY = (".tmp", ".part")
+STOP_S = 2.5
+"""Ctrl-C must end a command this soon [s] (the contract's 2 s, and the signal's delivery)."""
 
 
 @dataclass
@@ -104,11 +105,11 @@ def run_case(case: Case, root: Path) -> Outcome:
         return Outcome(case, -9, "(killed: no answer in time)", time.perf_counter() - t0, ["hung"])
     seconds = time.perf_counter() - t0
     lines = [line for line in out.strip().splitlines() if line.strip()]
-    return Outcome(case, p.returncode, lines[-1] if lines else "", seconds, _problems(case, p.returncode, out,
-                                                                                     before, digest(root), root))
+    problems = _problems(case, p.returncode, out, before, digest(root), root, seconds)
+    return Outcome(case, p.returncode, lines[-1] if lines else "", seconds, problems)
 
 
-def _problems(case: Case, code: int, out: str, before: dict, after: dict, root: Path) -> list:
+def _problems(case: Case, code: int, out: str, before: dict, after: dict, root: Path, seconds: float) -> list:
     """How the case broke the contract (empty when it kept it)."""
     problems = []
     if code != case.expect:
@@ -120,11 +121,12 @@ def _problems(case: Case, code: int, out: str, before: dict, after: dict, root: 
     changed = [str(k) for k, h in before.items() if after.get(k) != h]
     if changed:
         problems.append(f"changed or removed: {', '.join(changed[:3])}")
-    left = [str(p.relative_to(root)) for p in root.rglob("*") if any(t in p.name for t in TEMPORARY)]
+    left = [str(p.relative_to(root)) for p in root.rglob("*")
+            if ".tmp" in p.name or p.name.endswith(".part")]
     if left:
         problems.append(f"left behind: {', '.join(left[:3])}")
-    if case.interrupt_s is not None and code == 130 and case.interrupt_s + 2.5 < time.perf_counter():
-        problems.append("slow to stop")
+    if case.interrupt_s is not None and code == 130 and seconds - case.interrupt_s > STOP_S:
+        problems.append(f"stopped {seconds - case.interrupt_s:.1f} s after Ctrl-C")
     return problems
 
 
