@@ -3,12 +3,13 @@ and the start-up of the console script (quiet libraries, Ctrl-C as one line and 
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import re
 import signal
 import sys
 from pathlib import Path
-from typing import Callable, Iterable, Optional, Union
+from typing import Callable, Iterable, Iterator, Optional, Union
 
 import typer
 from rich.console import Console
@@ -96,6 +97,25 @@ def check_outputs(outputs: Iterable[Optional[Path]], inputs: Iterable[Optional[P
             probe.unlink()
         except OSError as e:
             fail(f"cannot write {p}: {e.strerror or e}; give a path in a folder you can write to")
+
+
+@contextlib.contextmanager
+def only_writer(folder: Path, command: str) -> Iterator[None]:
+    """Hold ``folder``'s lock (``percept.outputs.folder_lock``) for the block: a one-line exit 2 naming the process
+    that writes it already, a warning line when a lock left by a stopped process is taken over."""
+    from percept.outputs import FolderBusy, folder_lock
+
+    def warn(line: str) -> None:
+        err.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True)
+
+    with contextlib.ExitStack() as stack:
+        try:
+            stack.enter_context(folder_lock(folder, command, warn))
+        except FolderBusy as e:
+            fail(str(e))
+        except OSError as e:
+            fail(f"cannot write into {folder}: {e.strerror or e}; choose a folder you can write to")
+        yield
 
 
 def write_json(path: Optional[Path], data: dict) -> None:

@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
-from typing import Annotated, Iterator, List, Optional
+from typing import Annotated, List, Optional
 
 import typer
 from rich import box
@@ -13,7 +12,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from . import options as opt
-from .common import check_outputs, console, err, fail, fmt, on_interrupt, progress_bar, write_json
+from .common import check_outputs, console, err, fail, fmt, on_interrupt, only_writer, progress_bar, write_json
 
 
 def eval_(
@@ -69,25 +68,6 @@ def eval_(
         _report_failures(summary, len(plan.jobs), out)
         if strict:
             _strict(summary)
-
-
-@contextlib.contextmanager
-def only_writer(folder: Path, command: str) -> Iterator[None]:
-    """Hold ``folder``'s lock (``percept.outputs.folder_lock``) for the block: a one-line exit 2 naming the process
-    that writes it already, a warning line when a lock left by a stopped process is taken over."""
-    from percept.outputs import FolderBusy, folder_lock
-
-    def warn(line: str) -> None:
-        err.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True)
-
-    with contextlib.ExitStack() as stack:
-        try:
-            stack.enter_context(folder_lock(folder, command, warn))
-        except FolderBusy as e:
-            fail(str(e))
-        except OSError as e:
-            fail(f"cannot write into {folder}: {e.strerror or e}; choose a folder you can write to")
-        yield
 
 
 def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources):
