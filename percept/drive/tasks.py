@@ -59,6 +59,7 @@ class SlotContext:
     truth: "TruthFeed"  # this frame's ground truth, for privileged slots
     detector: str = "sim"  # people model of the vision pedestrian slot: "sim", "inria" or a model file
     start_pose: Pose2D | None = None  # the known start pose, where odometry starts (None: the origin)
+    rear_rig: StereoRig | None = None  # the rear-facing stereo rig (None: the car has none)
 
 
 @dataclass(frozen=True)

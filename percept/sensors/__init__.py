@@ -8,14 +8,17 @@ from .footage import (IMAGE_SUFFIXES, VIDEO_SUFFIXES, FootageKind, Undistorter, 
 from .ego_motion import (MAX_ACCEL_MPS2, MAX_SPEED_MPS, MAX_YAW_RATE_RPS, MIN_SPEED_MPS, EgoMotion, EgoMotionGate,
                          as_sample, plausible_accel, plausible_speed, plausible_yaw_rate)
 from .frame import FRAME_RATE_HZ, Frame, ImuSample, to_gray
-from .records import BrakingRequest, EgoPath, LandmarkMap, LaneEstimate, Lead, ObjectKind, PoseEstimate, Source
+from .records import (EGO_LENGTH_M, BrakingRequest, EgoPath, LandmarkMap, LaneEstimate, Lead, Neighbour, Neighbours,
+                      ObjectKind, PoseEstimate, Source, Zone)
 from .poses import Pose2D, Transform, rot_z, rotate_to_vehicle, wrap_angle
-from .rig import Side, StereoRig
+from .rig import REAR_MOUNT_X_M, Side, StereoRig, rear_rig
 
-__all__ = ["BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "ObjectKind", "PoseEstimate", "Source",
+__all__ = ["EGO_LENGTH_M", "BrakingRequest", "EgoPath", "LandmarkMap", "LaneEstimate", "Lead", "Neighbour", "Neighbours",
+           "ObjectKind", "PoseEstimate", "Source", "Zone",
            "IMAGE_SUFFIXES", "VIDEO_SUFFIXES", "FootageKind", "Undistorter", "VideoReader", "decode_image",
            "list_footage", "list_images", "open_video", "read_image",
-           "CameraCalibration", "FRAME_RATE_HZ", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "Side", "StereoRig",
+           "CameraCalibration", "FRAME_RATE_HZ", "Frame", "ImuSample", "PinholeCamera", "Pose2D", "REAR_MOUNT_X_M", "Side", "StereoRig",
+           "rear_rig",
            "Transform",
            "calibrate_chessboards", "check_boxes", "chessboard_images", "iou", "iou_matrix", "parse_pattern", "rot_z",
            "rotate_to_vehicle", "to_gray", "wrap_angle",

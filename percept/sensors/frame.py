@@ -57,9 +57,10 @@ class Frame:
 
     left, right: (H, W, 3) uint8 BGR images, or None when the frame was dropped;
     timestamp_s: time since the run started [s]; index: frame counter;
-    imu: IMU sample; wheel_speed_mps: speed from the wheel encoders [m/s].
-    ``left_gray`` / ``right_gray``: the images in grey, converted on first use and then shared by every slot that
-    reads them (read-only; None when dropped).
+    imu: IMU sample; wheel_speed_mps: speed from the wheel encoders [m/s];
+    rear_left, rear_right: (H, W, 3) uint8 BGR images of the rear-facing rig, or None (no rear rig, or dropped).
+    ``left_gray`` / ``right_gray`` (and ``rear_left_gray`` / ``rear_right_gray``): the images in grey, converted on
+    first use and then shared by every slot that reads them (read-only; None when dropped).
     """
 
     index: int
@@ -68,10 +69,17 @@ class Frame:
     right: np.ndarray | None
     imu: ImuSample
     wheel_speed_mps: float
+    rear_left: np.ndarray | None = None
+    rear_right: np.ndarray | None = None
 
     @property
     def dropped(self) -> bool:
         return self.left is None or self.right is None
+
+    @property
+    def has_rear(self) -> bool:
+        """Whether the rear rig's pair is in this frame."""
+        return self.rear_left is not None and self.rear_right is not None
 
     @cached_property
     def left_gray(self) -> np.ndarray | None:
@@ -88,3 +96,13 @@ class Frame:
         grey image only now and then (a keyframe, a sign's window) and converts what it reads, so that it shares the
         conversion when there is one but does not pay for a whole image each frame when there is not."""
         return self.__dict__.get("right_gray", self.right)
+
+    @cached_property
+    def rear_left_gray(self) -> np.ndarray | None:
+        """(H, W) uint8, read-only: ``rear_left`` in grey, converted once."""
+        return _read_only_gray(self.rear_left)
+
+    @cached_property
+    def rear_right_gray(self) -> np.ndarray | None:
+        """(H, W) uint8, read-only: ``rear_right`` in grey, converted once."""
+        return _read_only_gray(self.rear_right)

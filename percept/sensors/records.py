@@ -162,3 +162,76 @@ class LandmarkMap:
         items = sorted((int(k), v) for k, v in d.items())
         return cls(tuple(k for k, _ in items), np.array([v for _, v in items], dtype=float).reshape(-1, 3))
 
+
+
+EGO_LENGTH_M = 5.0
+"""The ego's length (highway-env's Vehicle.LENGTH): bumpers 2.5 m ahead of and behind its centre [m]."""
+
+
+class Zone(str, Enum):
+    """Where a neighbour is along the ego: wholly ahead of its front bumper, wholly behind its rear bumper, or
+    overlapping it (beside)."""
+
+    AHEAD = "ahead"
+    BESIDE = "beside"
+    BEHIND = "behind"
+
+
+@dataclass(frozen=True)
+class Neighbour:
+    """One vehicle in the ego lane or a lane beside it, ahead, beside or behind. Along-lane quantities are measured
+    along the ego lane (x forward); lateral ones from the centre of the neighbour's own lane (+ left)."""
+
+    track_id: int  # the tracker's id (the simulator's for the privileged slot)
+    lane: int  # its lane relative to the ego's: -1 right, 0 the ego lane, +1 left
+    zone: Zone  # ahead, beside or behind
+    x_m: float  # its centre's along-lane position from the ego's centre [m] (+ ahead)
+    gap_m: float  # bumper to bumper [m]: ahead its rear to the ego's front, behind the ego's rear to its front; 0 beside
+    rel_speed_mps: float  # d(x_m)/dt [m/s]: its speed less the ego's (+ pulling ahead)
+    lateral_m: float  # its centre's offset from the centre of its lane [m] (+ left)
+    lateral_speed_mps: float  # d(lateral_m)/dt [m/s] (+ left)
+    length_m: float = EGO_LENGTH_M  # its length [m]
+    sigma_x_m: float = 0.0  # 1-sigma of x_m (and so of gap_m) [m]
+    sigma_rel_speed_mps: float = 0.0  # 1-sigma of rel_speed_mps [m/s]
+    sigma_lateral_m: float = 0.0  # 1-sigma of lateral_m [m]
+    camera: str | None = None  # "front" or "rear": the rig that measured it this frame (None: predicted only)
+    box_px: tuple | None = None  # (u0, v0, u1, v1) in that rig's left image [px], or None
+    cut_in: bool = False  # its lateral motion will take it across the boundary into the ego lane
+    time_to_cross_s: float | None = None  # predicted time until its centre reaches that boundary [s] (cut-ins only)
+
+    @property
+    def predicted(self) -> bool:
+        """Whether no camera measured it this frame (in the blind zone beside the ego, or missed)."""
+        return self.camera is None
+
+
+@dataclass(frozen=True)
+class Neighbours:
+    """Every tracked vehicle within ``ahead_m`` ahead and ``behind_m`` behind in the ego lane and the lanes either
+    side, as the neighbours task provides it."""
+
+    tracks: tuple[Neighbour, ...]  # nearest first within each lane
+    ahead_m: float = 80.0  # how far ahead the lanes are covered [m]
+    behind_m: float = 50.0  # how far behind [m]
+    rear: bool = True  # whether the rear rig saw this frame (False: behind is covered by prediction only)
+
+    def in_lane(self, lane: int) -> tuple[Neighbour, ...]:
+        """The tracks in ``lane`` (-1, 0, +1), nearest first."""
+        return tuple(n for n in self.tracks if n.lane == lane)
+
+    def lane_free(self, lane: int, behind_m: float, ahead_m: float) -> bool:
+        """Whether no track (measured or predicted) may lie in ``lane`` with its centre between ``behind_m`` behind and
+        ``ahead_m`` ahead of the ego's centre, widened by three sigma of its position: a lane is never free while a
+        track may be in it."""
+        return not any(n.lane == lane and -behind_m - 3 * n.sigma_x_m <= n.x_m <= ahead_m + 3 * n.sigma_x_m
+                       for n in self.tracks)
+
+    def cut_in_lead(self) -> Lead | None:
+        """The nearest neighbour ahead flagged as cutting in, as a lead for the following law (its gap as the range,
+        its relative speed as the range rate); None when none is."""
+        ahead = [n for n in self.tracks if n.cut_in and n.zone is Zone.AHEAD and n.lane != 0]
+        if not ahead:
+            return None
+        n = min(ahead, key=lambda t: t.gap_m)
+        return Lead(n.gap_m, n.rel_speed_mps, ObjectKind.VEHICLE, 1.0, Lead.time_to_contact(n.gap_m, n.rel_speed_mps),
+                    n.box_px, n.track_id)
