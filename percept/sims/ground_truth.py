@@ -31,7 +31,8 @@ class ObjectTruth:
     share of its 3D box's projection that the image frame holds (a person half out of the frame is half visible);
     distance_m: left-camera depth of the nearest point of its
     3D box; position_m: (3,) box centre in the vehicle frame; size_m: (length, width, height); yaw_rad: heading
-    relative to the ego; speed_mps; crossing: pedestrians that cross the road; marker_id: landmark sign id."""
+    relative to the ego; speed_mps; crossing: pedestrians that cross the road; marker_id: landmark sign id;
+    rear_box_px, rear_visible: the same as box_px and visible for the rear rig's left camera (None and 0 without one)."""
 
     obj_id: int
     kind: ObjectKind
@@ -44,6 +45,8 @@ class ObjectTruth:
     speed_mps: float
     crossing: bool = False
     marker_id: int | None = None
+    rear_box_px: tuple | None = None
+    rear_visible: float = 0.0
 
     def to_dict(self) -> dict:
         d = {"kind": self.kind.value, "id": self.obj_id, "box_px": list(self.box_px) if self.box_px else None,
@@ -54,6 +57,8 @@ class ObjectTruth:
             d["crossing"] = self.crossing
         if self.marker_id is not None:
             d["marker_id"] = self.marker_id
+        if self.rear_box_px is not None:
+            d["rear_box_px"], d["rear_visible"] = list(self.rear_box_px), round(self.rear_visible, 4)
         return d
 
 
@@ -61,7 +66,7 @@ class ObjectTruth:
 class GroundTruth:
     """time_s; ego pose (world), speed_mps, steering_rad, accel_mps2; lane; objects; depth_m: (H, W) float32
     left-camera depth [m], inf for sky; imu: the true IMU values; crashed: the ego hit something;
-    pedestrians_hit: ids of the pedestrians hit so far."""
+    pedestrians_hit: ids of the pedestrians hit so far; collided_with: ids of the vehicles the ego touches now."""
 
     time_s: float
     ego: Pose2D
@@ -72,6 +77,7 @@ class GroundTruth:
     imu: ImuSample
     crashed: bool
     pedestrians_hit: tuple[int, ...]
+    collided_with: tuple[int, ...] = ()
 
     @property
     def pedestrian_hit(self) -> bool:
