@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from percept.sensors import PinholeCamera, Pose2D, Side, StereoRig
+from percept.sensors import REAR_MOUNT_X_M, PinholeCamera, Pose2D, Side, StereoRig, rear_rig
 
 
 def test_default_camera_matches_the_design():
@@ -79,10 +79,52 @@ def test_rig_save_load_round_trip(tmp_path):
     assert StereoRig.load(tmp_path / "camera.json") == rig
 
 
+def test_the_rear_rig_sits_at_the_rear_bumper_looking_back_its_left_camera_on_the_vehicles_right():
+    front = StereoRig(pitch_rad=0.02)
+    rear = rear_rig(front)
+    assert rear.looks_back and not front.looks_back
+    assert (rear.camera, rear.baseline_m, rear.pitch_rad) == (front.camera, front.baseline_m, front.pitch_rad)
+    b = front.baseline_m
+    # looking back, the cameras' left is the vehicle's right (-y)
+    np.testing.assert_allclose(rear.camera_position(Side.LEFT), [REAR_MOUNT_X_M, -b / 2, 1.0], atol=1e-12)
+    np.testing.assert_allclose(rear.camera_position(Side.RIGHT), [REAR_MOUNT_X_M, b / 2, 1.0], atol=1e-12)
+    # the optical axis (camera +z) points along the vehicle's -x, pitched down; camera +x (right) along vehicle +y
+    R = rear.rotation_cam_from_vehicle()
+    c, s = math.cos(0.02), math.sin(0.02)
+    np.testing.assert_allclose(R.T @ [0.0, 0.0, 1.0], [-c, 0.0, -s], atol=1e-12)
+    np.testing.assert_allclose(R.T @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], atol=1e-12)
+
+
+def test_a_point_behind_projects_into_the_rear_image_and_round_trips():
+    rear = rear_rig(StereoRig())
+    p = np.array([[-20.0, 3.0, 0.5], [-40.0, -4.0, 1.2]])
+    uv, z = rear.project_vehicle_points(p, Side.LEFT)
+    # straight behind along the axis: depth is the distance behind the camera
+    np.testing.assert_allclose(z, -p[:, 0] + REAR_MOUNT_X_M, atol=1e-9)
+    # a point to the vehicle's left (+y) is to the rear camera's right (u > cx)
+    assert uv[0, 0] > rear.camera.cx > uv[1, 0]
+    for side in (Side.LEFT, Side.RIGHT):
+        pc = rear.cam_from_vehicle(side).apply(p)
+        np.testing.assert_allclose(rear.vehicle_from_cam(side).apply(pc), p, atol=1e-12)  # [m]
+    # the pair is rectified: a point's rows agree, its disparity is f b / z
+    uvr, _ = rear.project_vehicle_points(p, Side.RIGHT)
+    np.testing.assert_allclose(uvr[:, 1], uv[:, 1], atol=1e-9)
+    np.testing.assert_allclose(uv[:, 0] - uvr[:, 0], rear.disparity_px(z), rtol=1e-9)
+
+
+def test_the_rear_rig_survives_to_dict_and_from_dict_and_a_forward_rig_keeps_its_dict(tmp_path):
+    rear = rear_rig(StereoRig(baseline_m=0.3, pitch_rad=0.02))
+    assert StereoRig.from_dict(rear.to_dict()) == rear and rear.to_dict()["yaw_rad"] == math.pi
+    rear.save(tmp_path / "rear_camera.json")
+    assert StereoRig.load(tmp_path / "rear_camera.json") == rear
+    assert "yaw_rad" not in StereoRig().to_dict()
+
+
 @pytest.mark.parametrize("kwargs, match", [
     ({"baseline_m": 0.0}, "baseline_m must be positive"),
     ({"mount_height_m": -1.0}, "mount_height_m must be positive"),
     ({"pitch_rad": 1.0}, "pitch_rad"),
+    ({"yaw_rad": math.inf}, "yaw_rad must be finite"),
 ])
 def test_bad_rig_values_are_rejected(kwargs, match):
     with pytest.raises(ValueError, match=match):

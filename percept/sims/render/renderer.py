@@ -44,8 +44,8 @@ _TEMPLATE_CACHE = 1024
 
 @dataclass(frozen=True)
 class StereoImages:
-    """left, right: (H, W, 3) uint8 BGR; depth_m: (H, W) float32 left-camera z [m], inf for sky;
-    ids: (H, W) int32 object id per left pixel (0 road/scenery, -1 sky);
+    """left, right: (H, W, 3) uint8 BGR; depth_m: (H, W) float32 left-camera z [m], inf for sky (None when rendered
+    without it); ids: (H, W) int32 object id per left pixel (0 road/scenery, -1 sky);
     boxes_px: obj id -> (u0, v0, u1, v1) tight box of the object's unoccluded silhouette in the left image [px],
     u1 and v1 exclusive; visible: obj id -> fraction 0..1 of that silhouette not hidden by nearer things;
     inv_depth, emission: (left, right) (H, W) float32 maps of each camera: 1/z [1/m] (0 for sky) and the
@@ -53,7 +53,7 @@ class StereoImages:
 
     left: np.ndarray
     right: np.ndarray
-    depth_m: np.ndarray
+    depth_m: np.ndarray | None
     ids: np.ndarray
     boxes_px: dict
     visible: dict
@@ -67,6 +67,9 @@ class StereoRenderer:
 
     def __init__(self, rig: StereoRig, road: RoadGeometry, seed: int = 0, palette: Palette = Palette(),
                  scenery: bool = True, signs_xy: np.ndarray | None = None):
+        if rig.yaw_rad:
+            raise ValueError(f"StereoRenderer draws a forward-looking rig (yaw_rad 0), got yaw_rad {rig.yaw_rad}; "
+                             "draw a rear rig with RearRenderer")
         self.rig = rig
         self.road = road
         self.layers = {s: GroundLayer(rig, s, seed, palette) for s in (Side.LEFT, Side.RIGHT)}
@@ -225,14 +228,16 @@ class StereoRenderer:
             target.depth = zbuffer_depth(target.inv_depth, target.base_inv_depth, layer.ground_depth)
         return target
 
-    def render(self, scene: Scene, emission: bool = True) -> StereoImages:
+    def render(self, scene: Scene, emission: bool = True, depth: bool = True) -> StereoImages:
         """Both cameras' images, the left depth, ids and boxes, and each camera's z-buffer and (``emission``) lamp
-        map; without ``emission`` (nothing glows: only the night reads it) the images are the same."""
+        map; without ``emission`` (nothing glows: only the night reads it) the images are the same, and without
+        ``depth`` the left depth is None (the z-buffers stay)."""
         patches = self.scene_patches(scene)
         ground = ground_paint(self.road_index, scene.ego, self.rig, self.layers[Side.LEFT].palette)
         sides = (Side.LEFT, Side.RIGHT)
         prep = prepare(patches, self.rig.camera, [self.cam_from_world(scene, s) for s in sides], self.atlas, SUN_DIR)
-        left = self.render_side(scene, Side.LEFT, prepared_ground=ground, prepared=prep[0], emission=emission)
+        left = self.render_side(scene, Side.LEFT, prepared_ground=ground, prepared=prep[0], depth=depth,
+                                emission=emission)
         right = self.render_side(scene, Side.RIGHT, prepared_ground=ground, ids=False, prepared=prep[1], depth=False,
                                  emission=emission)
         boxes, visible = {}, {}
