@@ -49,11 +49,18 @@ def is_dropped(condition: Condition, seed: int, frame: int) -> bool:
     return condition is Condition.DROPOUT and frame_rng(seed, frame, 9).random() < DROPOUT_RATE
 
 
+AMBIENT_NIGHT = np.float32(0.08)
+"""The light reaching every surface at night besides the ego's headlight beam (a share of the daylight)."""
+
+
 class ConditionEffects:
-    """Precomputed masks of one rig for applying a condition to each camera's image."""
+    """Precomputed masks of one rig for applying a condition to each camera's image. The ego's headlight beam and the
+    low sun (glare) lie ahead of the car: a rig that looks back (``StereoRig.looks_back``) sees at night only the
+    ambient light and the lamps (the headlights of the cars behind face it), and under the glare condition no sun."""
 
     def __init__(self, rig: StereoRig, condition: Condition):
         self.condition = Condition(condition)
+        self.looks_back = rig.looks_back
         cam = rig.camera
         H, W = cam.height, cam.width
         hz = rig.horizon_row
@@ -100,12 +107,17 @@ class ConditionEffects:
         """(H, W) light reaching each pixel's surface at night: ambient plus the headlight beam, which lights
         points ahead within about 1.5 m of the ego's centreline, widening and fading with distance. Computed from
         the camera's own inverse depth map (the road plane's without one), so that the beam lies on the world and
-        both cameras see it at the surface's disparity."""
+        both cameras see it at the surface's disparity. A rig looking back gets the ambient light alone."""
         return self._night_gain(inv_depth, camera).copy()
 
     def _night_gain(self, inv_depth: np.ndarray | None, camera: int) -> np.ndarray:
         """``night_gain`` written in place on scratch buffers (the result is one of them, valid until the next
         call)."""
+        if self.looks_back:
+            # no beam behind the car: the ambient light alone (what the beam's gain is where the beam is 0)
+            t = self._scratch("t")
+            t.fill(AMBIENT_NIGHT)
+            return t
         inv = self.ground_inv if inv_depth is None else inv_depth
         z, t = self._scratch("noise"), self._scratch("t")
         passes.beam_spread(inv, self.slope, np.float32(self.cam_y[camera]), z, t)
@@ -177,12 +189,13 @@ class ConditionEffects:
 
     def apply(self, img: np.ndarray, seed: int, frame: int, camera: int, inv_depth: np.ndarray | None = None,
               emission: np.ndarray | None = None) -> np.ndarray:
-        """The condition applied to one camera's image (camera 0 left, 1 right). At night, ``inv_depth`` (that
+        """The condition applied to one camera's image (camera 0 left, 1 right; a second rig's cameras take other
+        numbers, 2 and 3 for the rear rig, so that their random draws are their own). At night, ``inv_depth`` (that
         camera's (H, W) 1/Z map [1/m], 0 for sky) places the headlight beam on the world, and ``emission`` (the
         fraction of each pixel that is a lamp) says what glows; without them the beam lies on the road plane and
         red-and-bright pixels glow."""
         c = self.condition
-        if c in (Condition.CLEAR, Condition.DROPOUT):
+        if c in (Condition.CLEAR, Condition.DROPOUT) or (c is Condition.GLARE and self.looks_back):
             return img
         rng = frame_rng(seed, frame, camera)
         if c is Condition.NIGHT:
