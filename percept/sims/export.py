@@ -21,8 +21,8 @@ from percept.sensors import Frame
 from .ground_truth import GroundTruth
 from .world import SimWorld
 
-RENDER_FILE = re.compile(r"\d{6}_(left\.png|right\.png|depth\.npy|gt\.json)|camera\.json|landmarks\.json"
-                         r"|\.(\d{6}_\w+|camera|landmarks)\.\w+\.tmp\.\w+")
+RENDER_FILE = re.compile(r"\d{6}_((rear_)?left\.png|(rear_)?right\.png|depth\.npy|gt\.json)|(rear_)?camera\.json"
+                         r"|landmarks\.json|\.(\d{6}_\w+|(rear_)?camera|landmarks)\.\w+\.tmp\.\w+")
 """Names of the files a render writes (and of its temporaries, left by a killed process)."""
 
 
@@ -54,8 +54,8 @@ def prepare_out_dir(out: Path, force: bool = False) -> Path:
 
 
 def write_frame(out: Path, i: int, frame: Frame, gt: GroundTruth) -> None:
-    """``{i:06d}_left.png``, ``_right.png`` (absent for a dropped frame), ``_depth.npy`` (float32 m, inf sky),
-    ``_gt.json``: all of them or none."""
+    """``{i:06d}_left.png``, ``_right.png`` (and ``_rear_left.png``, ``_rear_right.png`` with a rear rig; absent for
+    a dropped frame), ``_depth.npy`` (float32 m, inf sky), ``_gt.json``: all of them or none."""
     stem = f"{i:06d}"
     d = gt.to_dict()
     d["frame"] = i
@@ -64,6 +64,9 @@ def write_frame(out: Path, i: int, frame: Frame, gt: GroundTruth) -> None:
                     "wheel_speed_mps": frame.wheel_speed_mps}
     files = {} if frame.dropped else {out / f"{stem}_left.png": png_bytes(frame.left),
                                       out / f"{stem}_right.png": png_bytes(frame.right)}
+    if frame.has_rear:
+        files.update({out / f"{stem}_rear_left.png": png_bytes(frame.rear_left),
+                      out / f"{stem}_rear_right.png": png_bytes(frame.rear_right)})
     files[out / f"{stem}_depth.npy"] = npy_bytes(gt.depth_m.astype(np.float32))
     # the ground truth last: a reader that finds it finds the whole frame
     files[out / f"{stem}_gt.json"] = json.dumps(d, indent=1).encode()
@@ -72,10 +75,13 @@ def write_frame(out: Path, i: int, frame: Frame, gt: GroundTruth) -> None:
 
 def render_run(world: SimWorld, frames: int, out: Path, progress: Callable[[], None] | None = None) -> None:
     """Render ``frames`` consecutive frames of ``world`` into ``out`` (made ready by ``prepare_out_dir``) with
-    camera.json (and landmarks.json); ``written`` counts the frames when stopped early."""
+    camera.json (rear_camera.json with a rear rig, landmarks.json with signs); ``written`` counts the frames when
+    stopped early."""
     if frames < 1:
         raise ValueError(f"--frames must be at least 1, got {frames}")
     world.cfg.rig.save(out / "camera.json")
+    if world.cfg.rear_rig is not None:
+        world.cfg.rear_rig.save(out / "rear_camera.json")
     landmarks = world.landmark_map()
     if len(landmarks):
         write_json_atomic(out / "landmarks.json", landmarks.to_dict(), indent=1)

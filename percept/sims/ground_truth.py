@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from highway_env.utils import are_polygons_intersecting
 
 from percept.sensors import ImuSample, ObjectKind, PinholeCamera, Pose2D, Transform, wrap_angle
 
@@ -84,7 +85,7 @@ class GroundTruth:
         return bool(self.pedestrians_hit)
 
     def to_dict(self) -> dict:
-        return {
+        d = {
             "time_s": round(self.time_s, 4),
             "ego": {"x": self.ego.x_m, "y": self.ego.y_m, "yaw": self.ego.yaw_rad, "speed": self.speed_mps},
             "lane": {"offset_m": self.lane.offset_m, "heading_rad": self.lane.heading_rad,
@@ -94,6 +95,9 @@ class GroundTruth:
             "pedestrian_hit": self.pedestrian_hit,
             "objects": [o.to_dict() for o in self.objects],
         }
+        if self.collided_with:
+            d["collided_with"] = list(self.collided_with)
+        return d
 
 
 def lane_truth(ego) -> LaneTruth:
@@ -127,11 +131,33 @@ def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:
     return np.where(ok, inside / np.where(ok, area, 1.0), 1.0)
 
 
+@dataclass(frozen=True)
+class CameraView:
+    """What one camera saw of a frame's objects: its intrinsics, its ``StereoRig.cam_from_vehicle()``, and per object
+    its silhouette box (u0, v0, u1, v1) [px] or None, and the unoccluded share of that silhouette (0..1)."""
+
+    camera: PinholeCamera
+    cam_from_vehicle: Transform
+    boxes_px: list
+    visible: list
+
+
+def _seen(view: CameraView, pts: np.ndarray) -> tuple[np.ndarray, list[float]]:
+    """Per object, the camera depth of the nearest of its box points ``pts`` (N, K, 3) (vehicle frame [m]) and the
+    share of it ``view``'s camera sees: the unoccluded share times the in-frame share where it has a box."""
+    pc = view.cam_from_vehicle.apply(pts.reshape(-1, 3)).reshape(pts.shape)
+    share = in_frame_share(view.camera, pc)
+    seen = [float(v * share[k]) if view.boxes_px[k] is not None else float(v) for k, v in enumerate(view.visible)]
+    return pc[..., 2].min(axis=1), seen
+
+
 def objects_truth(states: list[ObjectState], ego: Pose2D, camera: PinholeCamera, cam_from_vehicle: Transform,
-                  boxes_px: list, visible: list[float], crossing: list[bool]) -> tuple[ObjectTruth, ...]:
+                  boxes_px: list, visible: list[float], crossing: list[bool],
+                  rear: CameraView | None = None) -> tuple[ObjectTruth, ...]:
     """Vehicle-frame position and camera distance of each object of a frame (one entry of ``boxes_px``, ``visible``
     and ``crossing`` each); ``camera``, ``cam_from_vehicle``: the left camera's intrinsics and its
-    ``StereoRig.cam_from_vehicle()``. All objects at once: the same arithmetic element by element as one by one."""
+    ``StereoRig.cam_from_vehicle()``; ``rear``: what the rear rig's left camera saw (None: the car has no rear rig).
+    All objects at once: the same arithmetic element by element as one by one."""
     if not states:
         return ()
     c = ego.to_vehicle_xy(np.array([[s.pose.x_m, s.pose.y_m] for s in states]))
@@ -142,14 +168,34 @@ def objects_truth(states: list[ObjectState], ego: Pose2D, camera: PinholeCamera,
     local = _BOX_GRID[None] * size[:, None, :]
     pts = np.stack([c[:, :1] + cy * local[..., 0] - sy * local[..., 1], c[:, 1:] + sy * local[..., 0]
                     + cy * local[..., 1], local[..., 2]], axis=-1)
-    pc = cam_from_vehicle.apply(pts.reshape(-1, 3)).reshape(pts.shape)
-    share = in_frame_share(camera, pc)
-    nearest = pc[..., 2].min(axis=1)
+    nearest, seen = _seen(CameraView(camera, cam_from_vehicle, boxes_px, visible), pts)
+    rear_boxes, rear_seen = (rear.boxes_px, _seen(rear, pts)[1]) if rear is not None else ([None] * len(states),
+                                                                                          [0.0] * len(states))
     out = []
     for k, st in enumerate(states):
-        seen = float(visible[k] * share[k]) if boxes_px[k] is not None else float(visible[k])
         L, W, H = st.length_m, st.width_m, st.height_m
-        out.append(ObjectTruth(st.obj_id, st.kind, boxes_px[k], seen, float(nearest[k]),
+        out.append(ObjectTruth(st.obj_id, st.kind, boxes_px[k], seen[k], float(nearest[k]),
                                (float(c[k, 0]), float(c[k, 1]), H / 2), (L, W, H), float(yaw[k]), st.speed_mps,
-                               crossing[k], st.marker_id))
+                               crossing[k], st.marker_id, rear_boxes[k], rear_seen[k]))
     return tuple(out)
+
+
+def collided_with(ego, vehicles, ids, dt_s: float) -> tuple[int, ...]:
+    """Ids (``ids(vehicle)``, ascending) of the ``vehicles`` the highway-env ``ego`` is in contact with: both marked
+    ``crashed`` by highway-env and their rectangles meeting now or within the next ``dt_s`` [s] at their velocities
+    (highway-env's own test, ``utils.are_polygons_intersecting``: it pushes colliding vehicles apart a step ahead, so
+    the contact is sometimes a step away). Empty while the ego has not crashed."""
+    if not ego.crashed:
+        return ()
+    out = []
+    for v in vehicles:
+        if v is ego or not v.crashed:
+            continue
+        # highway-env's spherical pre-check: centres further apart than the half-diagonals plus a step's travel
+        if np.linalg.norm(v.position - ego.position) > (ego.diagonal + v.diagonal) / 2 + ego.speed * dt_s:
+            continue
+        now, soon, _ = are_polygons_intersecting(ego.polygon(), v.polygon(), ego.velocity * dt_s,
+                                                 v.velocity * dt_s)
+        if now or soon:
+            out.append(ids(v))
+    return tuple(sorted(out))

@@ -17,6 +17,10 @@ x, y, z [rad/s] in the vehicle frame (x forward, y left, z up), with seeded nois
 (percept.sims.imu), clipped to +-16 g and +-2000 deg/s. The environment's own observation is still
 computed by highway-env, and discarded. ``env.last_images`` keeps the renderer's output of the last
 observation (left depth, object ids and boxes) for users who want image ground truth.
+
+With ``rear=True`` the observation also holds ``rear_left`` and ``rear_right``: the rear stereo rig's images
+(``percept.sensors.rear_rig`` of the rig: the same cameras at the rear bumper, looking back), and
+``env.last_rear_images`` that rig's renderer output (its left depth, ids and boxes).
 """
 
 from __future__ import annotations
@@ -25,10 +29,10 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from percept.sensors import StereoRig
+from percept.sensors import StereoRig, rear_rig
 
 from .imu import ImuModel
-from .render import StereoRenderer
+from .render import RearRenderer, StereoRenderer, forward_twin
 from .road_geometry import build_road_geometry
 from .snapshot import ObjectIds, scene_from_road
 
@@ -39,19 +43,27 @@ GYRO_RANGE_RPS = np.radians(2000.0)
 
 
 class StereoObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
-    """Replaces a highway-env observation with {"left", "right": (H, W, 3) uint8 BGR, "imu": (6,) float32}.
+    """Replaces a highway-env observation with {"left", "right": (H, W, 3) uint8 BGR, "imu": (6,) float32} (and
+    "rear_left", "rear_right" with ``rear``).
 
     rig: the stereo rig (camera intrinsics, baseline, mount); seed: texture, scenery and IMU-noise seed;
-    scenery: roadside clutter on/off. The road geometry and renderer are rebuilt on a reset only when the
-    road network differs from the last one; object ids are kept for one episode.
+    scenery: roadside clutter on/off; rear: the rear rig's pair too (True: ``rear_rig(rig)``, or a rig looking
+    straight back). The road geometry and renderers are rebuilt on a reset only when the road network differs from
+    the last one; object ids are kept for one episode.
     """
 
-    def __init__(self, env: gym.Env, rig: StereoRig | None = None, seed: int = 0, scenery: bool = True):
-        gym.utils.RecordConstructorArgs.__init__(self, rig=rig, seed=seed, scenery=scenery)
+    def __init__(self, env: gym.Env, rig: StereoRig | None = None, seed: int = 0, scenery: bool = True,
+                 rear: bool | StereoRig = False):
+        gym.utils.RecordConstructorArgs.__init__(self, rig=rig, seed=seed, scenery=scenery, rear=rear)
         super().__init__(env)
         if seed < 0:
             raise ValueError(f"seed must be >= 0, got {seed}")
         self.rig = rig if rig is not None else StereoRig()
+        if not isinstance(rear, (bool, StereoRig)):
+            raise ValueError(f"rear must be True, False or a StereoRig, got {rear!r}")
+        self.rear_rig = rear_rig(self.rig) if rear is True else rear or None
+        if self.rear_rig is not None:
+            forward_twin(self.rear_rig)  # ValueError unless it looks straight back
         self.seed = int(seed)
         self.scenery = bool(scenery)
         self._imu_range = np.array([ACCEL_RANGE_MPS2] * 3 + [GYRO_RANGE_RPS] * 3, np.float32)
@@ -60,14 +72,17 @@ class StereoObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs)
         self.observation_space = spaces.Dict({
             "left": image, "right": image,
             "imu": spaces.Box(-self._imu_range, self._imu_range, (6,), np.float32),
+            **({} if self.rear_rig is None else {"rear_left": image, "rear_right": image}),
         })
         self.renderer: StereoRenderer | None = None
+        self.rear_renderer: RearRenderer | None = None
         self.imu: ImuModel | None = None
         self.ids = ObjectIds()
         self.episode = 0
         self._reset_seed: int | None = None
         self._network_key: tuple | None = None
         self.last_images = None
+        self.last_rear_images = None
         self._first = True
 
     @property
@@ -84,8 +99,10 @@ class StereoObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs)
         network = self.env.unwrapped.road.network
         key = _network_key(network)
         if key != self._network_key:  # highway-env rebuilds an identical network on most resets
-            self.renderer = StereoRenderer(self.rig, build_road_geometry(network), seed=self.seed,
-                                           scenery=self.scenery)
+            road = build_road_geometry(network)
+            self.renderer = StereoRenderer(self.rig, road, seed=self.seed, scenery=self.scenery)
+            self.rear_renderer = None if self.rear_rig is None else RearRenderer(self.rear_rig, road, seed=self.seed,
+                                                                                  scenery=self.scenery)
             self._network_key = key
         self.ids = ObjectIds()
         self._first = True
@@ -105,7 +122,11 @@ class StereoObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs)
         truth = self.imu.true_sample(scene.ego.yaw_rad, float(ego.speed), dt)
         meas, _wheel = self.imu.measure(truth, float(ego.speed), self.dt)
         imu = np.clip(np.concatenate([meas.accel_mps2, meas.gyro_rps]), -self._imu_range, self._imu_range)
-        return {"left": images.left, "right": images.right, "imu": imu.astype(np.float32)}
+        obs = {"left": images.left, "right": images.right, "imu": imu.astype(np.float32)}
+        if self.rear_renderer is not None:
+            self.last_rear_images = back = self.rear_renderer.render(scene)
+            obs.update(rear_left=back.left, rear_right=back.right)
+        return obs
 
 
 def _network_key(network) -> tuple:

@@ -2,20 +2,20 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from percept.sensors import Frame, LandmarkMap, Pose2D, Side, StereoRig
+from percept.sensors import Frame, LandmarkMap, Pose2D, Side, StereoRig, rear_rig
 from percept.sensors.vehicle import SIGN_PANEL_CENTRE_M
 
 from .actors import Pedestrian, Sign
 from .conditions import Condition, ConditionEffects, is_dropped
 from .coords import hw_to_world_xy
 from .env import PerceptEnv
-from .ground_truth import GroundTruth, lane_truth, objects_truth
+from .ground_truth import CameraView, GroundTruth, collided_with, lane_truth, objects_truth
 from .imu import ImuModel
-from .render import StereoRenderer
+from .render import RearRenderer, StereoImages, StereoRenderer, forward_twin
 from .road_geometry import build_road_geometry
 from .scenarios import SCENARIOS
 from .snapshot import ObjectIds, scene_from_road
@@ -40,7 +40,7 @@ def check_condition(name: str) -> Condition:
 
 @dataclass(frozen=True)
 class WorldConfig:
-    """What ``SimWorld`` simulates: the scenario, its seed, the condition and the rig."""
+    """What ``SimWorld`` simulates: the scenario, its seed, the condition and the rigs."""
 
     scenario: str = "highway"  # a name from SCENARIOS
     seed: int = 0  # seeds the scenario's traffic and people, the textures, the IMU's noise and the condition
@@ -49,12 +49,31 @@ class WorldConfig:
     # True for rendering data sets: highway-env's IDM drives the ego instead of the actions passed to ``step``
     autopilot: bool = False
     scenery: bool = True  # roadside clutter (rails, poles, trees, buildings) on or off
+    # the rear-facing rig (looking straight back, e.g. ``percept.sensors.rear_rig(rig)``), rendered beside the
+    # forward one; None: the car has none
+    rear_rig: StereoRig | None = None
 
     def __post_init__(self) -> None:
         check_scenario(self.scenario)
         object.__setattr__(self, "condition", check_condition(self.condition))
         if self.seed < 0:
             raise ValueError(f"seed must be >= 0, got {self.seed}")
+        if self.rear_rig is not None:
+            forward_twin(self.rear_rig)  # ValueError unless it looks straight back
+
+
+def with_rear(cfg: WorldConfig, rear: bool | None) -> WorldConfig:
+    """``cfg`` with the rear rig ``percept.sensors.rear_rig(cfg.rig)`` on (``rear`` True) or off (False); None keeps
+    the rear rig ``cfg`` has, or puts one on where the scenario's traffic changes lanes. ValueError for anything else
+    than a bool or None."""
+    if rear not in (None, True, False):
+        raise ValueError(f"rear must be True, False or None (the scenario's default), got {rear!r}")
+    on = (cfg.rear_rig is not None or SCENARIOS[cfg.scenario].lane_changes) if rear is None else bool(rear)
+    if on and cfg.rear_rig is None:
+        return replace(cfg, rear_rig=rear_rig(cfg.rig))
+    if not on and cfg.rear_rig is not None:
+        return replace(cfg, rear_rig=None)
+    return cfg
 
 
 class SimWorld:
@@ -68,9 +87,14 @@ class SimWorld:
         self.env.reset(seed=cfg.seed)
         self.dt = 1.0 / self.env.config["simulation_frequency"]
         self.road_geometry = build_road_geometry(self.env.road.network)
+        signs_xy = self.landmark_map().positions_m[:, :2]
         self.renderer = StereoRenderer(cfg.rig, self.road_geometry, seed=cfg.seed, scenery=cfg.scenery,
-                                       signs_xy=self.landmark_map().positions_m[:, :2])
+                                       signs_xy=signs_xy)
         self.effects = ConditionEffects(cfg.rig, cfg.condition)
+        # the rear pair: the same world (road, seed, scenery) seen looking back, under the same condition
+        self.rear_renderer = None if cfg.rear_rig is None else RearRenderer(
+            cfg.rear_rig, self.road_geometry, seed=cfg.seed, scenery=cfg.scenery, signs_xy=signs_xy)
+        self.rear_effects = None if cfg.rear_rig is None else ConditionEffects(cfg.rear_rig, cfg.condition)
         self.imu = ImuModel(cfg.seed)
         self.ids = ObjectIds()
         self.frame_index = 0
@@ -112,33 +136,59 @@ class SimWorld:
         self.frame_index += 1
 
     def observe(self, render: bool = True) -> tuple[Frame, GroundTruth]:
-        """The sensors' frame and the ground truth at the current step."""
+        """The sensors' frame and the ground truth at the current step. A dropped frame (dropout) drops both rigs'
+        images."""
         ego = self.ego
         scene = scene_from_road(self.env.road, ego, self.ids)
         rig = self.cfg.rig
         truth_imu = self.imu.true_sample(scene.ego.yaw_rad, float(ego.speed), self.dt if self.frame_index else 0.0)
         imu, wheel = self.imu.measure(truth_imu, float(ego.speed), self.dt)
         dropped = is_dropped(self.cfg.condition, self.cfg.seed, self.frame_index)
+        front = rear = None
         if render:
-            img = self.renderer.render(scene, emission=self.effects.reads_emission)
-            left = self.effects.apply(img.left, self.cfg.seed, self.frame_index, 0, img.inv_depth[0], img.emission[0])
-            right = self.effects.apply(img.right, self.cfg.seed, self.frame_index, 1, img.inv_depth[1],
-                                       img.emission[1])
-            depth, boxes, visible = img.depth_m, img.boxes_px, img.visible
+            front = self._pair(self.renderer.render(scene, emission=self.effects.reads_emission), self.effects, 0)
+            if self.rear_renderer is not None:
+                # the rear rig's depth map is not part of the truth: only its ids (boxes) are read
+                rear = self._pair(self.rear_renderer.render(scene, emission=self.rear_effects.reads_emission,
+                                                            depth=False), self.rear_effects, 2)
+        if front is not None:
+            depth = front[2].depth_m
         else:
-            left = right = None
             depth = np.full((rig.camera.height, rig.camera.width), np.nan, np.float32)
-            boxes, visible = {}, {}
-        near = [st for st in scene.objects if _within(st.pose, scene.ego, TRUTH_RANGE_M)]
-        objects = objects_truth(near, scene.ego, rig.camera, rig.cam_from_vehicle(Side.LEFT),
-                                [boxes.get(st.obj_id) for st in near], [visible.get(st.obj_id, 0.0) for st in near],
-                                [bool(getattr(self.ids.objects[st.obj_id], "crossing", False)) for st in near])
-        ped_hit = tuple(self.ids(p) for p in self.env.road.objects
-                        if isinstance(p, Pedestrian) and (p.crashed or p.hit))
-        gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), objects, depth, truth_imu,
-                         bool(ego.crashed), ped_hit)
-        frame = Frame(self.frame_index, self.time_s, None if dropped else left, None if dropped else right, imu, wheel)
+        gt = GroundTruth(self.time_s, scene.ego, float(ego.speed), lane_truth(ego), self._objects(scene, front, rear),
+                         depth, truth_imu, bool(ego.crashed), self._pedestrians_hit(),
+                         collided_with(ego, self.env.road.vehicles, self.ids, self.dt))
+        left, right = (None, None) if dropped or front is None else front[:2]
+        rear_left, rear_right = (None, None) if dropped or rear is None else rear[:2]
+        frame = Frame(self.frame_index, self.time_s, left, right, imu, wheel, rear_left, rear_right)
         return frame, gt
+
+    def _pair(self, img: StereoImages, effects: ConditionEffects, first_camera: int) -> tuple:
+        """(left, right, img): one rig's rendered pair ``img`` with the condition applied, its cameras numbered
+        ``first_camera`` and the next (their random draws)."""
+        seed, k = self.cfg.seed, self.frame_index
+        left = effects.apply(img.left, seed, k, first_camera, img.inv_depth[0], img.emission[0])
+        right = effects.apply(img.right, seed, k, first_camera + 1, img.inv_depth[1], img.emission[1])
+        return left, right, img
+
+    def _objects(self, scene, front: tuple | None, rear: tuple | None) -> tuple:
+        """The truth of the objects within TRUTH_RANGE_M, with their boxes in the rendered pairs (``_pair``'s
+        results; None: not rendered)."""
+        near = [st for st in scene.objects if _within(st.pose, scene.ego, TRUTH_RANGE_M)]
+        rig, back_rig = self.cfg.rig, self.cfg.rear_rig
+        boxes, visible = (front[2].boxes_px, front[2].visible) if front is not None else ({}, {})
+        back = None
+        if back_rig is not None:
+            rb, rv = (rear[2].boxes_px, rear[2].visible) if rear is not None else ({}, {})
+            back = CameraView(back_rig.camera, back_rig.cam_from_vehicle(Side.LEFT),
+                              [rb.get(st.obj_id) for st in near], [rv.get(st.obj_id, 0.0) for st in near])
+        return objects_truth(near, scene.ego, rig.camera, rig.cam_from_vehicle(Side.LEFT),
+                             [boxes.get(st.obj_id) for st in near], [visible.get(st.obj_id, 0.0) for st in near],
+                             [bool(getattr(self.ids.objects[st.obj_id], "crossing", False)) for st in near], back)
+
+    def _pedestrians_hit(self) -> tuple[int, ...]:
+        """Ids of the pedestrians hit so far."""
+        return tuple(self.ids(p) for p in self.env.road.objects if isinstance(p, Pedestrian) and (p.crashed or p.hit))
 
     @property
     def pedestrians(self) -> int:

@@ -9,7 +9,7 @@ import highway_env  # noqa: F401  (registers the environments)
 import numpy as np
 import pytest
 
-from percept.sensors import PinholeCamera, StereoRig
+from percept.sensors import PinholeCamera, StereoRig, rear_rig
 from percept.sims.coords import hw_pose, hw_to_world_xy
 from percept.sims.gym_wrapper import StereoObservation
 
@@ -142,3 +142,22 @@ def test_bad_use_raises():
         make("highway-v0", seed=-1)
     with pytest.raises(RuntimeError, match="reset"):
         make("highway-v0").observation(None)
+
+
+def test_the_rear_rig_is_offered_on_request():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        env = StereoObservation(gym.make("highway-v0", config=CONFIGS["highway-v0"]), rig=SMALL, scenery=False,
+                                rear=True)
+    assert env.rear_rig == rear_rig(SMALL)
+    assert set(env.observation_space.spaces) == {"left", "right", "imu", "rear_left", "rear_right"}
+    obs, _ = env.reset(seed=0)
+    obs, *_ = env.step(ACTIONS["highway-v0"])
+    assert env.observation_space.contains(obs)
+    assert not np.array_equal(obs["rear_left"], obs["left"]) and not np.array_equal(obs["rear_left"],
+                                                                                     obs["rear_right"])
+    assert env.last_rear_images.left is obs["rear_left"]
+    with pytest.raises(ValueError, match="rear must be True, False or a StereoRig"):
+        StereoObservation(gym.make("highway-v0"), rear="yes")
+    with pytest.raises(ValueError, match="looks straight back"):
+        StereoObservation(gym.make("highway-v0"), rear=SMALL)

@@ -26,6 +26,7 @@ class Scenario:
     duration_s: float  # default run length [s]
     build: Callable  # build(env, rng) -> highway-env Road, with the ego made by ``env.make_ego``
     ego_speed_mps: float = 25.0  # the ego's nominal speed [m/s] (``build`` sets its start and cruise speeds)
+    lane_changes: bool = False  # its traffic changes lanes (highway-env's MOBIL); runs carry the rear rig by default
 
 
 def _chain(net) -> list[str]:
