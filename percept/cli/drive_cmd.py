@@ -21,6 +21,7 @@ def drive(
     sources: dict = None,
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
+    rear: opt.Rear = None,
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
                                          "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,
@@ -42,7 +43,7 @@ def drive(
     opt.check_number("--duration", duration, 1e-3, opt.MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
-                          opt.slot_sources(sources, privileged), detector=detector)
+                          opt.slot_sources(sources, privileged), detector=detector, rear=rear)
     except ValueError as e:
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")

@@ -34,6 +34,7 @@ def eval_(
     sources: dict = None,
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
+    rear: opt.Rear = None,
     json_path: opt.JsonOut = None,
     redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
                                                       "settings (other slots, duration or percept version).")] = False,
@@ -53,8 +54,8 @@ def eval_(
     go on, and the exit code is 1. While it runs, --out holds .percept-lock (its pid, host and command line): a
     second command writing there is refused at once, and a lock left by a process that no longer runs is taken over.
     """
-    plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector, opt.slot_sources(sources,
-                                                                                                       privileged))
+    plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector,
+                      opt.slot_sources(sources, privileged), rear)
     with only_writer(out, "percept eval"):
         files = _scan(plan, out, redo)
         check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
@@ -70,7 +71,7 @@ def eval_(
             _strict(summary)
 
 
-def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources):
+def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources, rear=None):
     """The checked options as (EvalPlan, Engine), the model file included; one-line exit 2 otherwise."""
     from percept.evaluate.plan import Engine, EvalPlan, parse_seeds
     from percept.sims import SCENARIOS
@@ -86,7 +87,7 @@ def _plan(scenario, condition, seeds, workers, engine, duration, detector, sourc
         fail(f"--engine must be local or ray, got '{engine}'")
     try:
         plan = EvalPlan(tuple(dict.fromkeys(names)), tuple(dict.fromkeys(condition)), tuple(parse_seeds(seeds)),
-                        sources, duration, detector)
+                        sources, duration, detector, rear=rear)
     except ValueError as e:
         fail(str(e))
     return plan, eng

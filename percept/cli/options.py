@@ -27,6 +27,9 @@ Duration = Annotated[Optional[float], typer.Option("--duration", help=f"Simulate
                                                    f"{MAX_DURATION_S:g} (default: the scenario's own).")]
 Detector = Annotated[str, typer.Option("--detector", help="People model of the vision pedestrian slot: sim "
                                        "(trained on rendered people), inria (OpenCV's) or a model file.")]
+Rear = Annotated[Optional[bool], typer.Option("--rear/--no-rear", help="The rear stereo rig, looking back from the rear "
+                                              "bumper, on or off (default: on where the scenario's traffic changes "
+                                              "lanes).", show_default=False)]
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",
                                                  dir_okay=False)]
 

@@ -19,23 +19,26 @@ def render(
     seed: opt.Seed = 0,
     condition: opt.Condition = "clear",
     scenery: Annotated[bool, opt.flag(help="Roadside clutter (rails, poles, trees, buildings).")] = True,
+    rear: opt.Rear = None,
     force: Annotated[bool, opt.flag("--force", help="Replace an earlier render in --out (its files are removed "
                                                         "first; other files still refuse the folder).")] = False,
 ):
     """Render stereo PNGs, depth and ground truth of a scenario; the ego is driven by highway-env's IDM autopilot.
 
-    Writes for frame i: DIR/{i:06d}_left.png, _right.png (absent when the frame was dropped), _depth.npy
-    (float32 metres, inf for sky), _gt.json; plus DIR/camera.json and, with landmark signs, DIR/landmarks.json.
+    Writes for frame i: DIR/{i:06d}_left.png, _right.png (and _rear_left.png, _rear_right.png with the rear rig;
+    absent when the frame was dropped), _depth.npy (float32 metres, inf for sky), _gt.json; plus DIR/camera.json
+    (DIR/rear_camera.json with the rear rig) and, with landmark signs, DIR/landmarks.json.
     Each frame's files are complete or absent, also when the render is stopped; a folder that already holds files
     is refused unless --force.
     """
-    from percept.sims import SimWorld, WorldConfig
+    from percept.sims import SimWorld, WorldConfig, with_rear
     from percept.sims.export import prepare_out_dir, render_run, written
 
     opt.check_number("--frames", frames, 1, 10**6)
     opt.check_number("--seed", seed, 0, opt.MAX_SEED)
     try:
-        cfg = WorldConfig(scenario=scenario, seed=seed, condition=condition, autopilot=True, scenery=scenery)
+        cfg = with_rear(WorldConfig(scenario=scenario, seed=seed, condition=condition, autopilot=True,
+                                    scenery=scenery), rear)
         prepare_out_dir(out, force)
     except ValueError as e:
         fail(str(e))

@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass, field
 
 from percept.sensors import Source
-from percept.sims import WorldConfig
+from percept.sims import WorldConfig, with_rear
 
 from . import tasks as tasks_module
 from .limits import MAX_DURATION_S
@@ -23,8 +23,14 @@ class DriveConfig:
     tasks: tuple[Task, ...] = field(default_factory=lambda: tasks_module.TASKS)  # the slot table
     detector: str = "sim"  # people model of the vision pedestrian slot: "sim", "inria" or a model file
     default: Source = Source.VISION  # the source of a task not in sources (privileged where it has no vision slot)
+    # the rear stereo rig (``percept.sensors.rear_rig`` of the world's rig): True on, False off, None the scenario's
+    # default (on where its traffic changes lanes, or as ``world.rear_rig`` says); resolved to True or False, and
+    # ``world.rear_rig`` set to match
+    rear: bool | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "world", with_rear(self.world, self.rear))
+        object.__setattr__(self, "rear", self.world.rear_rig is not None)
         d = self.duration_s
         if d is not None and not (isinstance(d, (int, float)) and math.isfinite(d) and 0 < d <= MAX_DURATION_S):
             raise ValueError(f"--duration must be a finite number of seconds between 0 and {MAX_DURATION_S:g}, "

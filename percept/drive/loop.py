@@ -61,7 +61,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     sim_s = frames * world.dt
     result = {"scenario": cfg.world.scenario, "condition": cfg.world.condition.value, "seed": cfg.world.seed,
               "duration_s": round(sim_s, 4), "frames": frames, "realtime_factor": sim_s / wall if wall > 0 else None,
-              "slots": {name: src.value for name, src in cfg.sources.items()}, **safety.result()}
+              "slots": {name: src.value for name, src in cfg.sources.items()}, "rear": cfg.rear, **safety.result()}
     result.update({t.name: scorers[t.name].result() for t in cfg.tasks})
     result["timing_ms"] = timing_json(cfg, slot_ms, render_ms if render else None, frames)
     return result
@@ -69,9 +69,11 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
 
 def slot_context(world: SimWorld, feed: TruthFeed, detector: str = "sim") -> SlotContext:
     """What the slots of a run in ``world`` may use: its rig and frame period, its landmark map (None on a road
-    without signs), the truth ``feed``, the people model ``detector`` and the ego's start pose."""
+    without signs), the truth ``feed``, the people model ``detector``, the ego's start pose and the rear rig (None
+    when the car has none)."""
     lm = world.landmark_map()
-    return SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, detector, hw_pose(world.ego))
+    return SlotContext(world.cfg.rig, world.dt, lm if len(lm) else None, feed, detector, hw_pose(world.ego),
+                       world.cfg.rear_rig)
 
 
 def timing_json(cfg: DriveConfig, slot_ms: dict, render_ms: float | None, frames: int) -> dict:

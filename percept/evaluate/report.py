@@ -56,6 +56,8 @@ def reproduce_command(run: dict, settings: dict) -> str:
         cmd.append(f"--duration {settings['duration_s']:g}")
     if settings.get("detector") not in (None, "sim"):
         cmd.append(f"--detector {settings['detector']}")
+    if settings.get("rear") is not None:
+        cmd.append("--rear" if settings["rear"] else "--no-rear")
     return " ".join(cmd)
 
 

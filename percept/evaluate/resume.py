@@ -28,7 +28,8 @@ def groups(tasks=None) -> tuple[str, ...]:
 
 def run_settings(plan: EvalPlan) -> dict:
     """Everything besides the scenario, condition and seed that changes a run's result (a JSON object; two runs
-    are comparable only if theirs are equal): percept version, duration, slot sources, rendering, world options."""
+    are comparable only if theirs are equal): percept version, duration, slot sources, rendering, world options, the
+    rear rig option (None: each scenario's default; a run file without it was made so)."""
     from importlib.metadata import version
 
     cfg = plan.config(plan.jobs[0])
@@ -36,7 +37,7 @@ def run_settings(plan: EvalPlan) -> dict:
             "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
             "detector": cfg.detector if cfg.uses_detector else None,
             "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
-                      "autopilot": cfg.world.autopilot}}
+                      "autopilot": cfg.world.autopilot}, "rear": plan.rear}
 
 
 def differences(now: dict, then) -> list[str]:

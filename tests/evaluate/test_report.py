@@ -62,6 +62,8 @@ def test_unsafe_runs_come_with_the_command_that_reproduces_them():
     assert reproduce_command(bad[0][0], every).endswith("--condition clear --privileged --duration 12")
     vision = {**SETTINGS, "slots": {k: "vision" for k in SETTINGS["slots"]}, "detector": "inria"}
     assert reproduce_command(bad[0][0], vision).endswith("--condition clear --duration 12 --detector inria")
+    assert reproduce_command(bad[0][0], {**vision, "rear": True}).endswith("--detector inria --rear")
+    assert reproduce_command(bad[0][0], {**SETTINGS, "rear": False}).endswith("--duration 12 --no-rear")
 
 
 def test_stops_for_no_one_are_listed_and_summed_but_do_not_fail_strict(tmp_path):
