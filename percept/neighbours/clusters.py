@@ -34,7 +34,7 @@ class ClusterConfig:
     cell_l_m: float = 0.25  # grid cell across it [m]
     min_points: int = 2  # points that make a cell occupied
     min_cells: int = 2  # cells that make a group a vehicle
-    min_group_points: int = 8  # points that make a group a vehicle
+    min_group_points: int = 6  # points that make a group a vehicle
     face_quantile: float = 0.1  # the quantile of x that finds the face (1 - it behind)
     face_depth_m: float = 0.8  # points within this of the face measure it [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
@@ -103,7 +103,7 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     """One group's detection, or None when it is too narrow or its centre is outside the three lanes."""
     if np.quantile(pts.z[idx], 0.1) > cfg.max_low_m:
         return None
-    q = np.quantile(x, cfg.face_quantile if ahead else 1 - cfg.face_quantile)
+    q = np.quantile(x, cfg.face_quantile if ahead else 1 - cfg.face_quantile, method="nearest")
     face = np.abs(x - q) <= cfg.face_depth_m
     measured = face_range(pts, idx[face])
     if measured is None:

@@ -20,7 +20,7 @@ from percept.sensors import Side, StereoRig
 class PointsConfig:
     """What the band matcher looks at."""
 
-    near_m: float = 5.0  # the nearest camera depth matched [m] (sets the disparity range)
+    near_m: float = 3.5  # the nearest camera depth matched [m] (sets the disparity range)
     far_m: float = 90.0  # the farthest camera depth kept [m]
     top_m: float = 1.3  # the band's top: a vehicle's body this high above the road at the far range [m]
     low_m: float = 0.35  # the band's bottom: this high above the road at 6 m [m]
@@ -85,7 +85,12 @@ class BandStereo:
         k = cfg.shrink
         if k == 2:
             L, R = cv2.pyrDown(L), cv2.pyrDown(R)
-        disp = self.matcher.compute(L, R)
+        # StereoBM gives the first num_disp columns no value: padding both images on the left by that many lets it
+        # match every column whose partner is in view (a car close by in the lane to the left fills those columns)
+        pad = self.num_disp
+        L = cv2.copyMakeBorder(L, 0, 0, pad, 0, cv2.BORDER_REPLICATE)
+        R = cv2.copyMakeBorder(R, 0, 0, pad, 0, cv2.BORDER_REPLICATE)
+        disp = self.matcher.compute(L, R)[:, pad:]
         self.disparity = disp
         rows, cols = np.nonzero(disp > 0)
         # full-resolution disparity: d = shrink d_k / 16
