@@ -21,9 +21,6 @@ class RigFinder:
         self.fb = rig.camera.fx * rig.baseline_m
         self.cam_x = float(rig.camera_position(Side.LEFT)[0])
         self._pair: tuple[np.ndarray, np.ndarray] | None = None
-        k = points.shrink
-        # the full-resolution pixels (du, dv) a matching-resolution pixel stands for
-        self._sub = np.array([(a, b) for b in range(k) for a in range(k)], np.int64)
 
     def find(self, left_gray: np.ndarray, right_gray: np.ndarray, lane: LaneEstimate | None
              ) -> tuple[list[Detection], StandingPoints]:
@@ -35,15 +32,9 @@ class RigFinder:
     def face_range(self, pts: StandingPoints, idx: np.ndarray) -> tuple[float, float] | None:
         """The face's along-lane position from its points' refined disparity, and its 1-sigma [m]."""
         d0 = float(np.median(pts.d[idx]))
-        # every matched pixel of the face's box within a pixel of its median disparity, each as the full-resolution
-        # pixels it stands for
-        k, top = self.stereo.cfg.shrink, self.stereo.v0
-        c0, c1 = int(pts.u[idx].min()) // k, int(pts.u[idx].max()) // k + 1
-        r0, r1 = (int(pts.v[idx].min()) - top) // k, (int(pts.v[idx].max()) - top) // k + 1
-        box = self.stereo.disparity[r0:r1, c0:c1].astype(np.float32) * np.float32(k / 16.0)
-        rows, cols = np.nonzero(np.abs(box - np.float32(d0)) <= np.float32(min(1.0, 0.05 * d0)))
-        u = ((cols + c0)[:, None] * k + self._sub[None, :, 0]).ravel()
-        v = ((rows + r0)[:, None] * k + top + self._sub[None, :, 1]).ravel()
+        # every matched pixel of the face's box within 5 % (at most a pixel) of its median disparity
+        box = (int(pts.u[idx].min()), int(pts.v[idx].min()), int(pts.u[idx].max()) + 1, int(pts.v[idx].max()) + 1)
+        u, v = self.stereo.matcher_for(d0).pixels_near(box, d0, min(1.0, 0.05 * d0))
         refined = refine_face(*self._pair, u, v, d0)
         if refined is None:
             return None
