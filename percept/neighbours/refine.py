@@ -13,6 +13,10 @@ from __future__ import annotations
 import numpy as np
 
 
+INTERPOLATION_BIAS_PX = 0.04
+"""The largest error linear interpolation leaves in the aligned disparity at fractional shifts (pixel locking) [px]."""
+
+
 def refine_face(left: np.ndarray, right: np.ndarray, u: np.ndarray, v: np.ndarray, d0: float,
                 iterations: int = 6, tol_px: float = 0.005, max_step_px: float = 1.0) -> tuple[float, float] | None:
     """The disparity of the pixels (u, v) (left image, (N,) [px]) of one face, from ``d0`` [px], and its standard
@@ -43,6 +47,7 @@ def refine_face(left: np.ndarray, right: np.ndarray, u: np.ndarray, v: np.ndarra
             break
     if abs(d - d0) > 1.0:
         return None
-    # sigma_d^2 = sigma_r^2 / sum(g^2), with sigma_r^2 the residuals' variance
-    sigma = float(np.sqrt(max(float(r @ r) / max(len(r) - 1, 1), 1.0) / gg))
+    # sigma_d^2 = sigma_r^2 / sum(g^2), with sigma_r^2 the residuals' variance, and never below the bias that linear
+    # interpolation of the right image leaves at fractional shifts
+    sigma = max(float(np.sqrt(max(float(r @ r) / max(len(r) - 1, 1), 1.0) / gg)), INTERPOLATION_BIAS_PX)
     return d, sigma
