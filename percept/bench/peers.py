@@ -61,3 +61,19 @@ def people_detector_full_frame(frames: list) -> tuple[str, Callable]:
     def run(frame) -> None:
         hog.detectMultiScale(frame.left, winStride=(8, 8), padding=(8, 8), scale=1.05)
     return "OpenCV HOG detectMultiScale (default people detector), full frame", run
+
+
+def sgbm_both_rigs(frames: list) -> tuple[str, Callable]:
+    """The stock way to see the vehicles all round: OpenCV's StereoSGBM (as ``sgbm_full_frame``) over both full
+    frames of the forward rig and, where the frame has one, of the rear rig."""
+    name, forward = sgbm_full_frame(frames)
+    from percept.longitudinal.dense import sample_sgbm
+
+    sgbm = sample_sgbm(96, 5)
+
+    def run(frame) -> None:
+        forward(frame)
+        if frame.has_rear:
+            sgbm.compute(cv2.cvtColor(frame.rear_left, cv2.COLOR_BGR2GRAY),
+                         cv2.cvtColor(frame.rear_right, cv2.COLOR_BGR2GRAY))
+    return "OpenCV StereoSGBM, full frames of both rigs", run

@@ -1,10 +1,11 @@
-"""What the longitudinal laws act on: the nearest of the lead and the braking request, as a bumper gap."""
+"""What the longitudinal laws act on: the nearest of the lead, the braking request and a neighbour cutting in, as a
+bumper gap."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from percept.sensors import BrakingRequest, Lead, ObjectKind
+from percept.sensors import BrakingRequest, Lead, Neighbours, ObjectKind
 from percept.sensors.vehicle import bumper_gap_m
 
 
@@ -15,16 +16,21 @@ class Target:
     gap_m: float  # free distance from the front bumper [m]
     closing_mps: float  # how fast the gap shrinks, -range rate [m/s]
     kind: ObjectKind  # what is there
-    source: str  # the record it comes from: "lead" or "request"
+    source: str  # the record it comes from: "lead", "request" or "cut-in"
 
     @property
     def is_pedestrian(self) -> bool:
         return self.kind is ObjectKind.PEDESTRIAN
 
 
-def nearest_target(lead: Lead | None, request: BrakingRequest | None) -> Target | None:
-    """The nearer of the lead (longitudinal slot) and the braking request (pedestrian slot); None when neither."""
+def nearest_target(lead: Lead | None, request: BrakingRequest | None,
+                   neighbours: Neighbours | None = None) -> Target | None:
+    """The nearest of the lead (longitudinal slot), the braking request (pedestrian slot) and the neighbour flagged
+    as cutting in (neighbours slot); None when there is none."""
     cands = []
+    cut_in = neighbours.cutting_in() if neighbours is not None else None
+    if cut_in is not None:
+        cands.append(Target(cut_in.gap_m, -cut_in.rel_speed_mps, ObjectKind.VEHICLE, "cut-in"))
     if lead is not None:
         cands.append(Target(bumper_gap_m(lead.range_m), -lead.range_rate_mps, lead.kind, "lead"))
     if BrakingRequest.asking(request) is not None:

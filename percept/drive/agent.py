@@ -6,7 +6,7 @@ import time
 from dataclasses import dataclass
 
 from percept.control import EmergencyBraking, Following, LaneKeeping, nearest_target
-from percept.sensors import BrakingRequest, EgoPath, Frame, Lead, PoseEstimate, Source
+from percept.sensors import BrakingRequest, EgoPath, Frame, Lead, Neighbours, PoseEstimate, Source
 
 from .tasks import SlotContext, Task, task_order, upstream_of
 
@@ -26,7 +26,8 @@ class AgentStep:
 class Agent:
     """Slots from the table (vision or privileged per task), and the shared laws, each fed by the record that plays
     its role, whichever task provides it: lane keeping on the ego path (``EgoPath``); following and emergency
-    braking on the lead (``Lead``) and the braking request (``BrakingRequest``), at the speed of the pose estimate
+    braking on the lead (``Lead``), the braking request (``BrakingRequest``) and a neighbour cutting in
+    (``Neighbours``), at the speed of the pose estimate
     (``PoseEstimate``). ValueError when no task provides the ego path or the pose."""
 
     def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float):
@@ -60,7 +61,7 @@ class Agent:
         steer, keeping = self.keeping.update(by_record[EgoPath])
         speed = by_record[PoseEstimate].speed_mps
         request = by_record.get(BrakingRequest)
-        target = nearest_target(by_record.get(Lead), request)
+        target = nearest_target(by_record.get(Lead), request, by_record.get(Neighbours))
         follow, following = self.following.update(target, speed)
         accel, braking = self.braking.update(target, speed, follow, self.dt_s,
                                              withdrawn=request is not None and request.withdrawn)

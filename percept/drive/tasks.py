@@ -20,7 +20,7 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Callable, Protocol
 
 from percept.sensors.poses import Pose2D
-from percept.sensors.records import BrakingRequest, EgoPath, LandmarkMap, Lead, PoseEstimate
+from percept.sensors.records import BrakingRequest, EgoPath, LandmarkMap, Lead, Neighbours, PoseEstimate
 
 if TYPE_CHECKING:
     from percept.sensors import Frame, StereoRig
@@ -131,6 +131,11 @@ def _odometry_slot(ctx: SlotContext) -> Slot:
     return OdometrySlot(ctx.rig, ctx.dt_s, ctx.landmarks, ctx.start_pose or Pose2D(0.0, 0.0, 0.0))
 
 
+def _neighbour_slot(ctx: SlotContext) -> Slot:
+    from percept.neighbours import NeighbourSlot
+    return NeighbourSlot(ctx.rig, ctx.rear_rig, ctx.dt_s)
+
+
 def _lane_slot(ctx: SlotContext) -> Slot:
     from percept.lanes import LaneSlot
 
@@ -182,6 +187,19 @@ TASKS: tuple[Task, ...] = (
          higher_is_better=("consistency_3sigma", "consistency_3sigma_fused", "landmark_fixes", "landmark_sightings",
                            "path_length_m"),
          eval_plots=lazy("percept.evaluate.plots:worst_trajectories")),
+    Task("neighbours", Neighbours, lazy("percept.drive.neighbours_truth:PrivilegedNeighbours"),
+         lazy("percept.drive.neighbours_scoring:NeighbourScorer"), vision=_neighbour_slot,
+         recorder="percept.review.parts.neighbours:PART", reads=(EgoPath,),
+         headline=(Headline("recall ahead", "recall_ahead", "{:.3f}"), Headline("recall behind", "recall_behind", "{:.3f}"),
+                   Headline("beside absent [frames]", "beside_absent_frames", "{}"),
+                   Headline("gap error ahead (median)", "gap_abs_rel_err_ahead", "{:.3f}"),
+                   Headline("cut-in lead min [s]", "cut_in_warning_lead_s_min", "{:.2f}")),
+         help="vehicles ahead, beside and behind in the ego and next lanes (cut-ins)", bench_scenario="dense",
+         bench_peer=lazy("percept.bench.peers:sgbm_both_rigs"),
+         counts=(Count("beside_absent_frames", "frames a vehicle beside was absent", listed=True),
+                 Count("cut_ins_missed", "cut-ins not warned", listed=True)),
+         higher_is_better=("recall_ahead", "recall_beside", "recall_behind", "lane_accuracy",
+                           "cut_in_warning_lead_s_min")),
 )
 
 

@@ -226,12 +226,8 @@ class Neighbours:
         return not any(n.lane == lane and -behind_m - 3 * n.sigma_x_m <= n.x_m <= ahead_m + 3 * n.sigma_x_m
                        for n in self.tracks)
 
-    def cut_in_lead(self) -> Lead | None:
-        """The nearest neighbour ahead flagged as cutting in, as a lead for the following law (its gap as the range,
-        its relative speed as the range rate); None when none is."""
+    def cutting_in(self) -> Neighbour | None:
+        """The nearest neighbour ahead in a lane beside flagged as cutting in (the following law treats it as a lead
+        before it arrives); None when none is."""
         ahead = [n for n in self.tracks if n.cut_in and n.zone is Zone.AHEAD and n.lane != 0]
-        if not ahead:
-            return None
-        n = min(ahead, key=lambda t: t.gap_m)
-        return Lead(n.gap_m, n.rel_speed_mps, ObjectKind.VEHICLE, 1.0, Lead.time_to_contact(n.gap_m, n.rel_speed_mps),
-                    n.box_px, n.track_id)
+        return min(ahead, key=lambda t: t.gap_m) if ahead else None

@@ -1,0 +1,121 @@
+"""Vehicles among one rig's standing points: the points in lane coordinates (along the ego lane, across it from its
+centre line), binned on a ground grid, and each connected group of occupied cells one vehicle, measured at the face
+that looks at the rig.
+
+A vehicle ahead shows its rear (and, in a lane beside, its inner side); one behind its front. The face nearest the
+ego along the lane sets the gap, so the along-lane position of a detection is a low quantile of its points' x
+(ahead; a high one behind), then the median of the points within ``face_depth_m`` of it; its lateral centre is the
+middle of that face's lateral extent.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import cv2
+import numpy as np
+
+from percept.sensors import LaneEstimate
+
+from .points import StandingPoints
+
+VEHICLE_LENGTH_M = 5.0
+"""The length assumed for every vehicle (highway-env's Vehicle.LENGTH): a camera sees one face [m]."""
+DEFAULT_LANE_WIDTH_M = 3.75
+"""The lane width assumed while there is no lane estimate [m]."""
+
+
+@dataclass(frozen=True)
+class ClusterConfig:
+    """How the ground grid groups points."""
+
+    cell_x_m: float = 1.0  # grid cell along the lane [m]
+    cell_l_m: float = 0.25  # grid cell across it [m]
+    min_points: int = 2  # points that make a cell occupied
+    min_cells: int = 2  # cells that make a group a vehicle
+    min_group_points: int = 6  # points that make a group a vehicle
+    face_quantile: float = 0.1  # the quantile of x that finds the face (1 - it behind)
+    face_depth_m: float = 0.8  # points within this of the face measure it [m]
+    min_width_m: float = 0.4  # narrower groups are poles and the like [m]
+    max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One vehicle seen by one rig this frame, in lane coordinates."""
+
+    x_m: float  # its centre's along-lane position from the ego's centre [m] (+ ahead)
+    lat_m: float  # its centre's lateral position from the ego lane's centre line [m] (+ left)
+    face_x_m: float  # the along-lane position of the face the rig sees [m]
+    width_m: float  # the lateral extent of that face [m]
+    box_px: tuple  # (u0, v0, u1, v1) of its points in the rig's left image [px]
+    points: int  # how many points it has
+    sigma_x_m: float  # 1-sigma of x_m from the disparity noise [m]
+
+
+class FaceRange(Protocol):
+    """Measures a face: (the points, the indices of the face's points) -> (its along-lane position [m], its 1-sigma
+    [m]), or None when it cannot be measured."""
+
+    def __call__(self, pts: StandingPoints, idx: np.ndarray) -> tuple[float, float] | None: ...
+
+
+def lane_coordinates(pts: StandingPoints, lane: LaneEstimate | None) -> tuple[np.ndarray, np.ndarray, float]:
+    """(along, lateral, lane width): along = x; lateral = y - y_c(x), the offset from the ego lane's centre line
+    (the vehicle's x axis without an estimate)."""
+    if lane is None or not lane.valid:
+        return pts.x, pts.y, DEFAULT_LANE_WIDTH_M
+    return pts.x, pts.y - lane.centre_y(pts.x).astype(np.float32), float(lane.width_m)
+
+
+def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x_hi: float, face: FaceRange,
+                  cfg: ClusterConfig = ClusterConfig()) -> list[Detection]:
+    """The vehicles among ``pts`` with centres in the ego lane or a lane beside it and faces between ``x_lo`` and
+    ``x_hi`` along the lane [m], each face's range from ``face``."""
+    x, lat, width = lane_coordinates(pts, lane)
+    half = 1.5 * width + 1.0
+    keep = (x >= x_lo) & (x <= x_hi) & (np.abs(lat) <= half)
+    if not np.any(keep):
+        return []
+    x, lat, idx = x[keep], lat[keep], np.flatnonzero(keep)
+    nx, nl = int(np.ceil((x_hi - x_lo) / cfg.cell_x_m)), int(np.ceil(2 * half / cfg.cell_l_m))
+    ix = np.minimum(((x - x_lo) / cfg.cell_x_m).astype(np.int32), nx - 1)
+    il = np.minimum(((lat + half) / cfg.cell_l_m).astype(np.int32), nl - 1)
+    counts = np.bincount(ix * nl + il, minlength=nx * nl).reshape(nx, nl)
+    occupied = (counts >= cfg.min_points).astype(np.uint8)
+    n, labels = cv2.connectedComponents(occupied, connectivity=8)
+    point_label = labels[ix, il]
+    ahead = x_lo >= 0
+    out = []
+    for k in range(1, n):
+        sel = point_label == k
+        if sel.sum() < cfg.min_group_points or (labels == k).sum() < cfg.min_cells:
+            continue
+        det = _measure(pts, idx[sel], x[sel], lat[sel], ahead, width, face, cfg)
+        if det is not None:
+            out.append(det)
+    return out
+
+
+def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarray, ahead: bool, width: float,
+             face_range: FaceRange, cfg: ClusterConfig) -> Detection | None:
+    """One group's detection, or None when it is too narrow or its centre is outside the three lanes."""
+    if np.quantile(pts.z[idx], 0.1) > cfg.max_low_m:
+        return None
+    q = np.quantile(x, cfg.face_quantile if ahead else 1 - cfg.face_quantile, method="nearest")
+    face = np.abs(x - q) <= cfg.face_depth_m
+    measured = face_range(pts, idx[face])
+    if measured is None:
+        return None
+    fx, sigma = measured
+    l0, l1 = np.quantile(lat[face], [0.05, 0.95])
+    if l1 - l0 < cfg.min_width_m:
+        return None
+    centre_lat = float(0.5 * (l0 + l1))
+    if abs(centre_lat) > 1.5 * width:
+        return None
+    u, v = pts.u[idx], pts.v[idx]
+    box = (int(u.min()), int(v.min()), int(u.max()) + 1, int(v.max()) + 1)
+    centre = fx + VEHICLE_LENGTH_M / 2 if ahead else fx - VEHICLE_LENGTH_M / 2
+    return Detection(centre, centre_lat, fx, float(l1 - l0), box, len(idx), float(sigma))

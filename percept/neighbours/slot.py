@@ -1,0 +1,100 @@
+"""The vision neighbours slot: both rigs' stereo pairs and the ego path in, every vehicle in the ego lane and the
+lanes beside it, ahead, beside and behind, out (``Neighbours``).
+
+Each frame each rig's vehicles are found (``finder``: band stereo, ground-grid groups, the face's subpixel range) in
+the ego lane's coordinates, tracked (``tracker``), and each confirmed track reported with its lane, gap, relative
+speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside whose lateral
+speed (beyond three sigma of its estimate) takes its centre to the ego lane's boundary within ``horizon_s`` is
+flagged as cutting in, with the predicted time to that crossing, so the following law can treat it as a lead before
+it arrives.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from percept.sensors import EGO_LENGTH_M, EgoPath, Frame, Neighbour, Neighbours, StereoRig, Zone
+
+from .clusters import DEFAULT_LANE_WIDTH_M, VEHICLE_LENGTH_M, Detection
+from .finder import RigFinder
+from .tracker import NeighbourTracker, Track, TrackerConfig
+
+
+@dataclass(frozen=True)
+class NeighbourConfig:
+    """What the slot covers and when it warns."""
+
+    ahead_m: float = 80.0  # covered ahead of the ego's centre [m]
+    behind_m: float = 50.0  # covered behind it [m]
+    front_near_m: float = 3.0  # the nearest face the front rig measures, along the lane [m]
+    rear_near_m: float = -3.0  # the nearest face the rear rig measures [m]
+    horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]
+    min_lateral_speed_mps: float = 0.3  # and the lateral speed towards it at least this [m/s]
+    warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
+
+
+@dataclass(frozen=True)
+class NeighbourDebug:
+    """What the review shows: each rig's detections this frame and how long the slot's parts took."""
+
+    detections: dict  # rig name -> list of Detection
+    points: dict  # rig name -> number of standing points
+
+
+class NeighbourSlot:
+    """Vision neighbours from the forward rig and, when the car has one, the rear rig."""
+
+    def __init__(self, rig: StereoRig, rear_rig: StereoRig | None, dt_s: float, cfg: NeighbourConfig = NeighbourConfig(),
+                 tracker: TrackerConfig = TrackerConfig()):
+        self.cfg = cfg
+        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m)
+        self.rear = RigFinder(rear_rig, -cfg.behind_m - VEHICLE_LENGTH_M, cfg.rear_near_m) if rear_rig else None
+        self.tracker = NeighbourTracker(dt_s, tracker)
+
+    def reset(self) -> None:
+        self.tracker.reset()
+
+    def step(self, frame: Frame, upstream: dict) -> tuple[Neighbours, NeighbourDebug]:
+        path: EgoPath = upstream[EgoPath]
+        lane = path.lane if path.follows_lane else None
+        width = float(lane.width_m) if lane is not None else DEFAULT_LANE_WIDTH_M
+        detections: dict[str, list[Detection]] = {}
+        points = {}
+        if not frame.dropped:
+            detections["front"], pts = self.front.find(frame.left_gray, frame.right_gray, lane)
+            points["front"] = len(pts)
+        if self.rear is not None and frame.has_rear:
+            detections["rear"], pts = self.rear.find(frame.rear_left_gray, frame.rear_right_gray, lane)
+            points["rear"] = len(pts)
+        self.tracker.step(detections, width)
+        tracks = [self._report(t, width) for t in self.tracker.tracks if t.confirmed]
+        tracks = [n for n in tracks if n is not None]
+        tracks.sort(key=lambda n: (n.lane, abs(n.x_m)))
+        return (Neighbours(tuple(tracks), self.cfg.ahead_m, self.cfg.behind_m, self.rear is not None and frame.has_rear),
+                NeighbourDebug(detections, points))
+
+    def _report(self, t: Track, width: float) -> Neighbour | None:
+        x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
+        lane = int(round(lat / width))
+        if abs(lane) > 1 or not -self.cfg.behind_m - VEHICLE_LENGTH_M <= x <= self.cfg.ahead_m:
+            return None
+        half = (VEHICLE_LENGTH_M + EGO_LENGTH_M) / 2
+        zone = Zone.AHEAD if x > half else Zone.BEHIND if x < -half else Zone.BESIDE
+        gap = x - half if zone is Zone.AHEAD else -x - half if zone is Zone.BEHIND else 0.0
+        P = t.kf.P
+        sig_vl = math.sqrt(max(P[3, 3], 0.0))
+        cut_in, ttc = False, None
+        if lane != 0 and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m:
+            # towards the ego lane: -sign(lat) l' > 0; its centre reaches the boundary |l| = w/2 after
+            # t = (|l| - w/2) / (-sign(l) l')
+            toward = -math.copysign(1.0, lat) * vl
+            if toward > max(self.cfg.min_lateral_speed_mps, 3 * sig_vl):
+                ttc = max(abs(lat) - width / 2, 0.0) / toward
+                cut_in = ttc <= self.cfg.horizon_s
+                ttc = ttc if cut_in else None
+        return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
+                         math.sqrt(max(P[0, 0], 0.0)), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),
+                         t.camera, t.box_px, cut_in, ttc)

@@ -1,0 +1,142 @@
+"""Neighbour tracks: one Kalman filter (filterpy) per vehicle over its along-lane position and speed and its lateral
+position and speed, in the ego lane's coordinates, fed by both rigs' detections.
+
+Constant velocity with white acceleration noise (Bar-Shalom, Li & Kirubarajan 2001, sec. 6.3.2). A track is
+confirmed after ``confirm_hits`` detections, dropped after ``max_misses`` frames unseen where a rig could see it; in
+the blind band beside the ego, which neither rig sees, it is kept by prediction (held inside the band, its position
+uncertainty growing) until a rig takes it over as it comes out, so a lane is never reported free while a vehicle may
+be beside the ego.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+
+from .clusters import Detection
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """How tracks are made, kept and dropped."""
+
+    accel_noise_mps2: float = 2.0  # along-lane white acceleration (1-sigma) [m/s^2]
+    lateral_accel_noise_mps2: float = 0.8  # lateral white acceleration (1-sigma) [m/s^2]
+    lateral_sigma_m: float = 0.12  # a detection's lateral position noise (1-sigma) [m]
+    gate_x_m: float = 3.0  # association gate along the lane, plus gate_x_rel of the range [m]
+    gate_x_rel: float = 0.08  # ... [-]
+    gate_l_m: float = 1.4  # association gate across it [m]
+    confirm_hits: int = 3  # detections that confirm a track
+    max_misses: int = 6  # frames unseen (where a rig looks) that drop a track
+    blind_behind_m: float = -9.0  # the blind band beside the ego: centres from here ... [m]
+    blind_ahead_m: float = 7.5  # ... to here, along the lane, in the lanes beside [m]
+    max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
+
+
+@dataclass
+class Track:
+    """One vehicle's filter and bookkeeping."""
+
+    track_id: int
+    kf: KalmanFilter
+    hits: int = 1
+    misses: int = 0
+    blind_s: float = 0.0
+    camera: str | None = None
+    box_px: tuple | None = None
+    confirmed: bool = False
+
+    @property
+    def x(self) -> float:
+        return float(self.kf.x[0, 0])
+
+    @property
+    def lat(self) -> float:
+        return float(self.kf.x[2, 0])
+
+
+class NeighbourTracker:
+    """Tracks of the vehicles around the ego from per-rig detections."""
+
+    def __init__(self, dt_s: float, cfg: TrackerConfig = TrackerConfig()):
+        self.dt, self.cfg = dt_s, cfg
+        self.tracks: list[Track] = []
+        self._next_id = 1
+
+    def reset(self) -> None:
+        self.tracks.clear()
+        self._next_id = 1
+
+    def _new_filter(self, det: Detection) -> KalmanFilter:
+        dt, c = self.dt, self.cfg
+        kf = KalmanFilter(dim_x=4, dim_z=2)
+        # state (x, x', l, l'): x_k+1 = x_k + dt x'_k, l_k+1 = l_k + dt l'_k
+        kf.F = np.array([[1, dt, 0, 0], [0, 1, 0, 0], [0, 0, 1, dt], [0, 0, 0, 1]], float)
+        kf.H = np.array([[1, 0, 0, 0], [0, 0, 1, 0]], float)
+        # white acceleration: Q = q^2 [[dt^4/4, dt^3/2], [dt^3/2, dt^2]] per axis
+        block = np.array([[dt ** 4 / 4, dt ** 3 / 2], [dt ** 3 / 2, dt ** 2]])
+        kf.Q = np.zeros((4, 4))
+        kf.Q[:2, :2] = block * c.accel_noise_mps2 ** 2
+        kf.Q[2:, 2:] = block * c.lateral_accel_noise_mps2 ** 2
+        kf.x = np.array([[det.x_m], [0.0], [det.lat_m], [0.0]])
+        kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, c.lateral_sigma_m ** 2, 1.0 ** 2])
+        return kf
+
+    def in_blind_band(self, x_m: float, lat_m: float, width_m: float) -> bool:
+        """Whether a centre at (x_m, lat_m) lies where neither rig sees: beside the ego in a lane beside it."""
+        return self.cfg.blind_behind_m <= x_m <= self.cfg.blind_ahead_m and abs(lat_m) >= 0.5 * width_m
+
+    def step(self, detections: dict[str, list[Detection]], width_m: float) -> None:
+        """One frame: predict every track, associate each rig's detections (``detections``: rig name -> its
+        detections), make new tracks, keep the blind band's tracks and drop the lost ones."""
+        for t in self.tracks:
+            t.kf.predict()
+            t.camera, t.box_px = None, None
+        for rig, dets in detections.items():
+            self._associate(rig, dets)
+        self._keep_or_drop(width_m)
+
+    def _associate(self, rig: str, dets: list[Detection]) -> None:
+        c = self.cfg
+        pairs = []
+        for i, t in enumerate(self.tracks):
+            for j, d in enumerate(dets):
+                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x)
+                dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
+                if dx <= gate_x and dl <= c.gate_l_m:
+                    pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))
+        used_t, used_d = set(), set()
+        for _, i, j in sorted(pairs):
+            if i in used_t or j in used_d:
+                continue
+            used_t.add(i)
+            used_d.add(j)
+            t, d = self.tracks[i], dets[j]
+            R = np.diag([max(d.sigma_x_m, 0.05) ** 2, c.lateral_sigma_m ** 2])
+            t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
+            t.hits, t.misses, t.blind_s = t.hits + 1, 0, 0.0
+            t.camera, t.box_px = rig, d.box_px
+            t.confirmed = t.confirmed or t.hits >= c.confirm_hits
+        for j, d in enumerate(dets):
+            if j not in used_d:
+                self.tracks.append(Track(self._next_id, self._new_filter(d), camera=rig, box_px=d.box_px))
+                self._next_id += 1
+
+    def _keep_or_drop(self, width_m: float) -> None:
+        """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until
+        a rig takes it over; any other counts a miss, and too many drop it."""
+        c = self.cfg
+        kept = []
+        for t in self.tracks:
+            if t.camera is None:
+                beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
+                if beside and (self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0) and t.blind_s < c.max_blind_s:
+                    t.kf.x[0, 0] = float(np.clip(t.x, c.blind_behind_m, c.blind_ahead_m))
+                    t.blind_s += self.dt
+                else:
+                    t.misses += 1
+            if t.misses <= (c.max_misses if t.confirmed else 1):
+                kept.append(t)
+        self.tracks = kept
