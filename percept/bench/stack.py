@@ -2,7 +2,8 @@
 thread, beside the stock composition of the peers on the same scenario's frames; the render cost per condition;
 the closed loop's realtime factor with and without recording; and the memory of a long drive.
 
-The stack is timed where it runs: ``run_drive`` with every slot on vision over the scenario's first seconds (seed
+The stack is timed where it runs, with both rigs (the forward and the rear one) on every scenario: ``run_drive``
+with every slot on vision over the scenario's first seconds (seed
 0, so the sequence is fixed), which times each slot per frame under the run JSON's ``timing_ms`` keys and their
 sum (``perception_total``). The peers are the stock way to do each job, on frames of the same scenario: OpenCV's
 HOG ``detectMultiScale`` with its default people detector, ``StereoSGBM`` over the full frame, and a lane fit as
@@ -30,19 +31,19 @@ from .stages import cycle, median_ms
 CONDITIONS = ("clear", "night", "rain", "glare", "noise")
 """The conditions whose render cost is timed."""
 PAIR_FRAMES = 60
-"""Frames whose stereo pair is timed alone on each scenario; the figure is their median, which a few seconds'
+"""Frames whose stereo pairs are timed alone on each scenario; the figure is their median, which a few seconds'
 slowdown of the machine barely moves."""
 PERCEPTION_BUDGET_MS = 16.7
 """The whole perception stack's budget on one thread: 60 frames a second [ms/frame]."""
 STACK_SPEEDUP = 20.0
 """How many times faster than the stock composition the perception stack must be."""
-STEREO_PAIR_BUDGET_MS = 8.0
-"""The stereo pair's budget on every scenario [ms]."""
+STEREO_PAIR_BUDGET_MS = 14.0
+"""The budget of both stereo pairs together (the forward and the rear rig) on every scenario [ms]."""
 REALTIME_RECORDED = 2.0
 """The closed loop with every vision slot and recording must run at least this many times real time, every drive."""
 TARGETS = {"perception_total": f"perception total <= {PERCEPTION_BUDGET_MS:g} ms",
            "speedup": f">= {STACK_SPEEDUP:g}x the stock composition",
-           "stereo_pair": f"stereo pair <= {STEREO_PAIR_BUDGET_MS:g} ms",
+           "stereo_pair": f"both stereo pairs <= {STEREO_PAIR_BUDGET_MS:g} ms",
            "realtime_recorded": f"every recorded drive >= {REALTIME_RECORDED:g}x real time"}
 """The stack's targets, as ``StackCost.met`` names them, as a person reads them."""
 
@@ -62,7 +63,7 @@ class StackCost:
     # the run JSON's timing_ms (render, each slot, perception_total) of the unrecorded drive with the median
     # perception_total [ms/frame]; its render is the mean over the loop's frames, each rendered after the slots ran
     timing_ms: dict
-    # the median cost of one stereo pair alone (SimWorld.observe: the render and the ground truth) on the scenario's
+    # the median cost of both stereo pairs alone (SimWorld.observe: the renders and the ground truth) on the scenario's
     # first PAIR_FRAMES autopilot frames [ms]
     stereo_pair_ms: float
     # task name -> its bench_peer on the first of those frames, and "render" -> highway-env's top-down render
@@ -126,7 +127,7 @@ def _drive(scenario: str, seconds: float, record: Path | None = None, progress: 
     from percept.drive.loop import run_drive
 
     cfg = DriveConfig(WorldConfig(scenario, seed=0), duration_s=seconds,
-                      sources={t.name: Source.VISION for t in TASKS})
+                      sources={t.name: Source.VISION for t in TASKS}, rear=True)
     tick = (lambda i, n: progress()) if progress else None
     if record is None:
         return run_drive(cfg, progress=tick)
@@ -159,11 +160,11 @@ class _Ticking:
 
 
 def _peer_frames(scenario: str, frames: int, pair_frames: int = PAIR_FRAMES) -> tuple[list, float, float]:
-    """The first ``frames`` frames of ``scenario`` (autopilot, seed 0), the median cost of observing each of the
-    first ``pair_frames`` (the stereo pair and the ground truth) and highway-env's top-down render's median [ms]."""
-    from percept.sims import SimWorld, WorldConfig
+    """The first ``frames`` frames of ``scenario`` (autopilot, seed 0, both rigs), the median cost of observing each of
+    the first ``pair_frames`` (both stereo pairs and the ground truth) and highway-env's top-down render's median [ms]."""
+    from percept.sims import SimWorld, WorldConfig, with_rear
 
-    world = topdown_ready(SimWorld(WorldConfig(scenario, seed=0, autopilot=True)))
+    world = topdown_ready(SimWorld(with_rear(WorldConfig(scenario, seed=0, autopilot=True), True)))
     shots, pair_ms = [], []
     for k in range(max(frames, pair_frames)):
         t0 = time.perf_counter()

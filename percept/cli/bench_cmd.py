@@ -19,8 +19,8 @@ def bench(
                                                          "of 3 passes' means over consecutive frames; render "
                                                          "and peers: the median).")] = 30,
     stack: Annotated[bool, opt.flag("--stack", help="Also the whole stack: every vision slot in the closed loop on "
-                                                    "each scenario beside the stock composition of the peers, the "
-                                                    "stereo pair alone on each scenario, the render cost per "
+                                                    "each scenario (both rigs) beside the stock composition of the peers, "
+                                                    "both stereo pairs alone on each scenario, the render cost per "
                                                     "condition, the realtime factor with and without "
                                                     "recording.")] = False,
     scenario: Annotated[Optional[List[str]], typer.Option("--scenario", help="With --stack: only these scenarios "
@@ -123,7 +123,7 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
     out = {}
     if stacks:
         console.print(_stack_tables(stacks, repeats))
-        console.print(f"stereo pair alone on each scenario (clear, ms, the median of {PAIR_FRAMES} frames; \"render\" "
+        console.print(f"both stereo pairs alone on each scenario (clear, ms, the median of {PAIR_FRAMES} frames; \"render\" "
                       "above is the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}"
                                                                      for c in stacks))
         console.print("stereo pair with each condition (highway, ms): " + ", ".join(
