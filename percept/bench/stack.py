@@ -161,7 +161,8 @@ class _Ticking:
 
 def _peer_frames(scenario: str, frames: int, pair_frames: int = PAIR_FRAMES) -> tuple[list, float, float]:
     """The first ``frames`` frames of ``scenario`` (autopilot, seed 0, both rigs), the median cost of observing each of
-    the first ``pair_frames`` (both stereo pairs and the ground truth) and highway-env's top-down render's median [ms]."""
+    the first ``pair_frames`` (both stereo pairs and the ground truth) and highway-env's top-down render's median
+    [ms]."""
     from percept.sims import SimWorld, WorldConfig, with_rear
 
     world = topdown_ready(SimWorld(with_rear(WorldConfig(scenario, seed=0, autopilot=True), True)))

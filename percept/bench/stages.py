@@ -140,8 +140,8 @@ def bench_render(frames: int = 30, seed: int = 0, progress: Callable[[], None] |
 
 def bench_task(task: Task, tasks: tuple[Task, ...], frames: int = 30, seed: int = 0,
                progress: Callable[[], None] | None = None) -> StageCost:
-    """A task's vision slot on rendered frames of its bench scenario (640x480, both rigs, one thread); the slots upstream of
-    it are privileged (computed beforehand, not timed). A slot keeps state from frame to frame (trackers, filters,
+    """A task's vision slot on rendered frames of its bench scenario (640x480, both rigs, one thread); the slots
+    upstream of it are privileged (computed beforehand, not timed). A slot keeps state from frame to frame (trackers, filters,
     a search spread over frames), so it is timed on consecutive frames from a reset, as its mean cost per frame
     (``slot_ms``); the stateless peer as its median."""
     from percept.drive.loop import slot_context

@@ -123,8 +123,8 @@ def _stack(scenarios: list[str], seconds: float, repeats: int, soak_minutes: flo
     out = {}
     if stacks:
         console.print(_stack_tables(stacks, repeats))
-        console.print(f"both stereo pairs alone on each scenario (clear, ms, the median of {PAIR_FRAMES} frames; \"render\" "
-                      "above is the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}"
+        console.print(f"both stereo pairs alone on each scenario (clear, ms, the median of {PAIR_FRAMES} frames; "
+                      "\"render\" above is the closed loop's mean): " + ", ".join(f"{c.scenario} {fmt(c.stereo_pair_ms)}"
                                                                      for c in stacks))
         console.print("stereo pair with each condition (highway, ms): " + ", ".join(
             f"{k} {fmt(conditions[k])}" for k in CONDITIONS))

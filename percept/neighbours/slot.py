@@ -47,8 +47,8 @@ class NeighbourDebug:
 class NeighbourSlot:
     """Vision neighbours from the forward rig and, when the car has one, the rear rig."""
 
-    def __init__(self, rig: StereoRig, rear_rig: StereoRig | None, dt_s: float, cfg: NeighbourConfig = NeighbourConfig(),
-                 tracker: TrackerConfig = TrackerConfig()):
+    def __init__(self, rig: StereoRig, rear_rig: StereoRig | None, dt_s: float,
+                 cfg: NeighbourConfig = NeighbourConfig(), tracker: TrackerConfig = TrackerConfig()):
         self.cfg = cfg
         self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m)
         self.rear = RigFinder(rear_rig, -cfg.behind_m - VEHICLE_LENGTH_M, cfg.rear_near_m) if rear_rig else None
@@ -73,8 +73,8 @@ class NeighbourSlot:
         tracks = [self._report(t, width) for t in self.tracker.tracks if t.confirmed]
         tracks = [n for n in tracks if n is not None]
         tracks.sort(key=lambda n: (n.lane, abs(n.x_m)))
-        return (Neighbours(tuple(tracks), self.cfg.ahead_m, self.cfg.behind_m, self.rear is not None and frame.has_rear),
-                NeighbourDebug(detections, points))
+        rear = self.rear is not None and frame.has_rear
+        return Neighbours(tuple(tracks), self.cfg.ahead_m, self.cfg.behind_m, rear), NeighbourDebug(detections, points)
 
     def _report(self, t: Track, width: float) -> Neighbour | None:
         x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
