@@ -8,7 +8,8 @@ from importlib import import_module
 
 _HOME = {"Agent": "agent", "AgentStep": "agent", "DriveConfig": "config", "run_drive": "loop",
          "TruthFeed": "privileged", "in_path_obstacle": "privileged", "StepTruth": "scoring", "TASKS": "tasks",
-         "Headline": "tasks", "SlotContext": "tasks", "Task": "tasks", "task_order": "tasks"}
+         "Headline": "tasks", "SlotContext": "tasks", "Task": "tasks", "task_order": "tasks",
+         "truth_neighbours": "neighbours_truth"}
 
 __all__ = sorted(_HOME) + ["Source"]
 

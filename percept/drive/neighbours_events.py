@@ -1,0 +1,167 @@
+"""Events the neighbours scorer follows over a run: true cut-ins and the warnings for them, and who moved into whom
+when the ego collides with a vehicle.
+
+A cut-in is a true vehicle whose lane relative to the ego's goes from +-1 to 0 while it is ahead within
+``CUT_IN_GAP_M``: the frame its centre crosses the ego lane's boundary. Its warning lead is the crossing time less
+the onset of the warning run, on a track matched to that vehicle, still going on the frame before (0 when there is
+none: a missed cut-in). A warning onset is false when its track's vehicle does not cross into the ego lane (ahead,
+beside or behind, at any gap) within ``FALSE_WARNING_S``; onsets whose window outlasts the run are not judged.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+from percept.sensors import EGO_LENGTH_M, Zone
+from percept.sensors.vehicle import EGO_WIDTH_M
+
+from .neighbours_truth import ego_lane_velocity, lane_velocity, lateral_from_ego_lane
+
+CUT_IN_GAP_M = 60.0
+"""A crossing into the ego lane is a cut-in when the vehicle is ahead within this bumper gap [m]."""
+FALSE_WARNING_S = 3.0
+"""A warning is justified when its vehicle crosses into the ego lane within this after its onset [s]."""
+COLLISION_WINDOW_S = 1.0
+"""Lateral speeds before a collision are averaged over this [s]."""
+LATERAL_MOVE_MPS = 0.3
+"""Moving sideways towards the other faster than this makes a vehicle the mover in a collision [m/s]."""
+
+
+@dataclass
+class _Onset:
+    """A warning run's first frame, waiting for its vehicle to cross (or not) within FALSE_WARNING_S."""
+
+    time_s: float  # its first frame [s]
+    track_id: int  # the warning track
+    vehicle_id: int | None  # the true vehicle matched to the track (None until one is)
+
+
+class CutInEvents:
+    """True crossings into the ego lane and, when ``scored``, the warning lead of each and the false warnings."""
+
+    def __init__(self, scored: bool):
+        self.scored = scored
+        self.leads_s: list[float] = []  # per crossing, its warning lead [s] (0: missed), when scored
+        self.crossings = 0
+        self.missed = 0
+        self.false_warnings = 0
+        self._lanes: dict = {}  # vehicle id -> its relative lane on the previous frame
+        self._lane_index = None  # the ego's lane on the previous frame
+        self._since: dict = {}  # track id -> onset of its warning run going on at the previous frame [s]
+        self._matched: dict = {}  # track id -> vehicle id, on the previous frame
+        self._pending: list[_Onset] = []
+
+    def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict) -> None:
+        """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
+        ``matched`` track id -> vehicle id. When the ego's own lane changes, the relative lanes jump: no crossing."""
+        # into the ego lane anywhere (a warning for any of them is justified); ahead within CUT_IN_GAP_M: cut-ins
+        entered = [] if lane_index != self._lane_index else [
+            v for v, n in truth.items() if n.lane == 0 and self._lanes.get(v) in (-1, 1)]
+        crossed = [v for v in entered if truth[v].zone is Zone.AHEAD and truth[v].gap_m <= CUT_IN_GAP_M]
+        self.crossings += len(crossed)
+        if self.scored:
+            for v in crossed:
+                self._score_crossing(time_s, v, matched)
+            self._follow_warnings(time_s, tracks, matched, entered)
+        self._lanes = {v: n.lane for v, n in truth.items()}
+        self._lane_index = lane_index
+        self._matched = dict(matched)
+
+    def _score_crossing(self, time_s: float, vehicle_id, matched: dict) -> None:
+        """The lead of the warning run on a track matched to ``vehicle_id`` (now or the frame before)."""
+        tracks = {t for t, v in self._matched.items() if v == vehicle_id} | {t for t, v in matched.items()
+                                                                              if v == vehicle_id}
+        onsets = [self._since[t] for t in tracks if t in self._since]
+        # lead = t_cross - t_onset of the run still on the frame before the crossing
+        lead = time_s - min(onsets) if onsets else 0.0
+        self.leads_s.append(lead)
+        self.missed += int(not onsets)
+
+    def _follow_warnings(self, time_s: float, tracks, matched: dict, entered: list) -> None:
+        """Onsets of warning runs, and the judgement of each FALSE_WARNING_S after it."""
+        warning = {n.track_id for n in tracks if n.cut_in}
+        for t in sorted(warning - self._since.keys()):
+            self._since[t] = time_s
+            self._pending.append(_Onset(time_s, t, matched.get(t)))
+        self._since = {t: s for t, s in self._since.items() if t in warning}
+        keep = []
+        for o in self._pending:
+            o.vehicle_id = matched.get(o.track_id) if o.vehicle_id is None else o.vehicle_id
+            if o.vehicle_id is not None and o.vehicle_id in entered:
+                continue  # justified: its vehicle moved into the ego lane within the window
+            if time_s - o.time_s > FALSE_WARNING_S:
+                self.false_warnings += 1
+            else:
+                keep.append(o)
+        self._pending = keep
+
+    def result(self, minutes: float | None) -> dict:
+        """The group's cut-in keys; ``minutes``: the run's length [min] (None: too short to rate)."""
+        s = self.scored
+        return {"cut_ins": self.crossings,
+                "cut_ins_missed": self.missed if s else None,
+                "cut_in_warning_lead_s_min": min(self.leads_s) if s and self.leads_s else None,
+                "cut_in_leads_s": [round(v, 3) for v in self.leads_s] if s else None,
+                "false_warnings": self.false_warnings if s else None,
+                "false_warnings_per_min": self.false_warnings / minutes if s and minutes else None}
+
+
+@dataclass(frozen=True)
+class _Side:
+    """A vehicle near the ego on one frame, in the ego lane's frame."""
+
+    x_m: float  # its centre ahead of the ego's [m]
+    lateral_m: float  # its centre from the ego lane's centre [m] (+ left)
+    lateral_speed_mps: float  # [m/s] (+ left)
+    length_m: float  # [m]
+    width_m: float  # [m]
+
+
+class CollisionRecorder:
+    """Who moved into whom when the ego first collides: the vehicles it touches (``gt.collided_with``), each with
+    ``kind`` "rear-end" (the bodies meet end to end: the overlap along the lane is the smaller) or "side", and
+    ``mover``: the one moving sideways towards the other faster than LATERAL_MOVE_MPS (averaged over the last
+    COLLISION_WINDOW_S), else in a rear-end the one behind, else the one moving more towards the other."""
+
+    def __init__(self):
+        self.records: list[dict] = []
+        self._done = False
+        self._recent: deque = deque()  # (time [s], ego lateral speed [m/s], {vehicle id: _Side})
+
+    def update(self, gt) -> None:
+        near = {o.obj_id: _Side(float(o.position_m[0]), lateral_from_ego_lane(gt.lane, o),
+                                lane_velocity(gt.lane, o)[1], float(o.size_m[0]), float(o.size_m[1]))
+                for o in gt.objects if o.obj_id in gt.collided_with or abs(o.position_m[0]) < 20.0}
+        self._recent.append((gt.time_s, ego_lane_velocity(gt)[1], near))
+        while self._recent and gt.time_s - self._recent[0][0] > COLLISION_WINDOW_S:
+            self._recent.popleft()
+        if self._done or not gt.crashed:
+            return
+        self._done = True
+        if gt.pedestrians_hit and not gt.collided_with:
+            return
+        for other in gt.collided_with or (None,):
+            self.records.append(self._record(gt, other))
+
+    def _record(self, gt, other) -> dict:
+        rec = {"time_s": round(gt.time_s, 4), "other_id": other, "mover": None, "kind": None}
+        frames = [(ve, near[other]) for _, ve, near in self._recent if other in near]
+        if not frames:
+            return rec
+        o = frames[-1][1]
+        # the other's centre relative to the ego's, along and across the lane
+        dx, dy = o.x_m, o.lateral_m - gt.lane.offset_m
+        # overlap of the bodies along and across: (L_o + L_e)/2 - |dx|, (W_o + W_e)/2 - |dy|
+        along, across = (o.length_m + EGO_LENGTH_M) / 2 - abs(dx), (o.width_m + EGO_WIDTH_M) / 2 - abs(dy)
+        kind = "rear-end" if along < across else "side"
+        side = math.copysign(1.0, dy)
+        # speeds towards the other: the other's -s v_o, the ego's s v_e (s: the side the other is on)
+        to_ego = -side * sum(f[1].lateral_speed_mps for f in frames) / len(frames)
+        to_other = side * sum(f[0] for f in frames) / len(frames)
+        if max(to_ego, to_other) > LATERAL_MOVE_MPS or kind == "side":
+            mover = "other" if to_ego > to_other else "ego"
+        else:
+            mover = "ego" if dx > 0 else "other"
+        return rec | {"mover": mover, "kind": kind}
