@@ -27,8 +27,8 @@ from .tracker import NeighbourTracker, Track, TrackerConfig
 class NeighbourConfig:
     """What the slot covers and when it warns."""
 
-    ahead_m: float = 80.0  # covered ahead of the ego's centre [m]
-    behind_m: float = 50.0  # covered behind it [m]
+    ahead_m: float = 80.0  # covered ahead of the ego: the largest bumper gap reported [m]
+    behind_m: float = 60.0  # covered behind it [m]
     front_near_m: float = 3.0  # the nearest face the front rig measures, along the lane [m]
     rear_near_m: float = -3.0  # the nearest face the rear rig measures [m]
     horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]
@@ -50,8 +50,10 @@ class NeighbourSlot:
     def __init__(self, rig: StereoRig, rear_rig: StereoRig | None, dt_s: float,
                  cfg: NeighbourConfig = NeighbourConfig(), tracker: TrackerConfig = TrackerConfig()):
         self.cfg = cfg
-        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m)
-        self.rear = RigFinder(rear_rig, -cfg.behind_m - VEHICLE_LENGTH_M, cfg.rear_near_m) if rear_rig else None
+        # faces lie half the ego's length beyond the gap
+        reach = EGO_LENGTH_M / 2 + 2.0
+        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m + reach)
+        self.rear = RigFinder(rear_rig, -cfg.behind_m - reach, cfg.rear_near_m) if rear_rig else None
         self.tracker = NeighbourTracker(dt_s, tracker)
 
     def reset(self) -> None:
@@ -79,11 +81,11 @@ class NeighbourSlot:
     def _report(self, t: Track, width: float) -> Neighbour | None:
         x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
         lane = int(round(lat / width))
-        if abs(lane) > 1 or not -self.cfg.behind_m - VEHICLE_LENGTH_M <= x <= self.cfg.ahead_m:
-            return None
         half = (VEHICLE_LENGTH_M + EGO_LENGTH_M) / 2
         zone = Zone.AHEAD if x > half else Zone.BEHIND if x < -half else Zone.BESIDE
         gap = x - half if zone is Zone.AHEAD else -x - half if zone is Zone.BEHIND else 0.0
+        if abs(lane) > 1 or gap > (self.cfg.ahead_m if zone is Zone.AHEAD else self.cfg.behind_m):
+            return None
         P = t.kf.P
         sig_vl = math.sqrt(max(P[3, 3], 0.0))
         cut_in, ttc = False, None

@@ -207,12 +207,12 @@ class Neighbour:
 
 @dataclass(frozen=True)
 class Neighbours:
-    """Every tracked vehicle within ``ahead_m`` ahead and ``behind_m`` behind in the ego lane and the lanes either
-    side, as the neighbours task provides it."""
+    """Every tracked vehicle within bumper gaps of ``ahead_m`` ahead and ``behind_m`` behind in the ego lane and the
+    lanes either side, as the neighbours task provides it."""
 
     tracks: tuple[Neighbour, ...]  # nearest first within each lane
     ahead_m: float = 80.0  # how far ahead the lanes are covered [m]
-    behind_m: float = 50.0  # how far behind [m]
+    behind_m: float = 60.0  # how far behind [m]
     rear: bool = True  # whether the rear rig saw this frame (False: behind is covered by prediction only)
 
     def in_lane(self, lane: int) -> tuple[Neighbour, ...]:
