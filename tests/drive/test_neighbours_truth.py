@@ -42,7 +42,7 @@ def test_zones_and_bumper_gaps_and_the_ranges_covered(vehicle, truth):
     assert (n[2].zone, n[2].gap_m) == (Zone.BEHIND, pytest.approx(15.0))
     assert (n[3].zone, n[3].gap_m) == (Zone.BESIDE, 0.0)
     assert n[6].gap_m == pytest.approx(50 - 6 - 2.5) and n[6].length_m == 12.0
-    assert 4 not in n and 5 not in n   # 85 m ahead, 62.5 m behind: beyond 80 m and 60 m
+    assert 4 not in n and 5 not in n   # beyond 80 m ahead and 60 m behind
     wide = by_id(truth_neighbours(truth(cars), ahead_m=100, behind_m=100))
     assert 4 in wide and 5 in wide
 
