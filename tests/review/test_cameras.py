@@ -1,13 +1,12 @@
 """The rear camera in a recording: with a rear rig, its left image is stored as its own camera at the forward image's
 rate, with the true boxes on it and the neighbours part's tracks; without the rig, or on frames without its pair,
-nothing of it is stored; the layout shows a rear camera view only with a rear rig. Hand-made frames and truth."""
+nothing of it is stored. Hand-made frames and truth."""
 
 import numpy as np
-import rerun.blueprint as rrb
 
 from percept.drive import TASKS
 from percept.drive.agent import AgentStep
-from percept.review import RunRecorder, blueprint, parts
+from percept.review import RunRecorder
 from percept.review.context import REAR_CAMERA
 from percept.sensors import Frame, ImuSample, StereoRig, rear_rig
 
@@ -63,20 +62,3 @@ def test_without_a_rear_rig_or_its_pair_no_rear_image_is_stored(tmp_path):
         assert images(cols, "/world/ego/camera/left") == 2
         assert images(cols, REAR) == 0
         assert not [e for e in cols if e.startswith(f"{REAR}/")], name
-
-
-def views(container) -> list:
-    """Every view of a blueprint's container, depth first."""
-    out = []
-    for item in container.contents:
-        out += views(item) if isinstance(item, rrb.Container) else [item]
-    return out
-
-
-def test_the_layout_has_a_rear_camera_view_only_with_a_rear_rig():
-    part_list = [("neighbours", parts.control)]
-    with_rear = {v.name: v for v in views(blueprint(part_list, rear=True).root_container)}
-    without = {v.name: v for v in views(blueprint(part_list).root_container)}
-    assert "rear camera" in with_rear and "rear camera" not in without
-    assert str(with_rear["rear camera"].origin) == REAR_CAMERA
-    assert "left camera" in without and "3D (follows the ego)" in without

@@ -55,6 +55,12 @@ def label(n) -> str:
     return text + (" (predicted)" if n.predicted else "")
 
 
+def short_label(n) -> str:
+    """A track's label on an image: id and gap (the lane is its colour); a cut-in's time to crossing."""
+    text = f"#{n.track_id} {n.gap_m:.0f} m"
+    return f"CUT-IN {n.time_to_cross_s:.1f} s {text}" if n.cut_in and n.time_to_cross_s is not None else text
+
+
 def draw_tracks(ctx: PartContext, tracks, lane) -> None:
     """The tracks around the car in three entities: measured this frame, predicted only, cutting in."""
     groups = {"measured": [n for n in tracks if not n.cut_in and not n.predicted],
@@ -138,7 +144,7 @@ def draw_on_images(rec: rr.RecordingStream, ctx: PartContext, tracks, debug) -> 
             continue
         seen = [n for n in tracks if n.camera == rig and n.box_px is not None]
         boxes_2d(rec, ctx, on("tracks"), [n.box_px for n in seen],
-                 [CUT_IN_RGB if n.cut_in else LANE_RGB[n.lane] for n in seen], [label(n) for n in seen], 2.0)
+                 [CUT_IN_RGB if n.cut_in else LANE_RGB[n.lane] for n in seen], [short_label(n) for n in seen], 2.0)
         dets = detections.get(rig, [])
         boxes_2d(rec, ctx, on("detections"), [d.box_px for d in dets], [DETECTION_RGB],
                  [f"{d.x_m:.1f} m" for d in dets], 1.0)
