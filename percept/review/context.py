@@ -5,7 +5,9 @@ A part draws one task's record. It is called once per frame as ``part(rec, ctx, 
 task's slot returned (either may be None), ``truth`` the frame's ``StepTruth`` (truth: GroundTruth, in_path:
 Obstacle or None, the commands). A part logs its scalars under ``<task>/<key>/<series>``, what it draws on the
 left image under ``world/ego/camera/left/<task>/`` (in stored-image pixels, ``ctx.px(uv)``; only on frames with
-``ctx.image``, so that it never lags the image), what it draws around the car under ``world/ego/<task>/`` (vehicle frame) and anything in the world frame
+``ctx.image``, so that it never lags the image; on the rear rig's left image likewise under
+``world/ego/camera/rear_left/<task>/``, ``ctx.on_rear_image(name)``, on frames with ``ctx.rear_image``), what it
+draws around the car under ``world/ego/<task>/`` (vehicle frame) and anything in the world frame
 under ``world/<task>/``. A ``Part`` also names its plots and 3D trails so that the blueprint can lay them out;
 a plain callable gets one time-series view of everything under ``<task>/``. What a part draws every frame goes
 through ``ctx.buffer`` (``ctx.scalars``, ``ctx.buffer.clear``, ``ctx.buffer.add``: sent as columns, a tenth of the
@@ -30,6 +32,7 @@ from .series import ColumnBuffer
 TIMELINE = "sim_time"
 EGO = "world/ego"
 CAMERA = "world/ego/camera/left"
+REAR_CAMERA = "world/ego/camera/rear_left"
 TRUTH_RGB = (190, 190, 190)
 ESTIMATE_RGB = (255, 150, 30)
 TRUTH_VS_ESTIMATE = (("truth", TRUTH_RGB), ("estimate", ESTIMATE_RGB))
@@ -62,8 +65,9 @@ class PartContext:
     """task: the task's name (root of its entities); rig: the stereo rig; buffer: the recorder's rows sent as
     columns (what is drawn every frame: ``scalars``, clears, trails, what is around the car; the recorder sets each
     frame's time and sends them, so a part never holds a buffer of its own that nobody sends); image: this frame
-    stores a left image; image_scale: stored pixels per camera pixel; memory: the part's own state across frames
-    (a dict it may fill)."""
+    stores a left image; image_scale: stored pixels per camera pixel (both rigs); memory: the part's own state across
+    frames (a dict it may fill); rear_rig: the rear-facing rig (None: the car has none); rear_image: this frame
+    stores the rear rig's left image."""
 
     task: str
     rig: StereoRig
@@ -71,6 +75,8 @@ class PartContext:
     image: bool = False
     image_scale: float = 1.0
     memory: dict = field(default_factory=dict)
+    rear_rig: StereoRig | None = None
+    rear_image: bool = False
 
     def px(self, uv_px) -> np.ndarray:
         """Camera pixels (N, 2) (u, v) -> stored-image pixels."""
@@ -78,6 +84,9 @@ class PartContext:
 
     def on_image(self, name: str) -> str:
         return f"{CAMERA}/{self.task}/{name}"
+
+    def on_rear_image(self, name: str) -> str:
+        return f"{REAR_CAMERA}/{self.task}/{name}"
 
     def around_ego(self, name: str) -> str:
         return f"{EGO}/{self.task}/{name}"
@@ -101,12 +110,17 @@ class PartContext:
 @dataclass(frozen=True)
 class Plot:
     """One time-series view: key (entity under the task, e.g. "offset_m"), title with its unit, and the series
-    drawn in it as (name, RGB); the first (the truth, or the command) is drawn wider, so that an estimate equal to
-    it stays visible."""
+    drawn in it as (name, RGB); the first (the truth, or the command), or those named in ``wide``, are drawn wider,
+    so that an estimate equal to it stays visible."""
 
     key: str
     title: str
     series: tuple[tuple[str, tuple[int, int, int]], ...] = TRUTH_VS_ESTIMATE
+    wide: tuple[str, ...] | None = None  # the series drawn wide (None: the first)
+
+    def is_wide(self, i: int) -> bool:
+        """Whether the ``i``-th series is drawn wide."""
+        return i == 0 if self.wide is None else self.series[i][0] in self.wide
 
 
 @dataclass(frozen=True)
@@ -128,8 +142,9 @@ class Part:
         """Name and colour every series (static), then the part's own ``setup``."""
         for plot in self.plots:
             for i, (name, rgb) in enumerate(plot.series):
-                rec.log(f"{ctx.task}/{plot.key}/{name}", rr.SeriesLines(names=name, colors=[rgb],
-                                                                        widths=3.0 if i == 0 else 1.5), static=True)
+                width = 3.0 if plot.is_wide(i) else 1.5
+                rec.log(f"{ctx.task}/{plot.key}/{name}", rr.SeriesLines(names=name, colors=[rgb], widths=width),
+                        static=True)
         if self.setup is not None:
             self.setup(rec, ctx)
 

@@ -3,9 +3,11 @@
 Timeline ``sim_time`` in simulation seconds. Every recording has ``world`` (z up; object-kind annotation
 context), ``world/road`` (lane lines, static), ``world/ego`` (the ego pose, per frame; ``world/ego/body`` its
 box, static), ``world/ego/camera/left`` (mount and pinhole, static; the JPEG image at ``RecordOptions.camera_hz``),
-``world/ego/objects`` (true 3D boxes in the vehicle frame), ``world/ego/camera/left/objects`` (their true boxes in
-the image), ``world/trajectory`` (one true position per frame; the 3D view shows its whole past) and the control
-part's ``control/*``. Each task part adds ``<task>/*`` scalars and its drawings (see ``percept.review.context``).
+with a rear rig ``world/ego/camera/rear_left`` (the same for the rear rig's left camera, on frames that have its
+pair), ``world/ego/objects`` (true 3D boxes in the vehicle frame), ``world/ego/camera/left/objects`` and
+``world/ego/camera/rear_left/objects`` (their true boxes in each image; ``cameras.CameraStore``),
+``world/trajectory`` (one true position per frame; the 3D view shows its whole past) and the control part's
+``control/*``. Each task part adds ``<task>/*`` scalars and its drawings (see ``percept.review.context``).
 The drive is streamed to a temporary name beside the target (``.RUN.rrd.part``) without an RRD footer, the manifest
 of its chunks that Rerun's SDK would hold in memory, a row per chunk, until the file closes. ``close`` then writes a
 finished run's stream compacted and with its footer to ``RUN.rrd`` (``finish``: ``rerun rrd optimize`` in a child
@@ -19,7 +21,6 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import math
 import os
 import subprocess
 import sys
@@ -28,23 +29,20 @@ from dataclasses import replace
 from datetime import timedelta
 from pathlib import Path
 
-import cv2
 import numpy as np
 import rerun as rr
 
 from percept.outputs import atomic_path
-from percept.sensors import ObjectKind, Side, StereoRig
+from percept.sensors import StereoRig
 from percept.sensors.vehicle import EGO_LENGTH_M, EGO_WIDTH_M
 
 from . import parts, space
 from .blueprint import TRAJECTORY, blueprint
-from .context import CAMERA, EGO, TIMELINE, Part, PartContext, RecordOptions
+from .cameras import KIND_CLASSES, CameraStore
+from .context import CAMERA, EGO, REAR_CAMERA, TIMELINE, Part, PartContext, RecordOptions
 from .series import ColumnBuffer
 
 OBJECTS = f"{EGO}/objects"
-KIND_CLASSES = {ObjectKind.VEHICLE: (1, (70, 130, 230)), ObjectKind.PEDESTRIAN: (2, (240, 80, 60)),
-                ObjectKind.LANDMARK: (3, (250, 220, 60))}
-"""Class id and RGB of each object kind (the annotation context at ``world``)."""
 TRAJECTORY_RGB = (60, 220, 90)
 EGO_HEIGHT_M = 1.5
 """Height of the ego's box as drawn [m]."""
@@ -113,14 +111,16 @@ class RunRecorder:
 
     path: the recording (RUN.rrd); rig: the stereo rig; lane_lines: (N, 2) world polylines of the road's lane
     lines [m]; tasks: the slot table entries to draw (each with a ``recorder`` part, or None for none);
-    options: what is stored of the camera; duration_s: the run's simulated length [s] if known, for the free space
-    checked before anything is written (``space.check_space``). The free space is watched through the run: below
-    ``space.RESERVE_BYTES`` the stream is dropped and ``log_step`` raises ``space.no_space``. Also a context manager (an
-    exception closes it as partial).
+    options: what is stored of the cameras; duration_s: the run's simulated length [s] if known, for the free space
+    checked before anything is written (``space.check_space``); rear_rig: the rear-facing rig (None: the car has
+    none), whose left image is stored beside the forward one on frames that have its pair (``Frame.has_rear``). The
+    free space is watched through the run: below ``space.RESERVE_BYTES`` the stream is dropped and ``log_step`` raises
+    ``space.no_space``. Also a context manager (an exception closes it as partial).
     """
 
     def __init__(self, path: Path, rig: StereoRig, lane_lines: list[np.ndarray], tasks,
-                 options: RecordOptions = RecordOptions(), app_id: str = "percept", duration_s: float | None = None):
+                 options: RecordOptions = RecordOptions(), app_id: str = "percept", duration_s: float | None = None,
+                 rear_rig: StereoRig | None = None):
         self.path = Path(path)
         if not self.path.parent.is_dir():
             raise ValueError(f"cannot record to {self.path}: the folder {self.path.parent} does not exist")
@@ -132,17 +132,19 @@ class RunRecorder:
             raise ValueError("a task may not be named 'control': the control part records under that name")
         self.parts.append(("control", parts.control))
         self.buffer = ColumnBuffer(TIMELINE)
-        self.contexts = {name: PartContext(name, rig, self.buffer, image_scale=options.image_scale)
+        self.contexts = {name: PartContext(name, rig, self.buffer, image_scale=options.image_scale, rear_rig=rear_rig)
                          for name, _ in self.parts}
         self.rig = rig
+        self.camera = CameraStore(CAMERA, rig, options)
+        self.rear_camera = CameraStore(REAR_CAMERA, rear_rig, options, "rear_box_px") if rear_rig else None
         self.closed_as: Path | None = None
-        self._bucket: int | None = None
         self.failed: OSError | None = None
         self._watched_at = time.monotonic()
         self.tmp.unlink(missing_ok=True)  # left over from a run that was killed
         self.rec = rr.RecordingStream(app_id, batcher_config=rr.ChunkBatcherConfig(**BATCHING))
         # no footer (see the module's docstring)
-        self.rec.save(str(self.tmp), default_blueprint=blueprint(self.parts), write_footer=False)
+        self.rec.save(str(self.tmp), default_blueprint=blueprint(self.parts, rear=rear_rig is not None),
+                      write_footer=False)
         try:
             self._log_static(lane_lines)
         except BaseException:
@@ -151,19 +153,15 @@ class RunRecorder:
             raise
 
     def _log_static(self, lane_lines: list[np.ndarray]) -> None:
-        rec, rig = self.rec, self.rig
+        rec = self.rec
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         rec.log("world", rr.AnnotationContext([(cid, kind.value, rgb) for kind, (cid, rgb) in KIND_CLASSES.items()]),
                 static=True)
         strips = [np.column_stack([p, np.zeros(len(p))]) for p in lane_lines]
         rec.log("world/road", rr.LineStrips3D(strips, colors=[(200, 200, 200)], radii=0.08), static=True)
-        # camera mount: vehicle_from_camera rotation is the transpose of cam_from_vehicle
-        rec.log(CAMERA, rr.Transform3D(translation=rig.camera_position(Side.LEFT),
-                                       mat3x3=rig.rotation_cam_from_vehicle().T), static=True)
-        cam, s = rig.camera, self.options.image_scale
-        rec.log(CAMERA, rr.Pinhole(focal_length=[cam.fx * s, cam.fy * s], principal_point=[cam.cx * s, cam.cy * s],
-                                   resolution=[round(cam.width * s), round(cam.height * s)],
-                                   camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=2.0), static=True)
+        for camera in (self.camera, self.rear_camera):
+            if camera is not None:
+                camera.log_static(rec)
         rec.log(TRAJECTORY, rr.Points3D.from_fields(colors=[TRAJECTORY_RGB], radii=[0.3]), static=True)
         rec.log(f"{EGO}/body", rr.Boxes3D(centers=[[0, 0, EGO_HEIGHT_M / 2]],
                                           sizes=[[EGO_LENGTH_M, EGO_WIDTH_M, EGO_HEIGHT_M]], colors=[TRAJECTORY_RGB]),
@@ -184,11 +182,13 @@ class RunRecorder:
         e = gt.ego
         self.buffer.add(EGO, rr.Transform3D, translation=[[e.x_m, e.y_m, 0.0]],
                         rotation_axis_angle=[rr.RotationAxisAngle(axis=[0, 0, 1], radians=e.yaw_rad)])
-        image = self._log_image(frame)
-        self._log_objects(gt.objects, image)
+        image = self.camera.store(rec, frame.timestamp_s, frame.left)
+        rear = self.rear_camera is not None and frame.has_rear and self.rear_camera.store(rec, frame.timestamp_s,
+                                                                                           frame.rear_left)
+        self._log_objects(gt.objects, image, rear)
         self.buffer.add(TRAJECTORY, rr.Points3D, positions=[[e.x_m, e.y_m, 0.05]])
         for name, part in self.parts:
-            ctx = replace(self.contexts[name], image=image)
+            ctx = replace(self.contexts[name], image=image, rear_image=rear)
             if name == "control":
                 part(rec, ctx, step, step.control, truth)
             else:
@@ -212,25 +212,9 @@ class RunRecorder:
         the part file is removed, and its space comes back once Rerun's writer lets go of it."""
         self.tmp.unlink(missing_ok=True)
 
-    def _log_image(self, frame) -> bool:
-        """Store the left image if this frame starts a new 1 / camera_hz interval; whether it was stored."""
-        bucket = math.floor(frame.timestamp_s * self.options.camera_hz + 1e-6)
-        if frame.left is None or bucket == self._bucket:
-            return False
-        img, s = frame.left, self.options.image_scale
-        if s != 1:
-            h, w = img.shape[:2]
-            img = cv2.resize(img, (round(w * s), round(h * s)), interpolation=cv2.INTER_AREA)
-        ok, jpg = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, int(self.options.jpeg_quality)])
-        if not ok:
-            return False
-        self.rec.log(CAMERA, rr.EncodedImage(contents=jpg.tobytes(), media_type="image/jpeg"))
-        self._bucket = bucket
-        return True
-
-    def _log_objects(self, objects, image: bool) -> None:
-        """True boxes: 3D in the vehicle frame (under the ego's transform) and, with an image, 2D on it."""
-        rec = self.rec
+    def _log_objects(self, objects, image: bool, rear: bool) -> None:
+        """True boxes: 3D in the vehicle frame (under the ego's transform) and, on each image stored this frame (the
+        forward ``image``, the ``rear`` one), 2D on it."""
         if objects:
             # Boxes3D(sizes=s) logs half sizes: float32 s / 2
             self.buffer.add(OBJECTS, rr.Boxes3D, centers=[o.position_m for o in objects],
@@ -240,16 +224,10 @@ class RunRecorder:
                             class_ids=[KIND_CLASSES[o.kind][0] for o in objects], show_labels=[False])
         else:
             self.buffer.clear(OBJECTS)
-        if not image:
-            return
-        seen = [o for o in objects if o.box_px is not None]
-        if seen:
-            rec.log(f"{CAMERA}/objects", rr.Boxes2D(
-                array=np.asarray([o.box_px for o in seen], dtype=float) * self.options.image_scale,
-                array_format=rr.Box2DFormat.XYXY, class_ids=[KIND_CLASSES[o.kind][0] for o in seen],
-                show_labels=False))
-        else:
-            self.buffer.clear(f"{CAMERA}/objects")
+        if image:
+            self.camera.log_boxes(self.rec, self.buffer, objects)
+        if rear:
+            self.rear_camera.log_boxes(self.rec, self.buffer, objects)
 
     def close(self, complete: bool = True) -> Path:
         """Flush and move the recording into place: ``path`` when ``complete`` (compacted, with its footer:
