@@ -96,7 +96,7 @@ class Recording:
         duration_s = self.cfg.duration_s if self.cfg.duration_s is not None else world.scenario.duration_s
         # the rear rig, where the world has one (WorldConfig.rear_rig; None: none)
         self.recorder = RunRecorder(self.path, world.cfg.rig, world.road_geometry.lane_lines, self.cfg.tasks,
-                                    self.options, duration_s=duration_s, rear_rig=getattr(world.cfg, "rear_rig", None))
+                                    self.options, duration_s=duration_s, rear_rig=world.cfg.rear_rig)
         return self.recorder
 
     def close(self, complete: bool = True) -> None:

@@ -57,7 +57,8 @@ def test_privileged_puts_every_slot_on_ground_truth_and_a_slot_option_still_wins
                             "--json", str(js)])
     assert r.exit_code == 0, r.output
     assert json.loads(js.read_text())["slots"] == {"lanes": "vision", "longitudinal": "privileged",
-                                                   "pedestrians": "privileged", "odometry": "privileged"}
+                                                   "pedestrians": "privileged", "odometry": "privileged",
+                                                   "neighbours": "privileged"}
 
 
 def test_drive_default_recording_path(tmp_path, monkeypatch):
