@@ -22,6 +22,9 @@ from .points import StandingPoints
 
 VEHICLE_LENGTH_M = 5.0
 """The length assumed for every vehicle (highway-env's Vehicle.LENGTH): a camera sees one face [m]."""
+VEHICLE_WIDTH_M = 2.0
+"""The width assumed for every vehicle (highway-env's Vehicle.WIDTH): where the image's edge cuts a face off, its
+centre is put half this beyond the edge that is seen [m]."""
 DEFAULT_LANE_WIDTH_M = 3.75
 """The lane width assumed while there is no lane estimate [m]."""
 
@@ -31,12 +34,14 @@ class ClusterConfig:
     """How the ground grid groups points."""
 
     cell_x_m: float = 1.0  # grid cell along the lane [m]
-    cell_l_m: float = 0.25  # grid cell across it [m]
+    cell_l_m: float = 0.5  # grid cell across it [m]
     min_points: int = 2  # points that make a cell occupied
     min_cells: int = 2  # cells that make a group a vehicle
-    min_group_points: int = 6  # points that make a group a vehicle
-    face_quantile: float = 0.1  # the quantile of x that finds the face (1 - it behind)
-    face_depth_m: float = 0.8  # points within this of the face measure it [m]
+    min_group_points: int = 6  # points that make a group a vehicle, far away [-]
+    # ... and near by: a face of a square metre at range Z shows about (f / 2 Z)^2 points at half resolution, so a
+    # group needs at least this many points times 1 / Z^2 [m^2]
+    group_points_m2: float = 15000.0
+    side_m: float = 0.4  # points within this of a group's inner edge are its side, not its face [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
 
@@ -52,6 +57,7 @@ class Detection:
     box_px: tuple  # (u0, v0, u1, v1) of its points in the rig's left image [px]
     points: int  # how many points it has
     sigma_x_m: float  # 1-sigma of x_m from the disparity noise [m]
+    cut_off: bool = False  # the image's side edge cuts the face off: its lateral centre is inferred from one edge
 
 
 class FaceRange(Protocol):
@@ -90,7 +96,12 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
     out = []
     for k in range(1, n):
         sel = point_label == k
-        if sel.sum() < cfg.min_group_points or (labels == k).sum() < cfg.min_cells:
+        n_points = int(sel.sum())
+        if n_points < cfg.min_group_points or (labels == k).sum() < cfg.min_cells:
+            continue
+        # N >= max(min_group_points, c / Z^2), Z the group's nearest range along the lane
+        near = float(np.min(np.abs(x[sel])))
+        if n_points < cfg.group_points_m2 / max(near, 1.0) ** 2:
             continue
         det = _measure(pts, idx[sel], x[sel], lat[sel], ahead, width, face, cfg)
         if det is not None:
@@ -100,22 +111,30 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
 
 def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarray, ahead: bool, width: float,
              face_range: FaceRange, cfg: ClusterConfig) -> Detection | None:
-    """One group's detection, or None when it is too narrow or its centre is outside the three lanes."""
+    """One group's detection, or None when it does not reach down to the road, is too narrow or its centre is outside
+    the three lanes. The face is what is left of the group without its inner side (the points within ``side_m`` of
+    the edge nearest the ego lane's centre line, which a car in a lane beside shows along its length); the face's
+    range is ``face_range`` of those points, its lateral extent runs from that inner edge to the face's outer edge."""
     if np.quantile(pts.z[idx], 0.1) > cfg.max_low_m:
         return None
-    q = np.quantile(x, cfg.face_quantile if ahead else 1 - cfg.face_quantile, method="nearest")
-    face = np.abs(x - q) <= cfg.face_depth_m
+    l0, l1 = np.quantile(lat, [0.05, 0.95])
+    if l1 - l0 < cfg.min_width_m:
+        return None
+    beside = abs(0.5 * (l0 + l1)) > 0.5 * width
+    # the inner edge is the one nearer the ego lane's centre line; the outer one is the face's
+    inner, sign = (l0, 1.0) if l0 + l1 > 0 else (l1, -1.0)
+    face = sign * (lat - inner) > cfg.side_m if beside else np.ones(len(lat), bool)
+    if face.sum() < cfg.min_group_points:
+        face = np.ones(len(lat), bool)
     measured = face_range(pts, idx[face])
     if measured is None:
         return None
     fx, sigma = measured
-    l0, l1 = np.quantile(lat[face], [0.05, 0.95])
-    if l1 - l0 < cfg.min_width_m:
-        return None
-    centre_lat = float(0.5 * (l0 + l1))
+    outer = np.quantile(lat[face], 0.95 if sign > 0 else 0.05)
+    centre_lat = float(0.5 * (inner + outer))
     if abs(centre_lat) > 1.5 * width:
         return None
     u, v = pts.u[idx], pts.v[idx]
     box = (int(u.min()), int(v.min()), int(u.max()) + 1, int(v.max()) + 1)
     centre = fx + VEHICLE_LENGTH_M / 2 if ahead else fx - VEHICLE_LENGTH_M / 2
-    return Detection(centre, centre_lat, fx, float(l1 - l0), box, len(idx), float(sigma))
+    return Detection(centre, centre_lat, fx, float(abs(outer - inner)), box, len(idx), float(sigma))

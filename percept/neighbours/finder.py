@@ -2,13 +2,24 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from percept.sensors import LaneEstimate, Side, StereoRig
 
-from .clusters import ClusterConfig, Detection, find_vehicles
+from .clusters import VEHICLE_WIDTH_M, ClusterConfig, Detection, find_vehicles
 from .points import BandStereo, PointsConfig, StandingPoints
 from .refine import refine_face
+
+
+EDGE_PX = 48
+"""A face narrower than ``FULL_FACE_M`` whose points come this close to the image's side edge is cut off by it
+(block matching leaves the last columns unmatched) [px]."""
+CUT_OFF_SIGMA_X_M = 5.0
+"""The along-lane 1-sigma of a cut-off face: the nearest point seen is on the car's side, at the image's edge [m]."""
+FULL_FACE_M = 1.6
+"""A face at least this wide is seen whole [m]."""
 
 
 class RigFinder:
@@ -27,7 +38,28 @@ class RigFinder:
         """The detections of one grey pair, and the standing points they came from."""
         pts = self.stereo.points(left_gray, right_gray)
         self._pair = (left_gray, right_gray)
-        return find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters), pts
+        found = find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters)
+        return [self.cut_off(d) for d in found], pts
+
+    def cut_off(self, det: Detection) -> Detection:
+        """``det`` marked as cut off when it reaches the image's side edge (a car coming alongside); when its face is
+        narrower than a whole one, its lateral centre put half a car's width beyond the face's edge that is seen and
+        its along-lane position given little weight: the middle of a cut face would drift towards the ego lane, and
+        its nearest point is on the car's side where the image ends, which lags the car."""
+        width = self.rig.camera.width
+        # the image's left edge looks to the vehicle's left for a forward rig, to its right for a rear one
+        left_side = -1.0 if self.rig.looks_back else 1.0
+        if det.box_px[0] <= EDGE_PX:
+            missing = left_side
+        elif det.box_px[2] >= width - EDGE_PX:
+            missing = -left_side
+        else:
+            return det
+        if det.width_m >= FULL_FACE_M:
+            return replace(det, cut_off=True)
+        # the seen edge is the one away from the missing side: centre = seen edge + missing W_v / 2
+        seen = det.lat_m - missing * det.width_m / 2
+        return replace(det, lat_m=seen + missing * VEHICLE_WIDTH_M / 2, sigma_x_m=CUT_OFF_SIGMA_X_M, cut_off=True)
 
     def face_range(self, pts: StandingPoints, idx: np.ndarray) -> tuple[float, float] | None:
         """The face's along-lane position from its points' refined disparity, and its 1-sigma [m]."""

@@ -33,6 +33,8 @@ class NeighbourConfig:
     rear_near_m: float = -3.0  # the nearest face the rear rig measures [m]
     horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]
     min_lateral_speed_mps: float = 0.3  # and the lateral speed towards it at least this [m/s]
+    min_shift_m: float = 0.25  # and it has moved at least this from its lane's centre towards the ego lane [m]
+    min_hits: int = 10  # and it has been detected at least this often (its lateral speed is known) [-]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
 
 
@@ -89,13 +91,15 @@ class NeighbourSlot:
         P = t.kf.P
         sig_vl = math.sqrt(max(P[3, 3], 0.0))
         cut_in, ttc = False, None
-        if lane != 0 and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m:
+        c = self.cfg
+        if lane != 0 and zone is not Zone.BEHIND and x <= c.warn_ahead_m and t.hits >= c.min_hits and not t.cut_off:
             # towards the ego lane: -sign(lat) l' > 0; its centre reaches the boundary |l| = w/2 after
             # t = (|l| - w/2) / (-sign(l) l')
             toward = -math.copysign(1.0, lat) * vl
-            if toward > max(self.cfg.min_lateral_speed_mps, 3 * sig_vl):
+            shift = -math.copysign(1.0, lat) * (lat - lane * width)
+            if toward > max(c.min_lateral_speed_mps, 3 * sig_vl) and shift >= c.min_shift_m:
                 ttc = max(abs(lat) - width / 2, 0.0) / toward
-                cut_in = ttc <= self.cfg.horizon_s
+                cut_in = ttc <= c.horizon_s
                 ttc = ttc if cut_in else None
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
                          math.sqrt(max(P[0, 0], 0.0)), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),

@@ -30,8 +30,9 @@ class TrackerConfig:
     gate_l_m: float = 1.4  # association gate across it [m]
     confirm_hits: int = 3  # detections that confirm a track
     max_misses: int = 6  # frames unseen (where a rig looks) that drop a track
-    blind_behind_m: float = -9.0  # the blind band beside the ego: centres from here ... [m]
-    blind_ahead_m: float = 7.5  # ... to here, along the lane, in the lanes beside [m]
+    blind_behind_m: float = -14.0  # the blind band beside the ego, where a rig sees too little of a car to find it:
+    # centres from here ...
+    blind_ahead_m: float = 12.0  # ... to here, along the lane, in the lanes beside [m]
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
 
 
@@ -47,6 +48,7 @@ class Track:
     camera: str | None = None
     box_px: tuple | None = None
     confirmed: bool = False
+    cut_off: bool = False  # its last detection was cut off by the image's edge
 
     @property
     def x(self) -> float:
@@ -103,7 +105,8 @@ class NeighbourTracker:
         pairs = []
         for i, t in enumerate(self.tracks):
             for j, d in enumerate(dets):
-                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x)
+                # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
+                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
                 if dx <= gate_x and dl <= c.gate_l_m:
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))
@@ -117,7 +120,7 @@ class NeighbourTracker:
             R = np.diag([max(d.sigma_x_m, 0.05) ** 2, c.lateral_sigma_m ** 2])
             t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
             t.hits, t.misses, t.blind_s = t.hits + 1, 0, 0.0
-            t.camera, t.box_px = rig, d.box_px
+            t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
         for j, d in enumerate(dets):
             if j not in used_d:
@@ -134,6 +137,8 @@ class NeighbourTracker:
                 beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
                 if beside and (self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0) and t.blind_s < c.max_blind_s:
                     t.kf.x[0, 0] = float(np.clip(t.x, c.blind_behind_m, c.blind_ahead_m))
+                    # nothing says it moves sideways in the band: it keeps its lateral place
+                    t.kf.x[3, 0] = 0.0
                     t.blind_s += self.dt
                 else:
                     t.misses += 1
