@@ -82,7 +82,8 @@ class ScriptedVehicle(IDMVehicle):
     merge_road: (from, to) nodes of the road (an acceleration lane's) on which its MOBIL lane changes switch on,
     and stay on (a ramp vehicle that may not cross the gore before it);
     pace_offset_m: once its x minus the ego's [m] reaches this value it holds it (beside the ego) for ``pace_s``
-    seconds, matching the ego's speed, then drives on as IDM traffic.
+    seconds, matching the ego's speed (never faster than IDM allows behind a car ahead), then drives on as IDM
+    traffic.
     The scenario calls ``script(time_s, ego)`` every simulation step.
     """
 
@@ -133,7 +134,9 @@ class ScriptedVehicle(IDMVehicle):
             # brake at a constant deceleration to a standstill
             self.action["acceleration"] = self.brake_mps2
         elif self.pace_mps2 is not None:
-            self.action["acceleration"] = float(np.clip(self.pace_mps2, -self.ACC_MAX, self.ACC_MAX))
+            # pacing, but never faster than IDM allows behind whoever is ahead in its lane
+            pace = float(np.clip(self.pace_mps2, -self.ACC_MAX, self.ACC_MAX))
+            self.action["acceleration"] = min(pace, float(self.action["acceleration"]))
 
     def step(self, dt: float) -> None:
         super().step(dt)
