@@ -5,7 +5,7 @@ from __future__ import annotations
 from highway_env.vehicle.kinematics import Vehicle
 from highway_env.vehicle.objects import Landmark
 
-from .actors import Pedestrian, Sign
+from .actors import LaneEnd, Pedestrian, Sign
 from .coords import hw_pose
 from .render.scene import ObjectKind, ObjectState, Scene
 
@@ -42,7 +42,7 @@ def object_state(obj, oid: int) -> ObjectState | None:
     if isinstance(obj, Vehicle):
         return ObjectState(oid, ObjectKind.VEHICLE, pose, obj.LENGTH, obj.WIDTH, VEHICLE_HEIGHT_M, style=oid * 7919,
                            speed_mps=float(obj.speed))
-    if isinstance(obj, Landmark):  # highway-env's own goal markers are not physical
+    if isinstance(obj, (Landmark, LaneEnd)):  # goal markers are not physical; a lane's end is where its lines end
         return None
     return ObjectState(oid, ObjectKind.VEHICLE, pose, obj.LENGTH, obj.WIDTH, 1.0, style=oid)
 

@@ -13,7 +13,7 @@ from percept.sims.coords import world_to_hw_xy
 from percept.sims.ground_truth import lane_truth
 from percept.sims.road_geometry import SHOULDER_M
 from percept.sims.scenarios import ClothoidLane, winding_road
-from percept.sims.scenarios.catalog import _chain
+from percept.sims.scenarios.placing import chain_nodes as _chain
 
 
 def segments(net, lane_id: int):

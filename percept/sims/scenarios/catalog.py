@@ -11,122 +11,72 @@ from typing import Callable
 
 import numpy as np
 from highway_env.road.road import Road
-from highway_env.vehicle.behavior import IDMVehicle
 
 from ..actors import Pedestrian, ScriptedVehicle, Sign
+from .placing import chain_nodes, lane_at, new_road, place_idm, place_traffic
 from .roads import loop_road, straight_road, winding_road
+from .traffic import build_dense, build_merge, build_overtake
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """One scenario of the catalogue: its name, what it is and how its road is built."""
+    """One scenario of the catalogue: its name, what it is and how its road is built.
+
+    lane_changes: its traffic changes lanes (highway-env's MOBIL), so vehicles move into and out of the ego lane
+    and come up beside and behind the ego; what watches the neighbouring lanes (the rear rig) is on by default
+    there. Elsewhere every vehicle keeps its lane, apart from a scripted cut-in.
+    """
 
     name: str  # its name on the command line
     summary: str  # what it is, one line
     duration_s: float  # default run length [s]
     build: Callable  # build(env, rng) -> highway-env Road, with the ego made by ``env.make_ego``
     ego_speed_mps: float = 25.0  # the ego's nominal speed [m/s] (``build`` sets its start and cruise speeds)
-    lane_changes: bool = False  # its traffic changes lanes (highway-env's MOBIL); runs carry the rear rig by default
-
-
-def _chain(net) -> list[str]:
-    """Node names of a chained network in driving order, starting at "0"."""
-    order, node = ["0"], "0"
-    while node in net.graph and len(order) <= len(net.graph) + 1:
-        node = next(iter(net.graph[node]))
-        if node == "0":
-            break
-        order.append(node)
-    return order
-
-
-def lane_at(net, lane_id: int, s: float):
-    """(lane_index, longitudinal) of distance s along the chain of segments, for lane ``lane_id``."""
-    nodes = _chain(net)
-    for a, b in zip(nodes, nodes[1:] + ["0"]):
-        if b not in net.graph.get(a, {}):
-            break
-        lane = net.graph[a][b][lane_id]
-        if s < lane.length:
-            return (a, b, lane_id), s
-        s -= lane.length
-    raise ValueError(f"position {s:.0f} m is past the end of the road")
-
-
-def _idm(road, idx, s, speed, cls=IDMVehicle, **kw):
-    lane = road.network.get_lane(idx)
-    v = cls(road, lane.position(s, 0.0), lane.heading_at(s), speed, target_lane_index=idx, target_speed=speed,
-            **kw)
-    v.enable_lane_change = False
-    road.vehicles.append(v)
-    return v
-
-
-def _traffic(road, rng, lanes: list[int], s0: float, s1: float, count: int, speeds: tuple[float, float],
-             keep_clear: list[tuple[int, float, float]]) -> None:
-    """``count`` IDM vehicles on ``lanes`` between s0 and s1, at least 25 m apart, outside the keep-clear zones."""
-    placed: list[tuple[int, float]] = [(ln, (a + b) / 2) for ln, a, b in keep_clear]
-    tries = 0
-    while count > 0 and tries < 500:
-        tries += 1
-        ln = int(rng.choice(lanes))
-        s = float(rng.uniform(s0, s1))
-        if any(ln == l2 and a - 8 <= s <= b + 8 for l2, a, b in keep_clear):
-            continue
-        if any(ln == l2 and abs(s - s2) < 25 for l2, s2 in placed):
-            continue
-        idx, ss = lane_at(road.network, ln, s)
-        _idm(road, idx, ss, float(rng.uniform(*speeds)))
-        placed.append((ln, s))
-        count -= 1
-
-
-def _new_road(env, net) -> Road:
-    return Road(network=net, np_random=env.np_random, record_history=False)
+    lane_changes: bool = False  # True: the traffic changes lanes on its own (MOBIL); False: it keeps its lanes
 
 
 def build_highway(env, rng) -> Road:
-    road = _new_road(env, straight_road(4, 3000.0))
+    road = new_road(env, straight_road(4, 3000.0))
     env.road = road
     ego_lane = int(rng.integers(1, 3))
     env.make_ego(("0", "1", ego_lane), 60.0, 25.0)
     env.cruise_speed_mps = 30.0  # faster than the lead, so the ego settles into following it
     lead_s = 60.0 + float(rng.uniform(40.0, 60.0))
-    _idm(road, ("0", "1", ego_lane), lead_s, float(rng.uniform(25.0, 27.0)))
-    _traffic(road, rng, [0, 1, 2, 3], 0.0, 700.0, 14, (25.0, 30.0), [(ego_lane, 30.0, lead_s + 40.0)])
+    place_idm(road, ("0", "1", ego_lane), lead_s, float(rng.uniform(25.0, 27.0)))
+    place_traffic(road, rng, [0, 1, 2, 3], 0.0, 700.0, 14, (25.0, 30.0), [(ego_lane, 30.0, lead_s + 40.0)])
     return road
 
 
 def build_curves(env, rng) -> Road:
-    road = _new_road(env, winding_road(rng, lanes=3, length_m=2600.0))
+    road = new_road(env, winding_road(rng, lanes=3, length_m=2600.0))
     env.road = road
     env.make_ego(("0", "1", 1), 40.0, 20.0)
     idx, s = lane_at(road.network, 1, 95.0)
-    _idm(road, idx, s, 20.0)
-    _traffic(road, rng, [0, 1, 2], 0.0, 800.0, 10, (18.0, 22.0), [(1, 10.0, 140.0)])
+    place_idm(road, idx, s, 20.0)
+    place_traffic(road, rng, [0, 1, 2], 0.0, 800.0, 10, (18.0, 22.0), [(1, 10.0, 140.0)])
     return road
 
 
 def build_lead_brake(env, rng) -> Road:
-    road = _new_road(env, straight_road(3, 2000.0))
+    road = new_road(env, straight_road(3, 2000.0))
     env.road = road
     env.make_ego(("0", "1", 1), 60.0, 25.0)
     # the ego (set to 25 m/s) follows a lead at 24 m/s, from bumper gaps of 40-50 m, until the lead brakes
-    _idm(road, ("0", "1", 1), 60.0 + float(rng.uniform(45.0, 55.0)), 24.0, cls=ScriptedVehicle,
+    place_idm(road, ("0", "1", 1), 60.0 + float(rng.uniform(45.0, 55.0)), 24.0, cls=ScriptedVehicle,
          brake_at_s=float(rng.uniform(8.0, 10.0)), brake_mps2=-6.0)
-    _traffic(road, rng, [0, 2], 0.0, 500.0, 8, (24.0, 28.0), [])
+    place_traffic(road, rng, [0, 2], 0.0, 500.0, 8, (24.0, 28.0), [])
     return road
 
 
 def build_cut_in(env, rng) -> Road:
-    road = _new_road(env, straight_road(3, 2000.0))
+    road = new_road(env, straight_road(3, 2000.0))
     env.road = road
     env.make_ego(("0", "1", 1), 60.0, 25.0)
     side = int(rng.choice([0, 2]))
-    _idm(road, ("0", "1", side), 60.0 + float(rng.uniform(35.0, 50.0)), 21.0, cls=ScriptedVehicle,
+    place_idm(road, ("0", "1", side), 60.0 + float(rng.uniform(35.0, 50.0)), 21.0, cls=ScriptedVehicle,
          cut_in_lane=("0", "1", 1), cut_in_gap_m=float(rng.uniform(12.0, 20.0)))
-    _idm(road, ("0", "1", 1), 60.0 + 150.0, 24.0)
-    _traffic(road, rng, [2 - side], 0.0, 500.0, 5, (24.0, 28.0), [])
+    place_idm(road, ("0", "1", 1), 60.0 + 150.0, 24.0)
+    place_traffic(road, rng, [2 - side], 0.0, 500.0, 5, (24.0, 28.0), [])
     return road
 
 
@@ -135,7 +85,7 @@ CROSSING_LANE_W = 3.5
 
 def build_crossing(env, rng) -> Road:
     """Two-lane road; people cross the ego lane at ~5 km/h (Euro NCAP CPNA-like), others stay on the verge."""
-    road = _new_road(env, straight_road(2, 1500.0, width_m=CROSSING_LANE_W, speed_limit=17.0))
+    road = new_road(env, straight_road(2, 1500.0, width_m=CROSSING_LANE_W, speed_limit=17.0))
     env.road = road
     speed = float(rng.uniform(20.0, 60.0)) / 3.6
     ego_y = CROSSING_LANE_W  # lane 1 centre
@@ -172,11 +122,11 @@ SIGN_OFFSET_M = 4.0
 def build_loop(env, rng) -> Road:
     """A ~3.7 km circuit with ArUco signs at surveyed positions every 80 m, alternating sides."""
     net = loop_road()
-    road = _new_road(env, net)
+    road = new_road(env, net)
     env.road = road
     env.make_ego(("0", "1", 1), 30.0, 22.0)
-    _traffic(road, rng, [0, 1], 0.0, 3000.0, 12, (20.0, 24.0), [(1, 0.0, 120.0)])
-    nodes = _chain(net)
+    place_traffic(road, rng, [0, 1], 0.0, 3000.0, 12, (20.0, 24.0), [(1, 0.0, 120.0)])
+    nodes = chain_nodes(net)
     total = sum(net.graph[a][b][0].length for a, b in zip(nodes, nodes[1:] + ["0"]))
     n = int(total // LANDMARK_SPACING_M)
     for k in range(n):
@@ -206,4 +156,10 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
              "ego at 20-60 km/h", 70.0, build_crossing, 12.0),
     Scenario("loop", "a 3.7 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,
              22.0),
+    Scenario("dense", "highway-v0's traffic: 4 lanes, 50 cars at 20-30 m/s changing lanes (MOBIL); ego set to 30 m/s",
+             40.0, build_dense, 25.0, lane_changes=True),
+    Scenario("overtake", "3 lanes: a slow car ahead, faster traffic passing on the left, a car sitting beside the ego "
+             "where no camera sees it", 40.0, build_overtake, 25.0, lane_changes=True),
+    Scenario("merge", "highway-env's merge: ramp cars join the ego lane, two ahead of the ego, one behind; lane "
+             "changes", 40.0, build_merge, 25.0, lane_changes=True),
 ]}

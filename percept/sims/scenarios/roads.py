@@ -8,7 +8,7 @@ its left line is the solid road edge, the rightmost lane's right line too, lines
 from __future__ import annotations
 
 import numpy as np
-from highway_env.road.lane import CircularLane, LineType, StraightLane
+from highway_env.road.lane import CircularLane, LineType, SineLane, StraightLane
 
 from .clothoid import ClothoidLane
 from .network import IndexedRoadNetwork
@@ -137,3 +137,37 @@ def loop_road(lanes: int = 2, straight_m: float = 1000.0, radius_m: float = 260.
         b.transition(0.0, end_node=end)
     return b.net
 
+
+
+MERGE_GAP_M = 6.5
+"""highway-env's merge-v0: the ramp's centre runs this far outside the next lane's centre before it converges [m]."""
+
+
+def merge_road(lead_in_m: float, ramp_m: float, after_m: float, lanes: int = 2, converge_m: float = 80.0,
+               merge_m: float = 80.0, width_m: float = 4.0, speed_limit: float = 30.0) -> IndexedRoadNetwork:
+    """highway-env's merge layout (merge-v0) on a longer straight road: ``lanes`` lanes, and on their right a ramp,
+    lane index ``lanes`` of the first three segments, forbidden to the main road's traffic (MOBIL never moves there).
+    Nodes "0"-"1": the lead-in (the ramp runs beside its last ``ramp_m`` metres, MERGE_GAP_M outside the next lane);
+    "1"-"2": the ramp converges along a half sine (converge_m); "2"-"3": it is an acceleration lane beside the
+    rightmost lane, with a dashed line between them (merge_m); "3"-"4": the road goes on (after_m). All [m]."""
+    if not 0 < ramp_m <= lead_in_m:
+        raise ValueError(f"the ramp must be 0 to {lead_in_m:g} m long, got {ramp_m:g}")
+    net = IndexedRoadNetwork()
+    ends = np.cumsum([0.0, lead_in_m, converge_m, merge_m, after_m])
+    for k in range(4):
+        for i in range(lanes):
+            lt = line_types(i, lanes)
+            if k == 2 and i == lanes - 1:
+                lt = [lt[0], S]  # the acceleration lane joins here
+            y = i * width_m
+            net.add_lane(str(k), str(k + 1), StraightLane([ends[k], y], [ends[k + 1], y], width=width_m,
+                                                         line_types=lt, speed_limit=speed_limit))
+    y_join = lanes * width_m  # the ramp's centre once it has joined: one lane right of the rightmost
+    y_ramp = y_join + MERGE_GAP_M
+    ramp = dict(width=width_m, forbidden=True, speed_limit=speed_limit)
+    net.add_lane("0", "1", StraightLane([ends[1] - ramp_m, y_ramp], [ends[1], y_ramp], line_types=[C, C], **ramp))
+    # lateral offset from the mid line: (gap / 2) sin(pi s / converge_m + pi / 2), +gap/2 at its start, -gap/2 at its end
+    net.add_lane("1", "2", SineLane([ends[1], y_join + MERGE_GAP_M / 2], [ends[2], y_join + MERGE_GAP_M / 2],
+                                    MERGE_GAP_M / 2, np.pi / converge_m, np.pi / 2, line_types=[C, C], **ramp))
+    net.add_lane("2", "3", StraightLane([ends[2], y_join], [ends[3], y_join], line_types=[N, C], **ramp))
+    return net

@@ -1,0 +1,79 @@
+"""Placing highway-env vehicles on a scenario's road: positions along a chain of segments, single IDM cars and
+seeded traffic.
+
+Lane changes are opt-in: a vehicle placed here keeps its lane (``enable_lane_change = False``) unless the
+scenario asks for highway-env's MOBIL lane changes with ``lane_change=True``.
+"""
+
+from __future__ import annotations
+
+from highway_env.road.road import Road
+from highway_env.vehicle.behavior import IDMVehicle, LinearVehicle
+
+from .quick_road import QuickRoad
+
+
+def chain_nodes(net) -> list[str]:
+    """Node names of a chained network in driving order, starting at "0"."""
+    order, node = ["0"], "0"
+    while node in net.graph and len(order) <= len(net.graph) + 1:
+        node = next(iter(net.graph[node]))
+        if node == "0":
+            break
+        order.append(node)
+    return order
+
+
+def lane_at(net, lane_id: int, s: float):
+    """(lane_index, longitudinal) of distance s along the chain of segments, for lane ``lane_id``."""
+    nodes = chain_nodes(net)
+    for a, b in zip(nodes, nodes[1:] + ["0"]):
+        if b not in net.graph.get(a, {}):
+            break
+        lane = net.graph[a][b][lane_id]
+        if s < lane.length:
+            return (a, b, lane_id), s
+        s -= lane.length
+    raise ValueError(f"position {s:.0f} m is past the end of the road")
+
+
+def new_road(env, net, connected: bool = False) -> Road:
+    """A highway-env Road (QuickRoad: the same answers, faster) on ``net`` drawing from the environment's generator.
+    connected: vehicles look for their neighbours on the next and previous segments too (highway-env's
+    ``neighbour_vehicles_connected_lanes``), which a road of short segments needs so that traffic sees across the
+    joints."""
+    return QuickRoad(network=net, np_random=env.np_random, record_history=False,
+                neighbour_vehicles_connected_lanes=connected)
+
+
+def place_idm(road, idx, s: float, speed: float, cls=IDMVehicle, lane_change: bool = False, **kw):
+    """A vehicle of class ``cls`` (highway-env's IDMVehicle or a subclass) on lane ``idx`` at longitudinal s [m],
+    driving at ``speed`` [m/s], which is also its target speed; lane_change: MOBIL lane changes on."""
+    lane = road.network.get_lane(idx)
+    v = cls(road, lane.position(s, 0.0), lane.heading_at(s), speed, target_lane_index=idx, target_speed=speed,
+            **kw)
+    v.enable_lane_change = lane_change
+    if isinstance(v, LinearVehicle):
+        v.collecting_data = False  # its regression data would grow every step and is never read
+    road.vehicles.append(v)
+    return v
+
+
+def place_traffic(road, rng, lanes: list[int], s0: float, s1: float, count: int, speeds: tuple[float, float],
+                  keep_clear: list[tuple[int, float, float]], lane_change: bool = False) -> None:
+    """``count`` IDM vehicles on ``lanes`` between s0 and s1 [m], at least 25 m apart, outside the keep-clear zones
+    (lane, from, to [m]); speeds: (low, high) [m/s], drawn uniformly; lane_change: MOBIL lane changes on."""
+    placed: list[tuple[int, float]] = [(ln, (a + b) / 2) for ln, a, b in keep_clear]
+    tries = 0
+    while count > 0 and tries < 500:
+        tries += 1
+        ln = int(rng.choice(lanes))
+        s = float(rng.uniform(s0, s1))
+        if any(ln == l2 and a - 8 <= s <= b + 8 for l2, a, b in keep_clear):
+            continue
+        if any(ln == l2 and abs(s - s2) < 25 for l2, s2 in placed):
+            continue
+        idx, ss = lane_at(road.network, ln, s)
+        place_idm(road, idx, ss, float(rng.uniform(*speeds)), lane_change=lane_change)
+        placed.append((ln, s))
+        count -= 1
