@@ -2,9 +2,10 @@
 
 Each frame the estimated tracks are matched one to one to the true vehicles (``truth_neighbours``, bumper gaps to
 ``MATCH_RANGE_M``) by the Hungarian method on along-lane position and lateral position from the ego lane's centre,
-gated by |dx| <= max(4 m, 0.1 |x|) and |dy| <= 1.8 m. Recall per zone and lane: ahead and behind, of the vehicles
+gated by |dx| <= max(4 m, 0.1 |x|) (for a track no rig measured this frame, held by prediction, also up to three
+sigma of its own position: it says a vehicle may be anywhere there) and |dy| <= 1.8 m. Recall per zone and lane: ahead and behind, of the vehicles
 within ``RECALL_GAP_M`` at least half visible in the rig facing them; beside, of every vehicle there in a lane beside
-the ego's. Over the matched pairs: lane accuracy, the median |gap_est - gap_true| / gap_true ahead and behind
+the ego's that a rig has seen on its way there. Over the matched pairs: lane accuracy, the median |gap_est - gap_true| / gap_true ahead and behind
 (within ``GAP_ERR_M``, and by bin of the true gap), the median relative speed error. A metric with no sample is None.
 """
 
@@ -37,26 +38,29 @@ LANES = (-1, 0, 1)
 
 
 def match_tracks(tracks, truth, width_m: float) -> list[tuple[int, int]]:
-    """One-to-one (track index, truth index) pairs of ``Neighbour``s within the gate, at least total cost, the cost
-    of a pair (dx / gate_x)^2 + (dy / gate_y)^2; a track's lateral position is lane * ``width_m`` + lateral_m."""
+    """One-to-one (track index, truth index) pairs of ``Neighbour``s within the gate (see the module docstring), at
+    least total cost, the cost of a pair (dx / gate_x)^2 + (dy / gate_y)^2; a track's lateral position is
+    lane * ``width_m`` + lateral_m."""
     if not tracks or not truth:
         return []
     pos = np.array([[n.x_m, n.lane * width_m + n.lateral_m] for n in tracks])
     ref = np.array([[n.x_m, n.lane * width_m + n.lateral_m] for n in truth])
     d = np.abs(pos[:, None, :] - ref[None, :, :])
-    # gate_x = max(4 m, 0.1 |x_true|)
-    gate_x = np.maximum(GATE_X_M, GATE_X_SHARE * np.abs(ref[:, 0]))[None, :]
+    # gate_x = max(4 m, 0.1 |x_true|, 3 sigma_x of a predicted track)
+    spread = np.array([3 * n.sigma_x_m if n.predicted else 0.0 for n in tracks])[:, None]
+    gate_x = np.maximum(np.maximum(GATE_X_M, GATE_X_SHARE * np.abs(ref[:, 0]))[None, :], spread)
     inside = (d[..., 0] <= gate_x) & (d[..., 1] <= GATE_Y_M)
     cost = np.where(inside, (d[..., 0] / gate_x) ** 2 + (d[..., 1] / GATE_Y_M) ** 2, 1e6)
     rows, cols = linear_sum_assignment(cost)
     return [(int(r), int(c)) for r, c in zip(rows, cols) if inside[r, c]]
 
 
-def recall_eligible(n) -> bool:
-    """Whether recall counts a true ``Neighbour``: beside in a lane beside the ego's, or ahead (behind) within
-    RECALL_GAP_M seen by the forward (rear) rig."""
+def recall_eligible(n, seen: set = frozenset()) -> bool:
+    """Whether recall counts a true ``Neighbour``: beside in a lane beside the ego's once a rig has seen it (``seen``:
+    the ids of the vehicles at least half visible in a rig so far; one that has been beside the ego since the run
+    began, unseen, cannot be known), or ahead (behind) within RECALL_GAP_M seen by the forward (rear) rig."""
     if n.zone is Zone.BESIDE:
-        return n.lane != 0
+        return n.lane != 0 and n.track_id in seen
     facing = "front" if n.zone is Zone.AHEAD else "rear"
     return n.gap_m <= RECALL_GAP_M and n.camera == facing
 
@@ -102,6 +106,7 @@ class NeighbourScorer:
         self.gaps = Rows(3)  # zone (+1 ahead, -1 behind), estimated gap [m], true gap [m]
         self.rel_speed_err = Rows(1)  # |rel speed est - true| [m/s]
         self.beside_absent = 0
+        self.seen: set[int] = set()  # ids of the true vehicles a rig has seen at least half so far
         self.cut_ins = CutInEvents(ctx.vision)
         self.collisions = CollisionRecorder()
         self.frames = 0
@@ -124,9 +129,10 @@ class NeighbourScorer:
     def _score_pairs(self, tracks, truth, pairs) -> None:
         """Recall, beside-absent frames and the matched pairs' errors of one frame."""
         found = {j for _, j in pairs}
+        self.seen.update(n.track_id for n in truth if n.camera is not None)
         beside_missed = False
         for j, n in enumerate(truth):
-            if recall_eligible(n):
+            if recall_eligible(n, self.seen):
                 self.recall.add(n.zone, n.lane, j in found)
                 beside_missed |= n.zone is Zone.BESIDE and j not in found
         self.beside_absent += int(beside_missed)

@@ -102,5 +102,5 @@ class NeighbourSlot:
                 cut_in = ttc <= c.horizon_s
                 ttc = ttc if cut_in else None
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
-                         math.sqrt(max(P[0, 0], 0.0)), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),
+                         self.tracker.sigma_x(t), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),
                          t.camera, t.box_px, cut_in, ttc)

@@ -34,6 +34,7 @@ class TrackerConfig:
     # centres from here ...
     blind_ahead_m: float = 12.0  # ... to here, along the lane, in the lanes beside [m]
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
+    blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
 
 
 @dataclass
@@ -127,6 +128,23 @@ class NeighbourTracker:
                 self.tracks.append(Track(self._next_id, self._new_filter(d), camera=rig, box_px=d.box_px))
                 self._next_id += 1
 
+    def _hold_in_band(self, t: Track) -> None:
+        """One frame of a track held in the blind band: nothing says it moves sideways, so it keeps its lateral place;
+        if its prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed
+        somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
+        c = self.cfg
+        t.kf.x[3, 0] = 0.0
+        held = float(np.clip(t.x, c.blind_behind_m, c.blind_ahead_m))
+        if held != t.x:
+            t.kf.x[0, 0], t.kf.x[1, 0] = held, 0.0
+            t.kf.P[0, 0] = max(t.kf.P[0, 0], ((c.blind_ahead_m - c.blind_behind_m) / 2) ** 2)
+        t.blind_s += self.dt
+
+    def sigma_x(self, t: Track) -> float:
+        """A track's along-lane 1-sigma [m]: its filter's, widened at ``blind_spread_mps`` for as long as it has been
+        held in the blind band (a car there may change its speed unseen)."""
+        return float(np.sqrt(max(t.kf.P[0, 0], 0.0))) + self.cfg.blind_spread_mps * t.blind_s
+
     def _keep_or_drop(self, width_m: float) -> None:
         """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until
         a rig takes it over; any other counts a miss, and too many drop it."""
@@ -136,10 +154,7 @@ class NeighbourTracker:
             if t.camera is None:
                 beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
                 if beside and (self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0) and t.blind_s < c.max_blind_s:
-                    t.kf.x[0, 0] = float(np.clip(t.x, c.blind_behind_m, c.blind_ahead_m))
-                    # nothing says it moves sideways in the band: it keeps its lateral place
-                    t.kf.x[3, 0] = 0.0
-                    t.blind_s += self.dt
+                    self._hold_in_band(t)
                 else:
                     t.misses += 1
             if t.misses <= (c.max_misses if t.confirmed else 1):

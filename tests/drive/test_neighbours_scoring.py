@@ -86,14 +86,26 @@ def test_lane_gap_and_speed_errors_over_matched_pairs(vehicle, truth):
 
 
 def test_a_vehicle_beside_with_no_track_counts_its_frames(vehicle, truth):
-    frames = []
-    for k in range(5):
+    # seen ahead first (a rig saw it on its way beside the ego), then beside with no track for three frames
+    seen = truth([vehicle(1, 20.0, 4.0, visible=1.0)], time_s=0.0)
+    frames = [(seen, mirrored(seen))]
+    for k in range(1, 6):
         gt = truth([vehicle(1, 0.0, 4.0, visible=0)], time_s=k * DT)
-        frames.append((gt, [] if k < 3 else mirrored(gt, x_m=1.0)))
+        frames.append((gt, [] if k < 4 else mirrored(gt, x_m=1.0)))
     r = run(frames)
     assert r["beside_absent_frames"] == 3
     assert r["recall_beside"] == pytest.approx(0.4) and r["recall_beside_by_lane"] == {"-1": None,
                                                                                         "1": pytest.approx(0.4)}
+
+
+def test_a_vehicle_beside_since_the_start_and_never_seen_is_not_counted(vehicle, truth):
+    frames = []
+    for k in range(5):
+        gt = truth([vehicle(1, 0.0, 4.0, visible=0)], time_s=k * DT)
+        frames.append((gt, []))
+    r = run(frames)
+    assert r["beside_absent_frames"] == 0
+    assert r["recall_beside"] is None
 
 
 def cut_in_run(vehicle, truth, warned, seconds: float = 5.0, cross: bool = True):
