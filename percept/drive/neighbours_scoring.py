@@ -3,10 +3,12 @@
 Each frame the estimated tracks are matched one to one to the true vehicles (``truth_neighbours``, bumper gaps to
 ``MATCH_RANGE_M``) by the Hungarian method on along-lane position and lateral position from the ego lane's centre,
 gated by |dx| <= max(4 m, 0.1 |x|) (for a track no rig measured this frame, held by prediction, also up to three
-sigma of its own position: it says a vehicle may be anywhere there) and |dy| <= 1.8 m. Recall per zone and lane: ahead and behind, of the vehicles
-within ``RECALL_GAP_M`` at least half visible in the rig facing them; beside, of every vehicle there in a lane beside
-the ego's that a rig has seen on its way there. Over the matched pairs: lane accuracy, the median |gap_est - gap_true| / gap_true ahead and behind
-(within ``GAP_ERR_M``, and by bin of the true gap), the median relative speed error. A metric with no sample is None.
+sigma of its own position: it says a vehicle may be anywhere there) and |dy| <= 1.8 m. Recall per zone and lane:
+ahead and behind, of the vehicles within ``RECALL_GAP_M`` at least half visible in the rig facing them; beside, of
+every vehicle there in a lane beside the ego's that a rig has seen on its way there. Over the matched pairs: lane
+accuracy; of those ahead and behind that recall counts (what a rig measures), the median |gap_est - gap_true| /
+gap_true ahead and behind (within ``GAP_ERR_M``, and by bin of the true gap) and the median relative speed error.
+A metric with no sample is None.
 """
 
 from __future__ import annotations
@@ -139,10 +141,12 @@ class NeighbourScorer:
         for i, j in pairs:
             est, tru = tracks[i], truth[j]
             self.lanes_agree.append((float(est.lane == tru.lane),))
+            # gaps and speeds are what a rig measures: of the vehicles ahead and behind it sees at least half of
+            if tru.zone is Zone.BESIDE or not recall_eligible(tru):
+                continue
             # |v_rel_est - v_rel_true|
             self.rel_speed_err.append((abs(est.rel_speed_mps - tru.rel_speed_mps),))
-            if tru.zone is not Zone.BESIDE:
-                self.gaps.append((1.0 if tru.zone is Zone.AHEAD else -1.0, est.gap_m, tru.gap_m))
+            self.gaps.append((1.0 if tru.zone is Zone.AHEAD else -1.0, est.gap_m, tru.gap_m))
 
     def _minutes(self) -> float | None:
         """The run's length [min]: its frames times the frame period (from the first and last frame times)."""

@@ -20,11 +20,11 @@ from percept.sensors import LaneEstimate
 
 from .points import StandingPoints
 
+VEHICLE_WIDTH_M = 2.0
+"""The width assumed for every vehicle (highway-env's Vehicle.WIDTH): where only its side, or one edge of its face,
+is seen, its centre is put half this beyond it [m]."""
 VEHICLE_LENGTH_M = 5.0
 """The length assumed for every vehicle (highway-env's Vehicle.LENGTH): a camera sees one face [m]."""
-VEHICLE_WIDTH_M = 2.0
-"""The width assumed for every vehicle (highway-env's Vehicle.WIDTH): where the image's edge cuts a face off, its
-centre is put half this beyond the edge that is seen [m]."""
 DEFAULT_LANE_WIDTH_M = 3.75
 """The lane width assumed while there is no lane estimate [m]."""
 
@@ -42,6 +42,9 @@ class ClusterConfig:
     # group needs at least this many points times 1 / Z^2 [m^2]
     group_points_m2: float = 15000.0
     side_m: float = 0.4  # points within this of a group's inner edge are its side, not its face [m]
+    side_share: float = 0.6  # a group in a lane beside with this share of its points on one line along the lane ...
+    side_band_m: float = 0.2  # ... (within this of its median lateral place) is a car's side seen alone [m]
+    side_sigma_x_m: float = 5.0  # the along-lane 1-sigma of a side seen alone: its ends are where the image ends [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
 
@@ -117,6 +120,9 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     range is ``face_range`` of those points, its lateral extent runs from that inner edge to the face's outer edge."""
     if np.quantile(pts.z[idx], 0.1) > cfg.max_low_m:
         return None
+    side = _side_view(pts, idx, x, lat, width, face_range, cfg)
+    if side is not None:
+        return side
     l0, l1 = np.quantile(lat, [0.05, 0.95])
     if l1 - l0 < cfg.min_width_m:
         return None
@@ -138,3 +144,24 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     box = (int(u.min()), int(v.min()), int(u.max()) + 1, int(v.max()) + 1)
     centre = fx + VEHICLE_LENGTH_M / 2 if ahead else fx - VEHICLE_LENGTH_M / 2
     return Detection(centre, centre_lat, fx, float(abs(outer - inner)), box, len(idx), float(sigma))
+
+
+def _side_view(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarray, width: float,
+               face_range: FaceRange, cfg: ClusterConfig) -> Detection | None:
+    """A car in a lane beside seen only along its side (coming alongside, where the image's edge cuts its face off):
+    most of the group's points lie on one line along the lane. Its centre is half a car's width beyond that line,
+    away from the ego; its along-lane place is the side's, with little weight. None for any other group."""
+    mid = float(np.median(lat))
+    if abs(mid) <= 0.5 * width or np.mean(np.abs(lat - mid) <= cfg.side_band_m) < cfg.side_share:
+        return None
+    on_side = np.abs(lat - mid) <= cfg.side_band_m
+    measured = face_range(pts, idx[on_side])
+    if measured is None:
+        return None
+    centre_lat = mid + float(np.sign(mid)) * VEHICLE_WIDTH_M / 2
+    if abs(centre_lat) > 1.5 * width:
+        return None
+    u, v = pts.u[idx[on_side]], pts.v[idx[on_side]]
+    box = (int(u.min()), int(v.min()), int(u.max()) + 1, int(v.max()) + 1)
+    return Detection(measured[0], centre_lat, measured[0], 0.0, box, int(on_side.sum()), cfg.side_sigma_x_m,
+                     cut_off=True)

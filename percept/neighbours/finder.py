@@ -47,6 +47,8 @@ class RigFinder:
         its along-lane position given little weight: the middle of a cut face would drift towards the ego lane, and
         its nearest point is on the car's side where the image ends, which lags the car."""
         width = self.rig.camera.width
+        if det.cut_off:  # a side seen alone, placed already
+            return det
         # the image's left edge looks to the vehicle's left for a forward rig, to its right for a rear one
         left_side = -1.0 if self.rig.looks_back else 1.0
         if det.box_px[0] <= EDGE_PX:
