@@ -44,7 +44,7 @@ class ClusterConfig:
     side_m: float = 0.4  # points within this of a group's inner edge are its side, not its face [m]
     side_share: float = 0.6  # a group in a lane beside with this share of its points on one line along the lane ...
     side_band_m: float = 0.2  # ... (within this of its median lateral place) is a car's side seen alone [m]
-    side_sigma_x_m: float = 5.0  # the along-lane 1-sigma of a side seen alone: its ends are where the image ends [m]
+    side_sigma_x_m: float = 2.0  # the along-lane 1-sigma of a side seen alone: one end is where the image ends [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
 

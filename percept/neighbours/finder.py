@@ -16,7 +16,7 @@ from .refine import refine_face
 EDGE_PX = 48
 """A face narrower than ``FULL_FACE_M`` whose points come this close to the image's side edge is cut off by it
 (block matching leaves the last columns unmatched) [px]."""
-CUT_OFF_SIGMA_X_M = 5.0
+CUT_OFF_SIGMA_X_M = 2.5
 """The along-lane 1-sigma of a cut-off face: the nearest point seen is on the car's side, at the image's edge [m]."""
 FULL_FACE_M = 1.6
 """A face at least this wide is seen whole [m]."""
