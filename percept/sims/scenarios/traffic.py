@@ -40,6 +40,7 @@ def highway_v0_traffic(road, rng, lanes: int, s0: float, count: int, speeds: tup
     s = s0
     while count > 0:
         speed = float(rng.uniform(*speeds))
+        # s_k = s_(k-1) + exp(-5 lanes / 40) (12 + v) / density U(0.9, 1.1)
         s += HIGHWAY_V0_SPACING * (12.0 + speed) / density * float(rng.uniform(0.9, 1.1))
         lane = int(rng.integers(lanes))
         if lane == keep_clear[0] and keep_clear[1] <= s <= keep_clear[2]:
