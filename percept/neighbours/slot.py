@@ -4,7 +4,8 @@ lanes beside it, ahead, beside and behind, out (``Neighbours``).
 Each frame each rig's vehicles are found (``finder``: band stereo, ground-grid groups, the face's subpixel range) in
 the ego lane's coordinates, tracked (``tracker``), and each confirmed track reported with its lane, gap, relative
 speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside whose lateral
-speed (beyond three sigma of its estimate) takes its centre to the ego lane's boundary within ``horizon_s`` is
+speed (beyond three sigma of its estimate) takes its centre to the ego lane's boundary within ``horizon_s``, and which
+was a settled neighbour first (seen in the middle of its lane ``TrackerConfig.min_settled`` times in a row), is
 flagged as cutting in, with the predicted time to that crossing, so the following law can treat it as a lead before
 it arrives.
 """
@@ -34,7 +35,6 @@ class NeighbourConfig:
     horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]
     min_lateral_speed_mps: float = 0.3  # and the lateral speed towards it at least this [m/s]
     min_shift_m: float = 0.25  # and it has moved at least this from its lane's centre towards the ego lane [m]
-    min_hits: int = 10  # and it has been detected at least this often (its lateral speed is known) [-]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
 
 
@@ -92,7 +92,8 @@ class NeighbourSlot:
         sig_vl = math.sqrt(max(P[3, 3], 0.0))
         cut_in, ttc = False, None
         c = self.cfg
-        if lane != 0 and zone is not Zone.BEHIND and x <= c.warn_ahead_m and t.hits >= c.min_hits and not t.cut_off:
+        settled = t.settled >= self.tracker.cfg.min_settled
+        if lane != 0 and zone is not Zone.BEHIND and x <= c.warn_ahead_m and settled and not t.cut_off:
             # towards the ego lane: -sign(lat) l' > 0; its centre reaches the boundary |l| = w/2 after
             # t = (|l| - w/2) / (-sign(l) l')
             toward = -math.copysign(1.0, lat) * vl

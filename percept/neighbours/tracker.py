@@ -34,6 +34,8 @@ class TrackerConfig:
     # centres from here ...
     blind_ahead_m: float = 12.0  # ... to here, along the lane, in the lanes beside [m]
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
+    settle_m: float = 0.5  # a track is in the middle of its lane within this of its centre line [m]
+    min_settled: int = 10  # detections in a row in the middle of a lane that make a track a settled neighbour [-]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
 
 
@@ -50,6 +52,7 @@ class Track:
     box_px: tuple | None = None
     confirmed: bool = False
     cut_off: bool = False  # its last detection was cut off by the image's edge
+    settled: int = 0  # detections in a row with its centre near the middle of a lane
 
     @property
     def x(self) -> float:
@@ -67,6 +70,7 @@ class NeighbourTracker:
         self.dt, self.cfg = dt_s, cfg
         self.tracks: list[Track] = []
         self._next_id = 1
+        self.width = 3.75  # the lane width of the last frame [m]
 
     def reset(self) -> None:
         self.tracks.clear()
@@ -97,6 +101,7 @@ class NeighbourTracker:
         for t in self.tracks:
             t.kf.predict()
             t.camera, t.box_px = None, None
+        self.width = width_m
         for rig, dets in detections.items():
             self._associate(rig, dets)
         self._keep_or_drop(width_m)
@@ -122,6 +127,9 @@ class NeighbourTracker:
             t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
             t.hits, t.misses, t.blind_s = t.hits + 1, 0, 0.0
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
+            # |l - round(l / w) w| < settle_m: in the middle of its lane
+            in_middle = abs(t.lat - round(t.lat / self.width) * self.width) < c.settle_m
+            t.settled = t.settled + 1 if in_middle else 0 if t.settled < c.min_settled else t.settled
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
         for j, d in enumerate(dets):
             if j not in used_d:

@@ -46,13 +46,32 @@ def new_road(env, net, connected: bool = False) -> Road:
                 neighbour_vehicles_connected_lanes=connected)
 
 
+LANE_CHANGE_TAU_LATERAL_S = 1.5
+"""Lateral time constant of a lane-changing car's steering (highway-env's ControlledVehicle.TAU_LATERAL is 0.6 s) [s]:
+with ``LANE_CHANGE_TAU_HEADING_S`` a lane change takes about 4.3 s at highway speed, as drivers' do (4-6 s; Toledo and
+Zohar, "Modeling duration of lane changes", TRR 1999, 2007), where highway-env's defaults take 1.7 s."""
+LANE_CHANGE_TAU_HEADING_S = 0.4
+"""Heading time constant of a lane-changing car's steering (highway-env's TAU_HEADING is 0.2 s) [s]."""
+
+
+def drive_like_people(v) -> None:
+    """Give a lane-changing car the steering time constants of ``LANE_CHANGE_TAU_LATERAL_S`` and
+    ``LANE_CHANGE_TAU_HEADING_S`` (highway-env's controller reads its gains from the vehicle)."""
+    # KP = 1 / tau
+    v.KP_LATERAL = 1.0 / LANE_CHANGE_TAU_LATERAL_S
+    v.KP_HEADING = 1.0 / LANE_CHANGE_TAU_HEADING_S
+
+
 def place_idm(road, idx, s: float, speed: float, cls=IDMVehicle, lane_change: bool = False, **kw):
     """A vehicle of class ``cls`` (highway-env's IDMVehicle or a subclass) on lane ``idx`` at longitudinal s [m],
-    driving at ``speed`` [m/s], which is also its target speed; lane_change: MOBIL lane changes on."""
+    driving at ``speed`` [m/s], which is also its target speed; lane_change: MOBIL lane changes on, at a driver's
+    pace (``drive_like_people``)."""
     lane = road.network.get_lane(idx)
     v = cls(road, lane.position(s, 0.0), lane.heading_at(s), speed, target_lane_index=idx, target_speed=speed,
             **kw)
     v.enable_lane_change = lane_change
+    if lane_change:
+        drive_like_people(v)
     if isinstance(v, LinearVehicle):
         v.collecting_data = False  # its regression data would grow every step and is never read
     road.vehicles.append(v)
