@@ -22,7 +22,8 @@ from .neighbours_truth import ego_lane_velocity, lane_velocity, lateral_from_ego
 CUT_IN_GAP_M = 60.0
 """A crossing into the ego lane is a cut-in when the vehicle is ahead within this bumper gap [m]."""
 FALSE_WARNING_S = 3.0
-"""A warning is justified when its vehicle crosses into the ego lane within this after its onset [s]."""
+"""A warning is justified when its vehicle crosses into the ego lane within this after its onset, or while the warning
+goes on (a merging car may wait on the line) [s]."""
 COLLISION_WINDOW_S = 1.0
 """Lateral speeds before a collision are averaged over this [s]."""
 LATERAL_MOVE_MPS = 0.3
@@ -52,6 +53,7 @@ class CutInEvents:
         self._since: dict = {}  # track id -> onset of its warning run going on at the previous frame [s]
         self._matched: dict = {}  # track id -> vehicle id, on the previous frame
         self._pending: list[_Onset] = []
+        self._last_s = 0.0  # the last frame's time [s]
 
     def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict) -> None:
         """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
@@ -90,22 +92,25 @@ class CutInEvents:
         for o in self._pending:
             o.vehicle_id = matched.get(o.track_id) if o.vehicle_id is None else o.vehicle_id
             if o.vehicle_id is not None and o.vehicle_id in entered:
-                continue  # justified: its vehicle moved into the ego lane within the window
-            if time_s - o.time_s > FALSE_WARNING_S:
+                continue  # justified: its vehicle moved into the ego lane within the window or the warning
+            if time_s - o.time_s > FALSE_WARNING_S and o.track_id not in warning:
                 self.false_warnings += 1
             else:
                 keep.append(o)
         self._pending = keep
+        self._last_s = time_s
 
     def result(self, minutes: float | None) -> dict:
         """The group's cut-in keys; ``minutes``: the run's length [min] (None: too short to rate)."""
         s = self.scored
+        # warnings still going on at the end, older than the window, whose vehicle never crossed
+        unjustified = sum(self._last_s - o.time_s > FALSE_WARNING_S for o in self._pending)
         return {"cut_ins": self.crossings,
                 "cut_ins_missed": self.missed if s else None,
                 "cut_in_warning_lead_s_min": min(self.leads_s) if s and self.leads_s else None,
                 "cut_in_leads_s": [round(v, 3) for v in self.leads_s] if s else None,
-                "false_warnings": self.false_warnings if s else None,
-                "false_warnings_per_min": self.false_warnings / minutes if s and minutes else None}
+                "false_warnings": self.false_warnings + unjustified if s else None,
+                "false_warnings_per_min": (self.false_warnings + unjustified) / minutes if s and minutes else None}
 
 
 @dataclass(frozen=True)

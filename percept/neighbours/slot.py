@@ -5,8 +5,8 @@ Each frame each rig's vehicles are found (``finder``: band stereo, ground-grid g
 the ego lane's coordinates, tracked (``tracker``), and each confirmed track reported with its lane, gap, relative
 speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside whose lateral
 speed (beyond three sigma of its estimate) takes its centre to the ego lane's boundary within ``horizon_s``, and which
-was a settled neighbour first (seen in the middle of its lane ``TrackerConfig.min_settled`` times in a row), is
-flagged as cutting in, with the predicted time to that crossing, so the following law can treat it as a lead before
+was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row: a car changing into it
+from the lane beyond is not cutting in to the ego's), is flagged as cutting in, with the predicted time to that crossing, so the following law can treat it as a lead before
 it arrives.
 """
 
@@ -80,6 +80,28 @@ class NeighbourSlot:
         rear = self.rear is not None and frame.has_rear
         return Neighbours(tuple(tracks), self.cfg.ahead_m, self.cfg.behind_m, rear), NeighbourDebug(detections, points)
 
+    def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float
+                ) -> tuple[bool, float | None]:
+        """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
+        track, settled in its lane and not cut off by the image's edge, moves towards the ego lane faster than both
+        ``min_lateral_speed_mps`` and three sigma, has left its lane's centre by ``min_shift_m`` towards it and will
+        reach the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back
+        (a merging car may pause on the line)."""
+        c = self.cfg
+        # towards the ego lane: -sign(l) l' > 0; shift from its lane's centre towards it: -sign(l) (l - lane w)
+        toward = -math.copysign(1.0, lat) * vl
+        shift = -math.copysign(1.0, lat) * (lat - lane * width)
+        if t.warning:
+            holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
+        else:
+            holds = (t.settled >= self.tracker.cfg.min_settled and not t.cut_off and shift >= c.min_shift_m
+                     and toward > max(c.min_lateral_speed_mps, 3 * sig_vl))
+        if not holds:
+            return False, None
+        # its centre reaches the boundary |l| = w/2 after t = (|l| - w/2) / max(-sign(l) l', v_min)
+        ttc = max(abs(lat) - width / 2, 0.0) / max(toward, c.min_lateral_speed_mps)
+        return (True, ttc) if t.warning or ttc <= c.horizon_s else (False, None)
+
     def _report(self, t: Track, width: float) -> Neighbour | None:
         x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
         lane = int(round(lat / width))
@@ -89,19 +111,9 @@ class NeighbourSlot:
         if abs(lane) > 1 or gap > (self.cfg.ahead_m if zone is Zone.AHEAD else self.cfg.behind_m):
             return None
         P = t.kf.P
-        sig_vl = math.sqrt(max(P[3, 3], 0.0))
-        cut_in, ttc = False, None
-        c = self.cfg
-        settled = t.settled >= self.tracker.cfg.min_settled
-        if lane != 0 and zone is not Zone.BEHIND and x <= c.warn_ahead_m and settled and not t.cut_off:
-            # towards the ego lane: -sign(lat) l' > 0; its centre reaches the boundary |l| = w/2 after
-            # t = (|l| - w/2) / (-sign(l) l')
-            toward = -math.copysign(1.0, lat) * vl
-            shift = -math.copysign(1.0, lat) * (lat - lane * width)
-            if toward > max(c.min_lateral_speed_mps, 3 * sig_vl) and shift >= c.min_shift_m:
-                ttc = max(abs(lat) - width / 2, 0.0) / toward
-                cut_in = ttc <= c.horizon_s
-                ttc = ttc if cut_in else None
+        warn = lane != 0 and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
+        cut_in, ttc = self._intent(t, lat, vl, lane, width, math.sqrt(max(P[3, 3], 0.0))) if warn else (False, None)
+        t.warning = cut_in
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
                          self.tracker.sigma_x(t), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),
                          t.camera, t.box_px, cut_in, ttc)

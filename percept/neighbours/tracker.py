@@ -34,8 +34,7 @@ class TrackerConfig:
     # centres from here ...
     blind_ahead_m: float = 12.0  # ... to here, along the lane, in the lanes beside [m]
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
-    settle_m: float = 0.5  # a track is in the middle of its lane within this of its centre line [m]
-    min_settled: int = 10  # detections in a row in the middle of a lane that make a track a settled neighbour [-]
+    min_settled: int = 10  # detections in a row in one lane that make a track a settled neighbour there [-]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
 
 
@@ -52,7 +51,9 @@ class Track:
     box_px: tuple | None = None
     confirmed: bool = False
     cut_off: bool = False  # its last detection was cut off by the image's edge
-    settled: int = 0  # detections in a row with its centre near the middle of a lane
+    lane: int | None = None  # the lane its centre was in at its last detection (-1, 0, +1 ...)
+    settled: int = 0  # detections in a row in that lane
+    warning: bool = False  # flagged as cutting in at the last report
 
     @property
     def x(self) -> float:
@@ -127,9 +128,10 @@ class NeighbourTracker:
             t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
             t.hits, t.misses, t.blind_s = t.hits + 1, 0, 0.0
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
-            # |l - round(l / w) w| < settle_m: in the middle of its lane
-            in_middle = abs(t.lat - round(t.lat / self.width) * self.width) < c.settle_m
-            t.settled = t.settled + 1 if in_middle else 0 if t.settled < c.min_settled else t.settled
+            # its lane: round(l / w)
+            lane = int(round(t.lat / self.width))
+            t.settled = t.settled + 1 if lane == t.lane else 1
+            t.lane = lane
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
         for j, d in enumerate(dets):
             if j not in used_d:

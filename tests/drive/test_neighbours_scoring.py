@@ -218,3 +218,25 @@ def test_the_ego_rear_ending_or_moving_over_is_the_mover_and_a_car_behind_runnin
 def test_a_crash_with_no_known_vehicle_is_recorded_once_without_a_mover(truth):
     frames = [(truth(time_s=k * DT, crashed=k >= 2), []) for k in range(5)]
     assert run(frames)["collisions"] == [{"time_s": 0.2, "other_id": None, "mover": None, "kind": None}]
+
+
+def test_a_warning_held_while_a_car_waits_on_the_line_is_justified(vehicle, truth):
+    # 30 m ahead in lane +1: on the line (shifted 1 m towards the ego lane) for 4 s, then over it; warned throughout
+    frames = []
+    for k in range(60):
+        t = k * DT
+        y = 3.0 if t < 4.0 else 3.0 - 1.0 * (t - 4.0)
+        gt = truth([vehicle(1, 30.0, y, lateral_speed=0.0 if t < 4.0 else -1.0)], time_s=t)
+        frames.append((gt, mirrored(gt, cut_in=True)))
+    r = run(frames)
+    assert r["cut_ins"] == 1 and r["false_warnings"] == 0
+    assert r["cut_in_warning_lead_s_min"] > 4.0
+
+
+def test_a_warning_that_never_ends_in_a_crossing_is_false(vehicle, truth):
+    frames = []
+    for k in range(50):
+        gt = truth([vehicle(1, 30.0, 3.0)], time_s=k * DT)
+        frames.append((gt, mirrored(gt, cut_in=True)))
+    r = run(frames)
+    assert r["cut_ins"] == 0 and r["false_warnings"] == 1
