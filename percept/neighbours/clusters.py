@@ -44,6 +44,7 @@ class ClusterConfig:
     side_m: float = 0.4  # points within this of a group's inner edge are its side, not its face [m]
     side_share: float = 0.6  # a group in a lane beside with this share of its points on one line along the lane ...
     side_band_m: float = 0.2  # ... (within this of its median lateral place) is a car's side seen alone [m]
+    side_reach_m: float = 20.0  # a side is seen alone only this near the ego [m]
     side_sigma_x_m: float = 2.0  # the along-lane 1-sigma of a side seen alone: one end is where the image ends [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
@@ -79,9 +80,10 @@ def lane_coordinates(pts: StandingPoints, lane: LaneEstimate | None) -> tuple[np
 
 
 def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x_hi: float, face: FaceRange,
-                  cfg: ClusterConfig = ClusterConfig()) -> list[Detection]:
+                  cfg: ClusterConfig = ClusterConfig(), split_m: float = np.inf) -> list[Detection]:
     """The vehicles among ``pts`` with centres in the ego lane or a lane beside it and faces between ``x_lo`` and
-    ``x_hi`` along the lane [m], each face's range from ``face``."""
+    ``x_hi`` along the lane [m], each face's range from ``face``; split_m: the range beyond which the points were
+    matched at full resolution [m]."""
     x, lat, width = lane_coordinates(pts, lane)
     half = 1.5 * width + 1.0
     keep = (x >= x_lo) & (x <= x_hi) & (np.abs(lat) <= half)
@@ -104,7 +106,9 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
             continue
         # N >= max(min_group_points, c / Z^2), Z the group's nearest range along the lane
         near = float(np.min(np.abs(x[sel])))
-        if n_points < cfg.group_points_m2 / max(near, 1.0) ** 2:
+        # beyond the split the points come at full resolution: four times as many, of which a far face shows fewer
+        density = 1.0
+        if n_points < density * cfg.group_points_m2 / max(near, 1.0) ** 2:
             continue
         det = _measure(pts, idx[sel], x[sel], lat[sel], ahead, width, face, cfg)
         if det is not None:
@@ -152,7 +156,8 @@ def _side_view(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndar
     most of the group's points lie on one line along the lane. Its centre is half a car's width beyond that line,
     away from the ego; its along-lane place is the side's, with little weight. None for any other group."""
     mid = float(np.median(lat))
-    if abs(mid) <= 0.5 * width or np.mean(np.abs(lat - mid) <= cfg.side_band_m) < cfg.side_share:
+    if (abs(mid) <= 0.5 * width or np.min(np.abs(x)) > cfg.side_reach_m
+            or np.mean(np.abs(lat - mid) <= cfg.side_band_m) < cfg.side_share):
         return None
     on_side = np.abs(lat - mid) <= cfg.side_band_m
     measured = face_range(pts, idx[on_side])

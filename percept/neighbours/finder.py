@@ -38,7 +38,8 @@ class RigFinder:
         """The detections of one grey pair, and the standing points they came from."""
         pts = self.stereo.points(left_gray, right_gray)
         self._pair = (left_gray, right_gray)
-        found = find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters)
+        found = find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters,
+                              self.stereo.cfg.split_m)
         return [self.cut_off(d) for d in found], pts
 
     def cut_off(self, det: Detection) -> Detection:

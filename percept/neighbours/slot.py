@@ -84,7 +84,7 @@ class NeighbourSlot:
                 ) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
         track, settled in its lane and not cut off by the image's edge, moves towards the ego lane faster than both
-        ``min_lateral_speed_mps`` and three sigma, has left its lane's centre by ``min_shift_m`` towards it and will
+        ``min_lateral_speed_mps`` and three sigma as a rig measures it, has left its lane's centre by ``min_shift_m`` towards it and will
         reach the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back
         (a merging car may pause on the line)."""
         c = self.cfg
@@ -94,7 +94,8 @@ class NeighbourSlot:
         if t.warning:
             holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
         else:
-            holds = (t.settled >= self.tracker.cfg.min_settled and not t.cut_off and shift >= c.min_shift_m
+            holds = (t.settled >= self.tracker.cfg.min_settled and t.camera is not None and not t.cut_off
+                     and shift >= c.min_shift_m
                      and toward > max(c.min_lateral_speed_mps, 3 * sig_vl))
         if not holds:
             return False, None
