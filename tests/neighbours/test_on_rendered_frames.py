@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 
 from percept.neighbours import NeighbourSlot
-from percept.sensors import EgoPath, LaneEstimate
+from percept.sensors import EgoPath
 from percept.sims.world import SimWorld, WorldConfig
 
 
 @pytest.mark.slow
-def test_vehicles_ahead_are_found_ranged_and_put_in_their_lanes():
+def test_vehicles_ahead_are_found_ranged_and_put_in_their_lanes(path_from_truth):
     w = SimWorld(WorldConfig("highway", 1, autopilot=True))
     slot = NeighbourSlot(w.cfg.rig, None, w.dt)
     found, gap_err, lanes = [], [], []
@@ -18,8 +18,7 @@ def test_vehicles_ahead_are_found_ranged_and_put_in_their_lanes():
         w.step()
         frame, gt = w.observe()
         lt = gt.lane
-        path = EgoPath(LaneEstimate(lt.offset_m, lt.heading_rad, lt.curvature_1pm, lt.width_m, 1.0), gt.speed_mps)
-        nb, _ = slot.step(frame, {EgoPath: path})
+        nb, _ = slot.step(frame, {EgoPath: path_from_truth(gt)})
         if step < 15:  # tracks are confirmed after a few frames
             continue
         for o in gt.objects:

@@ -8,24 +8,22 @@ import pytest
 from percept.drive.neighbours_scoring import match_tracks
 from percept.drive.neighbours_truth import truth_neighbours
 from percept.neighbours import NeighbourSlot
-from percept.sensors import EgoPath, LaneEstimate, StereoRig, Zone, rear_rig
+from percept.sensors import EgoPath, StereoRig, Zone, rear_rig
 from percept.sims.world import SimWorld, WorldConfig
 
 
 @pytest.mark.slow
-def test_cars_behind_and_beside_are_tracked():
+def test_cars_behind_and_beside_are_tracked(path_from_truth):
     w = SimWorld(WorldConfig("overtake", 1, autopilot=True, rear_rig=rear_rig(StereoRig())))
     slot = NeighbourSlot(w.cfg.rig, w.cfg.rear_rig, w.dt)
     behind, beside, seen = [], [], set()
     for step in range(330):
         w.step()
         frame, gt = w.observe()
-        lt = gt.lane
-        path = EgoPath(LaneEstimate(lt.offset_m, lt.heading_rad, lt.curvature_1pm, lt.width_m, 1.0), gt.speed_mps)
-        nb, _ = slot.step(frame, {EgoPath: path})
+        nb, _ = slot.step(frame, {EgoPath: path_from_truth(gt)})
         truth = truth_neighbours(gt).tracks
         seen.update(n.track_id for n in truth if n.camera is not None)
-        found = {j for _, j in match_tracks(nb.tracks, truth, lt.width_m)}
+        found = {j for _, j in match_tracks(nb.tracks, truth, gt.lane.width_m)}
         for j, n in enumerate(truth):
             if n.zone is Zone.BEHIND and n.camera == "rear" and n.gap_m <= 60 and step >= 15:
                 behind.append(j in found)
