@@ -24,6 +24,10 @@ CUT_IN_GAP_M = 60.0
 FALSE_WARNING_S = 3.0
 """A warning is justified when its vehicle crosses into the ego lane within this after its onset, or while the warning
 goes on (a merging car may wait on the line) [s]."""
+SEEN_BEFORE_S = 2.0
+"""A cut-in's warning lead is scored when a rig had seen its car at least this long before it crossed; one that
+crossed sooner after it came into view (a car already moving over as the run begins) is counted apart, in
+``cut_ins_unscored`` [s]."""
 COLLISION_WINDOW_S = 1.0
 """Lateral speeds before a collision are averaged over this [s]."""
 LATERAL_MOVE_MPS = 0.3
@@ -54,6 +58,8 @@ class CutInEvents:
         self._matched: dict = {}  # track id -> vehicle id, on the previous frame
         self._pending: list[_Onset] = []
         self._last_s = 0.0  # the last frame's time [s]
+        self._first_seen: dict = {}  # vehicle id -> when a rig first saw it at least half [s]
+        self.unscored = 0  # cut-ins whose car crossed less than SEEN_BEFORE_S after a rig first saw it
 
     def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict) -> None:
         """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
@@ -63,8 +69,14 @@ class CutInEvents:
             v for v, n in truth.items() if n.lane == 0 and self._lanes.get(v) in (-1, 1)]
         crossed = [v for v in entered if truth[v].zone is Zone.AHEAD and truth[v].gap_m <= CUT_IN_GAP_M]
         self.crossings += len(crossed)
+        for v, n in truth.items():
+            if n.camera is not None:
+                self._first_seen.setdefault(v, time_s)
         if self.scored:
             for v in crossed:
+                if time_s - self._first_seen.get(v, time_s) < SEEN_BEFORE_S:
+                    self.unscored += 1
+                    continue
                 self._score_crossing(time_s, v, matched)
             self._follow_warnings(time_s, tracks, matched, entered)
         self._lanes = {v: n.lane for v, n in truth.items()}
@@ -107,6 +119,7 @@ class CutInEvents:
         unjustified = sum(self._last_s - o.time_s > FALSE_WARNING_S for o in self._pending)
         return {"cut_ins": self.crossings,
                 "cut_ins_missed": self.missed if s else None,
+                "cut_ins_unscored": self.unscored if s else None,
                 "cut_in_warning_lead_s_min": min(self.leads_s) if s and self.leads_s else None,
                 "cut_in_leads_s": [round(v, 3) for v in self.leads_s] if s else None,
                 "false_warnings": self.false_warnings + unjustified if s else None,

@@ -48,6 +48,7 @@ class ClusterConfig:
     side_sigma_x_m: float = 2.0  # the along-lane 1-sigma of a side seen alone: one end is where the image ends [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
+    min_top_m: float = 1.0  # and, beyond side_reach_m, up to this height (a guard rail, 0.45-0.77 m, does not) [m]
 
 
 @dataclass(frozen=True)
@@ -80,10 +81,9 @@ def lane_coordinates(pts: StandingPoints, lane: LaneEstimate | None) -> tuple[np
 
 
 def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x_hi: float, face: FaceRange,
-                  cfg: ClusterConfig = ClusterConfig(), split_m: float = np.inf) -> list[Detection]:
+                  cfg: ClusterConfig = ClusterConfig(), camera_height_m: float = np.inf) -> list[Detection]:
     """The vehicles among ``pts`` with centres in the ego lane or a lane beside it and faces between ``x_lo`` and
-    ``x_hi`` along the lane [m], each face's range from ``face``; split_m: the range beyond which the points were
-    matched at full resolution [m]."""
+    ``x_hi`` along the lane [m], each face's range from ``face``; camera_height_m: the rig's height, which bounds what the band shows of a car [m]."""
     x, lat, width = lane_coordinates(pts, lane)
     half = 1.5 * width + 1.0
     keep = (x >= x_lo) & (x <= x_hi) & (np.abs(lat) <= half)
@@ -106,23 +106,24 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
             continue
         # N >= max(min_group_points, c / Z^2), Z the group's nearest range along the lane
         near = float(np.min(np.abs(x[sel])))
-        # beyond the split the points come at full resolution: four times as many, of which a far face shows fewer
-        density = 1.0
-        if n_points < density * cfg.group_points_m2 / max(near, 1.0) ** 2:
+        if n_points < cfg.group_points_m2 / max(near, 1.0) ** 2:
             continue
-        det = _measure(pts, idx[sel], x[sel], lat[sel], ahead, width, face, cfg)
+        det = _measure(pts, idx[sel], x[sel], lat[sel], ahead, width, face, cfg, camera_height_m)
         if det is not None:
             out.append(det)
     return out
 
 
 def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarray, ahead: bool, width: float,
-             face_range: FaceRange, cfg: ClusterConfig) -> Detection | None:
-    """One group's detection, or None when it does not reach down to the road, is too narrow or its centre is outside
-    the three lanes. The face is what is left of the group without its inner side (the points within ``side_m`` of
+             face_range: FaceRange, cfg: ClusterConfig, camera_height_m: float = np.inf) -> Detection | None:
+    """One group's detection, or None when it does not reach down to the road and up to a car's height, is too narrow
+    or its centre is outside the three lanes. The face is what is left of the group without its inner side (the points within ``side_m`` of
     the edge nearest the ego lane's centre line, which a car in a lane beside shows along its length); the face's
     range is ``face_range`` of those points, its lateral extent runs from that inner edge to the face's outer edge."""
-    if np.quantile(pts.z[idx], 0.1) > cfg.max_low_m:
+    low, top = np.quantile(pts.z[idx], [0.1, 0.9])
+    # near by the band holds only a car's lower part; farther, up to a little above the camera's height
+    if low > cfg.max_low_m or (top < min(cfg.min_top_m, camera_height_m - 0.1)
+                               and np.min(np.abs(x)) > cfg.side_reach_m):
         return None
     side = _side_view(pts, idx, x, lat, width, face_range, cfg)
     if side is not None:

@@ -39,7 +39,7 @@ class RigFinder:
         pts = self.stereo.points(left_gray, right_gray)
         self._pair = (left_gray, right_gray)
         found = find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters,
-                              self.stereo.cfg.split_m)
+                              self.rig.mount_height_m)
         return [self.cut_off(d) for d in found], pts
 
     def cut_off(self, det: Detection) -> Detection:

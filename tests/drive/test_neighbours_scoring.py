@@ -240,3 +240,15 @@ def test_a_warning_that_never_ends_in_a_crossing_is_false(vehicle, truth):
         frames.append((gt, mirrored(gt, cut_in=True)))
     r = run(frames)
     assert r["cut_ins"] == 0 and r["false_warnings"] == 1
+
+
+def test_a_car_that_crosses_soon_after_it_comes_into_view_is_not_scored_for_its_lead(vehicle, truth):
+    # already moving over when first seen, 1 s before it crosses: counted, not scored
+    frames = []
+    for k in range(20):
+        t = k * DT
+        gt = truth([vehicle(1, 30.0, 2.9 - 1.0 * t, lateral_speed=-1.0)], time_s=t)
+        frames.append((gt, []))
+    r = run(frames)
+    assert r["cut_ins"] == 1 and r["cut_ins_unscored"] == 1
+    assert r["cut_ins_missed"] == 0 and r["cut_in_warning_lead_s_min"] is None
