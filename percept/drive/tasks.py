@@ -196,6 +196,7 @@ TASKS: tuple[Task, ...] = (
                    Headline("gap error ahead (median)", "gap_abs_rel_err_ahead", "{:.3f}"),
                    Headline("cut-in lead min [s]", "cut_in_warning_lead_s_min", "{:.2f}")),
          help="vehicles ahead, beside and behind in the ego and next lanes (cut-ins)", bench_scenario="dense",
+         budget_ms=8.0,
          bench_peer=lazy("percept.bench.peers:sgbm_both_rigs"),
          counts=(Count("beside_absent_frames", "frames a vehicle beside was absent", listed=True),
                  Count("cut_ins_missed", "cut-ins not warned", listed=True)),
