@@ -7,6 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from percept.cli import app
+from percept.drive.tasks import TASKS
 from percept.cli.view_cmd import rerun_executable
 
 runner = CliRunner()
@@ -29,8 +30,8 @@ def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
     assert d["scenario"] == "highway" and d["frames"] == 15
     assert d["timing_ms"]["render"] > 0
     # every slot sees by default, and each one's stage is timed
-    assert d["slots"] == {t: "vision" for t in ("lanes", "longitudinal", "pedestrians", "odometry")}
-    assert all(d["timing_ms"][k] > 0 for k in ("lanes", "longitudinal", "pedestrians", "odometry"))
+    assert d["slots"] == {t.name: "vision" for t in TASKS}
+    assert all(d["timing_ms"][t.name] > 0 for t in TASKS)
     assert rrd.exists() and not (tmp_path / "run.rrd.part").exists()
     # a finished recording passes Rerun's own check as it is, footer included
     v = subprocess.run([rerun_bin(), "rrd", "verify", str(rrd)], capture_output=True, text=True,
