@@ -9,7 +9,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "percept"
-PERCEPTION = ("lanes", "longitudinal", "detection", "odometry")
+PERCEPTION = ("lanes", "longitudinal", "detection", "odometry", "neighbours")
 MAX_FUNCTION_LINES = 60
 MAX_FILE_LINES = 300
 
