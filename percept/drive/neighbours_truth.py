@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from percept.sensors import EGO_LENGTH_M, Frame, Neighbour, Neighbours, ObjectKind, Zone
+from percept.sensors import Frame, Neighbour, Neighbours, ObjectKind, Zone, zone_and_gap
 
 from .privileged import TruthSlot, true_centre_y
 
@@ -45,19 +45,6 @@ def ego_lane_velocity(gt) -> tuple[float, float]:
 def lateral_from_ego_lane(lane, obj) -> float:
     """An object's centre from the true ego lane's centre line at its x [m] (+ left)."""
     return obj.position_m[1] - true_centre_y(lane, obj.position_m[0])
-
-
-def zone_and_gap(x_m: float, length_m: float) -> tuple[Zone, float]:
-    """Where a vehicle of ``length_m`` with its centre x_m ahead of the ego's lies, and the bumper gap [m]."""
-    # ahead: its rear bumper beyond the ego's front one, x - L/2 - L_ego/2 > 0
-    ahead = x_m - length_m / 2 - EGO_LENGTH_M / 2
-    # behind: its front bumper short of the ego's rear one, -(x + L/2) - L_ego/2 > 0
-    behind = -(x_m + length_m / 2) - EGO_LENGTH_M / 2
-    if ahead > 0:
-        return Zone.AHEAD, ahead
-    if behind > 0:
-        return Zone.BEHIND, behind
-    return Zone.BESIDE, 0.0
 
 
 def cut_in(lane: int, lateral_m: float, lateral_speed_mps: float, width_m: float,

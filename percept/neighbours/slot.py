@@ -15,9 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-from percept.sensors import EGO_LENGTH_M, EgoPath, Frame, Neighbour, Neighbours, StereoRig, Zone
+from percept.sensors import EGO_LENGTH_M, EgoPath, Frame, Neighbour, Neighbours, StereoRig, Zone, zone_and_gap
 
 from .clusters import DEFAULT_LANE_WIDTH_M, VEHICLE_LENGTH_M, Detection
 from .finder import RigFinder
@@ -106,9 +104,7 @@ class NeighbourSlot:
     def _report(self, t: Track, width: float) -> Neighbour | None:
         x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
         lane = int(round(lat / width))
-        half = (VEHICLE_LENGTH_M + EGO_LENGTH_M) / 2
-        zone = Zone.AHEAD if x > half else Zone.BEHIND if x < -half else Zone.BESIDE
-        gap = x - half if zone is Zone.AHEAD else -x - half if zone is Zone.BEHIND else 0.0
+        zone, gap = zone_and_gap(x, VEHICLE_LENGTH_M)
         if abs(lane) > 1 or gap > (self.cfg.ahead_m if zone is Zone.AHEAD else self.cfg.behind_m):
             return None
         P = t.kf.P

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from .clusters import Detection
+from .clusters import DEFAULT_LANE_WIDTH_M, Detection
 
 
 @dataclass(frozen=True)
@@ -71,7 +71,7 @@ class NeighbourTracker:
         self.dt, self.cfg = dt_s, cfg
         self.tracks: list[Track] = []
         self._next_id = 1
-        self.width = 3.75  # the lane width of the last frame [m]
+        self.width = DEFAULT_LANE_WIDTH_M  # the lane width of the last frame [m]
 
     def reset(self) -> None:
         self.tracks.clear()

@@ -177,6 +177,19 @@ class Zone(str, Enum):
     BEHIND = "behind"
 
 
+def zone_and_gap(x_m: float, length_m: float) -> tuple[Zone, float]:
+    """Where a vehicle of ``length_m`` with its centre x_m ahead of the ego's lies, and the bumper gap [m] (0 beside)."""
+    # ahead: its rear bumper beyond the ego's front one, x - L/2 - L_ego/2 > 0
+    ahead = x_m - length_m / 2 - EGO_LENGTH_M / 2
+    # behind: its front bumper short of the ego's rear one, -(x + L/2) - L_ego/2 > 0
+    behind = -(x_m + length_m / 2) - EGO_LENGTH_M / 2
+    if ahead > 0:
+        return Zone.AHEAD, ahead
+    if behind > 0:
+        return Zone.BEHIND, behind
+    return Zone.BESIDE, 0.0
+
+
 @dataclass(frozen=True)
 class Neighbour:
     """One vehicle in the ego lane or a lane beside it, ahead, beside or behind. Along-lane quantities are measured

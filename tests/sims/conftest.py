@@ -46,3 +46,31 @@ def autopilot_world():
 def scenario_env():
     """``scenario_env(name, seed)``: the highway-env side of a scenario alone (no renderer), reset with ``seed``."""
     return _scenario_env
+
+
+def _projected_box(obj, rig, ego, side=None):
+    """The box a vehicle's silhouette should have in ``side``'s image of ``rig`` (the left camera by default), with
+    the ego at ``ego``: every patch of the vehicle that faces the camera, its corners projected; (box (u0, v0, u1, v1)
+    [px] with u1, v1 exclusive, the corners' pixels (N, 2), their camera depths (N,) [m])."""
+    import numpy as np
+
+    from percept.sensors import Side
+    from percept.sims.render import PatchBuilder
+    from percept.sims.render.vehicles import vehicle_patches
+
+    side = Side.LEFT if side is None else side
+    b = PatchBuilder()
+    vehicle_patches(b, obj, 0)
+    p = b.build()
+    cam = ego.world_from_vehicle().apply(rig.camera_position(side))
+    facing = np.einsum("ij,ij->i", np.cross(p.e1, p.e2), p.origin - cam) < 0
+    pts = np.concatenate([p.origin[facing], (p.origin + p.e1)[facing], (p.origin + p.e2)[facing],
+                          (p.origin + p.e1 + p.e2)[facing]])
+    uv, z = rig.project_vehicle_points(ego.vehicle_from_world().apply(pts), side)
+    return (uv[:, 0].min(), uv[:, 1].min(), uv[:, 0].max() + 1, uv[:, 1].max() + 1), uv, z
+
+
+@pytest.fixture
+def projected_box():
+    """``projected_box(obj, rig, ego, side=None)``: the silhouette box a vehicle should have (``_projected_box``)."""
+    return _projected_box

@@ -5,8 +5,7 @@ import numpy as np
 import pytest
 
 from percept.sensors import Pose2D, Side
-from percept.sims.render import ObjectKind, ObjectState, PatchBuilder, Scene, StereoRenderer
-from percept.sims.render.vehicles import vehicle_patches
+from percept.sims.render import ObjectKind, ObjectState, Scene, StereoRenderer
 
 EGO = Pose2D(100.0, -4.0, 0.0)
 """Ego in lane 1 of highway-env's straight 4-lane road (world y = -4), looking along +x."""
@@ -62,7 +61,7 @@ def test_lane_dash_corners_project_where_drawn(rig, road, bare):
 
 
 @pytest.mark.parametrize("ahead_m", [9.0, 20.0, 45.0])
-def test_vehicle_rear_face_and_silhouette_box(rig, bare, ahead_m):
+def test_vehicle_rear_face_and_silhouette_box(rig, bare, ahead_m, projected_box):
     obj = car(7, EGO.x_m + ahead_m)
     out = bare.render(Scene(EGO, (obj,)))
     # the body's rear face: x = -L/2 in the object frame, |y| <= W/2, z in [0.32, 0.58 H + 0.1]
@@ -82,17 +81,8 @@ def test_vehicle_rear_face_and_silhouette_box(rig, bare, ahead_m):
     np.testing.assert_allclose(out.depth_m[face & body], z_rear, rtol=1e-5)
     assert (face & body).sum() > 0.7 * face.sum()
     # silhouette box against the projected corners of every patch that faces the left camera
-    b = PatchBuilder()
-    vehicle_patches(b, obj, 0)
-    p = b.build()
-    cam_pos = EGO.world_from_vehicle().apply(rig.camera_position(Side.LEFT))
-    front = np.einsum("ij,ij->i", np.cross(p.e1, p.e2), p.origin - cam_pos) < 0
-    pts = np.concatenate([p.origin[front], (p.origin + p.e1)[front], (p.origin + p.e2)[front],
-                          (p.origin + p.e1 + p.e2)[front]])
-    uv, _ = rig.project_vehicle_points(to_vehicle(pts), Side.LEFT)
-    u0, v0, u1, v1 = out.boxes_px[7]
-    expected = (uv[:, 0].min(), uv[:, 1].min(), uv[:, 0].max() + 1, uv[:, 1].max() + 1)
-    np.testing.assert_allclose((u0, v0, u1, v1), expected, atol=1.0)
+    expected, _, _ = projected_box(obj, rig, EGO)
+    np.testing.assert_allclose(out.boxes_px[7], expected, atol=1.0)
     assert out.visible[7] == pytest.approx(1.0)
 
 

@@ -8,9 +8,7 @@ import pytest
 
 from percept.sensors import Pose2D, Side, StereoRig, rear_rig
 from percept.sims.conditions import Condition, ConditionEffects
-from percept.sims.render import (ObjectKind, ObjectState, PatchBuilder, RearRenderer, Scene, StereoRenderer,
-                                 forward_twin, turned)
-from percept.sims.render.vehicles import vehicle_patches
+from percept.sims.render import ObjectKind, ObjectState, RearRenderer, Scene, StereoRenderer, forward_twin, turned
 
 EGO = Pose2D(200.0, -4.0, 0.0)
 """Ego in lane 1 of highway-env's straight 4-lane road (world y = -4), heading along +x."""
@@ -47,20 +45,12 @@ def test_renderers_refuse_rigs_they_cannot_draw(road):
 
 
 @pytest.mark.parametrize("behind_m, dy_m", [(12.0, 0.0), (25.0, 4.0), (45.0, -4.0)])
-def test_a_vehicle_behind_is_drawn_where_the_rear_rig_projects_it(rear, behind_m, dy_m):
+def test_a_vehicle_behind_is_drawn_where_the_rear_rig_projects_it(rear, behind_m, dy_m, projected_box):
     obj = car(7, behind_m, dy_m)
     out = rear.render(Scene(EGO, (obj,)))
     # every patch that faces the rear left camera, projected with the rear rig: their bounds are the silhouette box
-    b = PatchBuilder()
-    vehicle_patches(b, obj, 0)
-    p = b.build()
-    cam = EGO.world_from_vehicle().apply(REAR.camera_position(Side.LEFT))
-    facing = np.einsum("ij,ij->i", np.cross(p.e1, p.e2), p.origin - cam) < 0
-    pts = np.concatenate([p.origin[facing], (p.origin + p.e1)[facing], (p.origin + p.e2)[facing],
-                          (p.origin + p.e1 + p.e2)[facing]])
-    uv, z = REAR.project_vehicle_points(EGO.vehicle_from_world().apply(pts), Side.LEFT)
+    expected, _, z = projected_box(obj, REAR, EGO)
     assert (z > 0).all()
-    expected = (uv[:, 0].min(), uv[:, 1].min(), uv[:, 0].max() + 1, uv[:, 1].max() + 1)
     np.testing.assert_allclose(out.boxes_px[7], expected, atol=1.0)
     assert out.visible[7] == pytest.approx(1.0)
     # its front face's centre is the car in the id map, at the face's depth (x = L/2 ahead of its centre)
