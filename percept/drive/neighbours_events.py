@@ -2,7 +2,8 @@
 when the ego collides with a vehicle.
 
 A cut-in is a true vehicle whose lane relative to the ego's goes from +-1 to 0 while it is ahead within
-``CUT_IN_GAP_M``: the frame its centre crosses the ego lane's boundary. Its warning lead is the crossing time less
+``CUT_IN_GAP_M``, having been clear of the ego lane (all of its width beyond the boundary) since it was last in it:
+the frame its centre crosses the ego lane's boundary. A car that turns back halfway out of the ego lane never left it. Its warning lead is the crossing time less
 the onset of the warning run, on a track matched to that vehicle, still going on the frame before (0 when there is
 none: a missed cut-in). A warning onset is false when its track's vehicle does not cross into the ego lane (ahead,
 beside or behind, at any gap) within ``FALSE_WARNING_S``; onsets whose window outlasts the run are not judged.
@@ -28,6 +29,9 @@ SEEN_BEFORE_S = 2.0
 """A cut-in's warning lead is scored when a rig had seen its car at least this long before it crossed; one that
 crossed sooner after it came into view (a car already moving over as the run begins) is counted apart, in
 ``cut_ins_unscored`` [s]."""
+CAR_HALF_WIDTH_M = 1.0
+"""Half a car's width (highway-env's Vehicle.WIDTH / 2): a car whose centre is this far beyond the ego lane's boundary
+is clear of the lane [m]."""
 COLLISION_WINDOW_S = 1.0
 """Lateral speeds before a collision are averaged over this [s]."""
 LATERAL_MOVE_MPS = 0.3
@@ -60,14 +64,17 @@ class CutInEvents:
         self._last_s = 0.0  # the last frame's time [s]
         self._first_seen: dict = {}  # vehicle id -> when a rig first saw it at least half [s]
         self.unscored = 0  # cut-ins whose car crossed less than SEEN_BEFORE_S after a rig first saw it
+        self._clear: set = set()  # vehicles clear of the ego lane since they were last in it
 
-    def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict) -> None:
+    def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict, width_m: float) -> None:
         """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
-        ``matched`` track id -> vehicle id. When the ego's own lane changes, the relative lanes jump: no crossing."""
+        ``matched`` track id -> vehicle id; ``width_m`` the true ego lane's width [m]. When the ego's own lane changes, the relative lanes jump: no crossing."""
         # into the ego lane anywhere (a warning for any of them is justified); ahead within CUT_IN_GAP_M: cut-ins
         entered = [] if lane_index != self._lane_index else [
             v for v, n in truth.items() if n.lane == 0 and self._lanes.get(v) in (-1, 1)]
-        crossed = [v for v in entered if truth[v].zone is Zone.AHEAD and truth[v].gap_m <= CUT_IN_GAP_M]
+        crossed = [v for v in entered if truth[v].zone is Zone.AHEAD and truth[v].gap_m <= CUT_IN_GAP_M
+                   and v in self._clear]
+        self._follow_clear(truth, width_m)
         self.crossings += len(crossed)
         for v, n in truth.items():
             if n.camera is not None:
@@ -82,6 +89,15 @@ class CutInEvents:
         self._lanes = {v: n.lane for v, n in truth.items()}
         self._lane_index = lane_index
         self._matched = dict(matched)
+
+    def _follow_clear(self, truth: dict, width_m: float) -> None:
+        """Which vehicles are clear of the ego lane since they were last in it."""
+        for v, n in truth.items():
+            # clear: |l_ego| >= w/2 + W/2, l_ego = lane w + l its offset from the ego lane's centre line
+            if abs(n.lane * width_m + n.lateral_m) >= width_m / 2 + CAR_HALF_WIDTH_M:
+                self._clear.add(v)
+            elif n.lane == 0:
+                self._clear.discard(v)
 
     def _score_crossing(self, time_s: float, vehicle_id, matched: dict) -> None:
         """The lead of the warning run on a track matched to ``vehicle_id`` (now or the frame before)."""

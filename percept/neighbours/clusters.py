@@ -63,6 +63,7 @@ class Detection:
     points: int  # how many points it has
     sigma_x_m: float  # 1-sigma of x_m from the disparity noise [m]
     cut_off: bool = False  # the image's side edge cuts the face off: its lateral centre is inferred from one edge
+    sigma_lat_m: float = 0.0  # 1-sigma of lat_m from the face's edges' pixel noise at its range [m]
 
 
 class FaceRange(Protocol):

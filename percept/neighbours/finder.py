@@ -20,6 +20,9 @@ CUT_OFF_SIGMA_X_M = 2.5
 """The along-lane 1-sigma of a cut-off face: the nearest point seen is on the car's side, at the image's edge [m]."""
 FULL_FACE_M = 1.6
 """A face at least this wide is seen whole [m]."""
+EDGE_SIGMA_PX = 3.0
+"""1-sigma of a face's edges in the image [px]: at night and in rain the lit or wet parts of a car, not its outline,
+bound its points, so the lateral place of a face at range Z is uncertain by Z EDGE_SIGMA_PX / f."""
 
 
 class RigFinder:
@@ -40,7 +43,13 @@ class RigFinder:
         self._pair = (left_gray, right_gray)
         found = find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters,
                               self.rig.mount_height_m)
-        return [self.cut_off(d) for d in found], pts
+        return [self.lateral_sigma(self.cut_off(d)) for d in found], pts
+
+    def lateral_sigma(self, det: Detection) -> Detection:
+        """``det`` with the lateral 1-sigma of its face's edges at its range."""
+        # sigma_l = Z sigma_u / f, Z the face's range from the camera along the lane
+        z = abs(det.face_x_m - self.cam_x)
+        return replace(det, sigma_lat_m=z * EDGE_SIGMA_PX / self.rig.camera.fx)
 
     def cut_off(self, det: Detection) -> Detection:
         """``det`` marked as cut off when it reaches the image's side edge (a car coming alongside); when its face is

@@ -24,7 +24,9 @@ class TrackerConfig:
 
     accel_noise_mps2: float = 2.0  # along-lane white acceleration (1-sigma) [m/s^2]
     lateral_accel_noise_mps2: float = 0.8  # lateral white acceleration (1-sigma) [m/s^2]
-    lateral_sigma_m: float = 0.12  # a detection's lateral position noise (1-sigma) [m]
+    lateral_sigma_m: float = 0.12  # a detection's lateral position noise near by (1-sigma), added in quadrature to
+    # the detection's own range-dependent sigma_lat_m [m]
+    outlier_sigmas: float = 3.0  # a lateral innovation beyond this many sigmas is down-weighted to this size [-]
     gate_x_m: float = 3.0  # association gate along the lane, plus gate_x_rel of the range [m]
     gate_x_rel: float = 0.08  # ... [-]
     gate_l_m: float = 1.4  # association gate across it [m]
@@ -33,6 +35,8 @@ class TrackerConfig:
     blind_behind_m: float = -14.0  # the blind band beside the ego, where a rig sees too little of a car to find it:
     # centres from here ...
     blind_ahead_m: float = 12.0  # ... to here, along the lane, in the lanes beside [m]
+    fringe_m: float = 10.0  # beyond each end of the band, where a rig sees a car beside only in part (cut off by the
+    # image's edge): an established track there heading for the band coasts unseen instead of counting misses [m]
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
     min_settled: int = 10  # detections in a row in one lane that make a track a settled neighbour there [-]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
@@ -46,7 +50,8 @@ class Track:
     kf: KalmanFilter
     hits: int = 1
     misses: int = 0
-    blind_s: float = 0.0
+    blind_s: float = 0.0  # how long it has been held in the blind band (0: not held) [s]
+    takeover: int = 0  # detections in a row since a rig saw it again while it was held
     camera: str | None = None
     box_px: tuple | None = None
     confirmed: bool = False
@@ -89,7 +94,7 @@ class NeighbourTracker:
         kf.Q[:2, :2] = block * c.accel_noise_mps2 ** 2
         kf.Q[2:, 2:] = block * c.lateral_accel_noise_mps2 ** 2
         kf.x = np.array([[det.x_m], [0.0], [det.lat_m], [0.0]])
-        kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, c.lateral_sigma_m ** 2, 1.0 ** 2])
+        kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, c.lateral_sigma_m ** 2 + det.sigma_lat_m ** 2, 1.0 ** 2])
         return kf
 
     def in_blind_band(self, x_m: float, lat_m: float, width_m: float) -> bool:
@@ -115,7 +120,7 @@ class NeighbourTracker:
                 # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
                 gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
-                if dx <= gate_x and dl <= c.gate_l_m:
+                if dx <= gate_x and dl <= c.gate_l_m and self._may_take_over(t, d):
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))
         used_t, used_d = set(), set()
         for _, i, j in sorted(pairs):
@@ -124,9 +129,13 @@ class NeighbourTracker:
             used_t.add(i)
             used_d.add(j)
             t, d = self.tracks[i], dets[j]
-            R = np.diag([max(d.sigma_x_m, 0.05) ** 2, c.lateral_sigma_m ** 2])
-            t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
-            t.hits, t.misses, t.blind_s = t.hits + 1, 0, 0.0
+            t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=self._noise(t, d))
+            t.hits, t.misses = t.hits + 1, 0
+            # a held track leaves the band once a rig has seen it confirm_hits times in a row: a lone detection of
+            # something else does not carry it off (the next unseen frame puts it back in the band)
+            t.takeover = t.takeover + 1 if t.blind_s > 0 else 0
+            if t.takeover >= c.confirm_hits:
+                t.blind_s, t.takeover = 0.0, 0
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
             # its lane: round(l / w)
             lane = int(round(t.lat / self.width))
@@ -138,17 +147,49 @@ class NeighbourTracker:
                 self.tracks.append(Track(self._next_id, self._new_filter(d), camera=rig, box_px=d.box_px))
                 self._next_id += 1
 
+    def _may_take_over(self, t: Track, d: Detection) -> bool:
+        """Whether detection ``d`` may update track ``t``: any may, but a track held in the blind band is taken over
+        only by a car coming out of it, which a rig first sees at its image's edge (``cut_off``) or near the band's
+        ends (within ``gate_x_m``), not by another car farther along the lane beside."""
+        c = self.cfg
+        if t.blind_s <= 0 or d.cut_off:
+            return True
+        return c.blind_behind_m - c.gate_x_m <= d.x_m <= c.blind_ahead_m + c.gate_x_m
+
+    def _noise(self, t: Track, d: Detection) -> np.ndarray:
+        """The measurement noise R of detection ``d`` for track ``t``: its along-lane sigma and its lateral one, the
+        latter widened so that an innovation beyond ``outlier_sigmas`` counts as that many sigmas (Huber's weighting):
+        a face that briefly takes in a car's side, or loses a lit part of its rear, jumps sideways by a metre."""
+        c = self.cfg
+        # sigma_l^2 = sigma_0^2 + sigma_d^2; innovation variance S_l = P_ll + sigma_l^2
+        var_l = c.lateral_sigma_m ** 2 + d.sigma_lat_m ** 2
+        s_l = float(t.kf.P[2, 2]) + var_l
+        nu = abs(d.lat_m - t.lat)
+        k = c.outlier_sigmas
+        if nu > k * np.sqrt(s_l):
+            # widen R_l until nu = k sqrt(P_ll + R_l)
+            var_l = max(var_l, (nu / k) ** 2 - float(t.kf.P[2, 2]))
+        return np.diag([max(d.sigma_x_m, 0.05) ** 2, var_l])
+
     def _hold_in_band(self, t: Track) -> None:
         """One frame of a track held in the blind band: nothing says it moves sideways, so it keeps its lateral place;
         if its prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed
         somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
         c = self.cfg
         t.kf.x[3, 0] = 0.0
+        t.takeover = 0
         held = float(np.clip(t.x, c.blind_behind_m, c.blind_ahead_m))
         if held != t.x:
             t.kf.x[0, 0], t.kf.x[1, 0] = held, 0.0
             t.kf.P[0, 0] = max(t.kf.P[0, 0], ((c.blind_ahead_m - c.blind_behind_m) / 2) ** 2)
         t.blind_s += self.dt
+
+    def _heading_for_band(self, t: Track) -> bool:
+        """Whether a track lies within ``fringe_m`` of the blind band's ends, outside it, and moves towards it."""
+        c = self.cfg
+        x, vx = t.x, float(t.kf.x[1, 0])
+        return (c.blind_ahead_m < x <= c.blind_ahead_m + c.fringe_m and vx < 0) or (
+            c.blind_behind_m - c.fringe_m <= x < c.blind_behind_m and vx > 0)
 
     def sigma_x(self, t: Track) -> float:
         """A track's along-lane 1-sigma [m]: its filter's, widened at ``blind_spread_mps`` for as long as it has been
@@ -157,7 +198,8 @@ class NeighbourTracker:
 
     def _keep_or_drop(self, width_m: float) -> None:
         """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until
-        a rig takes it over; any other counts a miss, and too many drop it."""
+        a rig takes it over; an established one heading for the band from its fringe coasts; any other counts a miss,
+        and too many drop it."""
         c = self.cfg
         kept = []
         for t in self.tracks:
@@ -165,7 +207,7 @@ class NeighbourTracker:
                 beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
                 if beside and (self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0) and t.blind_s < c.max_blind_s:
                     self._hold_in_band(t)
-                else:
+                elif not (beside and t.hits >= c.min_settled and self._heading_for_band(t)):
                     t.misses += 1
             if t.misses <= (c.max_misses if t.confirmed else 1):
                 kept.append(t)

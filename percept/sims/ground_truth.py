@@ -117,8 +117,9 @@ _BOX_GRID = np.array([[a, b, h] for a in (-0.5, 0, 0.5) for b in (-0.5, 0, 0.5) 
 
 def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:
     """Per object, the share of the box that bounds the projections of its points ``points_c`` (camera frame,
-    (N, K, 3) [m]: K points of each of N objects) inside the image; 1 when some point is behind the camera (the
-    projection is not a box then). (N,)"""
+    (N, K, 3) [m]: K points of each of N objects) inside the image; for an object with a point behind the camera (the
+    projection is not a box then: a car beside it), the share of the horizontal angle its points span that lies
+    within the image's. (N,)"""
     behind = np.any(points_c[..., 2] <= 0.1, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         uv = camera.project(points_c)
@@ -128,7 +129,20 @@ def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:
     inside = (np.maximum(np.minimum(u1, camera.width) - np.maximum(u0, 0.0), 0.0)
               * np.maximum(np.minimum(v1, camera.height) - np.maximum(v0, 0.0), 0.0))
     ok = ~behind & ~(area <= 0)
-    return np.where(ok, inside / np.where(ok, area, 1.0), 1.0)
+    return np.where(ok, inside / np.where(ok, area, 1.0), _angle_share(camera, points_c))
+
+
+def _angle_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:
+    """Per object, the share of the horizontal angle its points span (about its mean direction, so a span across the
+    camera's back is whole) that the image's columns cover. (N,)"""
+    # theta = atan2(x, z); the image spans atan((0 - c_x) / f_x) .. atan((W - c_x) / f_x)
+    theta = np.arctan2(points_c[..., 0], points_c[..., 2])
+    mid = np.arctan2(np.sin(theta).mean(axis=1), np.cos(theta).mean(axis=1))[:, None]
+    theta = mid + np.angle(np.exp(1j * (theta - mid)))
+    lo, hi = theta.min(axis=1), theta.max(axis=1)
+    a0, a1 = np.arctan(-camera.cx / camera.fx), np.arctan((camera.width - camera.cx) / camera.fx)
+    overlap = np.maximum(np.minimum(hi, a1) - np.maximum(lo, a0), 0.0)
+    return np.where(hi > lo, overlap / np.where(hi > lo, hi - lo, 1.0), 1.0)
 
 
 @dataclass(frozen=True)

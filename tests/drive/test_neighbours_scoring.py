@@ -243,12 +243,24 @@ def test_a_warning_that_never_ends_in_a_crossing_is_false(vehicle, truth):
 
 
 def test_a_car_that_crosses_soon_after_it_comes_into_view_is_not_scored_for_its_lead(vehicle, truth):
-    # already moving over when first seen, 1 s before it crosses: counted, not scored
+    # already moving over when first seen, 1.2 s before it crosses: counted, not scored
     frames = []
     for k in range(20):
         t = k * DT
-        gt = truth([vehicle(1, 30.0, 2.9 - 1.0 * t, lateral_speed=-1.0)], time_s=t)
+        gt = truth([vehicle(1, 30.0, 3.2 - 1.0 * t, lateral_speed=-1.0)], time_s=t)
         frames.append((gt, []))
     r = run(frames)
     assert r["cut_ins"] == 1 and r["cut_ins_unscored"] == 1
     assert r["cut_ins_missed"] == 0 and r["cut_in_warning_lead_s_min"] is None
+
+
+def test_a_car_that_turns_back_halfway_out_of_the_ego_lane_is_no_cut_in(vehicle, truth):
+    # from the ego lane's centre out to 2.4 m (its near side still 0.6 m inside the 4 m lane), then back
+    path = [0.3 * k for k in range(9)] + [2.4 - 0.3 * k for k in range(1, 9)]
+    frames = [(truth([vehicle(1, 30.0, y)], time_s=k * DT), []) for k, y in enumerate([0.0] * 30 + path)]
+    r = run(frames)
+    assert r["cut_ins"] == 0 and r["cut_ins_missed"] == 0
+    # the same car going on until it is clear of the lane (3 m), then coming back, cuts in
+    out = [0.3 * k for k in range(12)] + [3.3 - 0.3 * k for k in range(1, 12)]
+    frames = [(truth([vehicle(1, 30.0, y)], time_s=k * DT), []) for k, y in enumerate([0.0] * 30 + out)]
+    assert run(frames)["cut_ins"] == 1

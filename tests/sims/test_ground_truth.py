@@ -59,7 +59,10 @@ def test_the_visible_share_is_cut_by_the_frame_and_kept_for_objects_not_seen():
     assert u0 < 0 < u1
     assert cut.visible == pytest.approx(0.8 * inside / ((u1 - u0) * (v1 - v0)))
     assert whole.visible == pytest.approx(0.8)
-    # no box (not drawn): its visible share is what the renderer said; behind the camera the share is 1
+    # no box (not drawn): its visible share is what the renderer said; wholly behind the camera it is 0
     (unseen,) = truth([placed(1, 6.0, 5.0, EGO.yaw_rad)], boxes=[None], visible=[0.25])
     (behind,) = truth([placed(1, -10.0, 0.0, EGO.yaw_rad)], visible=[0.5])
-    assert unseen.visible == 0.25 and behind.visible == 0.5
+    assert unseen.visible == 0.25 and behind.visible == 0.0
+    # beside the ego, across the camera's plane: the share of the angle it spans that the image holds (its nose)
+    (beside,) = truth([placed(1, 5.0, 3.75, EGO.yaw_rad)], visible=[1.0])
+    assert 0.0 < beside.visible < 0.15

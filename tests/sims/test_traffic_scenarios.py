@@ -12,6 +12,7 @@ from percept.sims.actors import LaneEnd, ScriptedVehicle
 from percept.sims.env import PerceptEnv
 from percept.sims.road_geometry import build_road_geometry
 from percept.sims.scenarios import merge_road
+from percept.sims.scenarios.placing import LANE_CHANGE_LATERAL_SPEED_MPS, PeoplePaced
 from percept.sims.scenarios.traffic import MERGE_LEAD_IN_M, MERGE_RAMP_M
 from percept.sims.snapshot import ObjectIds, scene_from_road
 
@@ -71,7 +72,9 @@ def test_dense_is_highway_v0_like():
     e = _env("dense", 2)
     ego, others = e.vehicle, e.road.vehicles[1:]
     assert len(others) == 50 and len(e.road.network.graph["0"]["1"]) == 4
-    assert {type(v) for v in others} == {IDMVehicle, AggressiveVehicle, DefensiveVehicle}
+    # highway-env's own classes, paced like drivers when they change lanes
+    assert {type(v).__mro__[2] for v in others} == {IDMVehicle, AggressiveVehicle, DefensiveVehicle}
+    assert all(isinstance(v, PeoplePaced) for v in others)
     speeds = np.array([v.speed for v in others])
     assert np.all((speeds >= 20.0) & (speeds <= 30.0)) and e.cruise_speed_mps > np.median(speeds)
     dx = np.array([v.position[0] - ego.position[0] for v in others])
@@ -197,3 +200,31 @@ def test_renders_at_night_and_in_rain(name):
         frame, gt = w.observe()
         assert frame.left.shape == frame.right.shape and frame.left.mean() > 5
         assert any(o.kind == "vehicle" for o in gt.objects)
+
+
+@pytest.mark.slow
+def test_lane_changing_cars_move_over_at_a_drivers_pace():
+    # highway-env's own steering crosses the boundary about 1.3 s (Linear vehicles: under 1 s) after a car begins to move
+    e = _env("dense", 0)
+    dt = 1 / e.config["policy_frequency"]
+    began, leads, peak = {}, [], 0.0
+    lanes = {id(v): v.lane_index for v in e.road.vehicles}
+
+    def look(k):
+        nonlocal peak
+        for v in e.road.vehicles[1:]:
+            # the road is straight along x: lateral speed = v sin(heading)
+            lateral = abs(v.speed * np.sin(v.heading))
+            if lateral > 0.1:
+                began.setdefault(id(v), k)
+                peak = max(peak, lateral)
+            else:
+                began.pop(id(v), None)
+            if v.lane_index[2] != lanes[id(v)][2] and id(v) in began:
+                leads.append((k - began[id(v)]) * dt)
+            lanes[id(v)] = v.lane_index
+
+    _drive(e, 300, look)
+    assert len(leads) >= 5
+    assert peak <= LANE_CHANGE_LATERAL_SPEED_MPS * 1.15  # the heading lags the command and overshoots a little
+    assert np.median(leads) >= 2.0, leads  # a car moving over from off its lane's centre crosses sooner

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from highway_env.road.road import Road
 from highway_env.vehicle.behavior import IDMVehicle, LinearVehicle
+from highway_env.vehicle.controller import ControlledVehicle
 
 from .quick_road import QuickRoad
 
@@ -47,16 +48,49 @@ def new_road(env, net, connected: bool = False) -> Road:
 
 
 LANE_CHANGE_TAU_LATERAL_S = 1.5
-"""Lateral time constant of a lane-changing car's steering (highway-env's ControlledVehicle.TAU_LATERAL is 0.6 s) [s]:
-with ``LANE_CHANGE_TAU_HEADING_S`` a lane change takes about 4.3 s at highway speed, as drivers' do (4-6 s; Toledo and
-Zohar, "Modeling duration of lane changes", TRR 1999, 2007), where highway-env's defaults take 1.7 s."""
+"""Lateral time constant of a lane-changing car's steering (highway-env's ControlledVehicle.TAU_LATERAL is 0.6 s) [s]."""
 LANE_CHANGE_TAU_HEADING_S = 0.4
 """Heading time constant of a lane-changing car's steering (highway-env's TAU_HEADING is 0.2 s) [s]."""
+LANE_CHANGE_LATERAL_SPEED_MPS = 1.0
+"""The largest lateral speed a lane-changing car's steering asks for [m/s]: with the time constants above a lane
+change takes about 5 s at highway speed, as drivers' do (4-6 s; Toledo and Zohar, "Modeling duration of lane
+changes", TRR 1999, 2007), and the car crosses the boundary about half way through. highway-env's proportional law
+alone asks for its largest lateral speed at the start, so its car crosses the boundary about 1.3 s after it begins
+to move over, and its defaults take 1.7 s in all."""
+
+
+class PeoplePaced:
+    """Mixin over a highway-env ControlledVehicle class: it steers with ControlledVehicle's law, its lateral speed
+    command, -K_p l, capped at ``LANE_CHANGE_LATERAL_SPEED_MPS``. highway-env's LinearVehicle classes (Aggressive,
+    Defensive) steer with that law's linearisation at its default gains, which ignores a vehicle's own gains; they
+    steer with the law itself here."""
+
+    def steering_control(self, target_lane_index) -> float:
+        lateral = self.road.network.get_lane(target_lane_index).local_coordinates(self.position)[1]
+        gain = self.KP_LATERAL
+        # |K_p l| <= v_max  <=>  K_p <= v_max / |l|: the law runs with that gain this step
+        self.KP_LATERAL = min(gain, LANE_CHANGE_LATERAL_SPEED_MPS / max(abs(float(lateral)), 1e-6))
+        try:
+            return ControlledVehicle.steering_control(self, target_lane_index)
+        finally:
+            self.KP_LATERAL = gain
+
+
+_PACED: dict[type, type] = {}
+
+
+def people_paced(cls: type) -> type:
+    """``cls`` (a highway-env ControlledVehicle class) with the lateral speed cap of ``PeoplePaced``, by the same
+    name."""
+    if cls not in _PACED:
+        _PACED[cls] = type(cls.__name__, (PeoplePaced, cls), {"__module__": cls.__module__})
+    return _PACED[cls]
 
 
 def drive_like_people(v) -> None:
-    """Give a lane-changing car the steering time constants of ``LANE_CHANGE_TAU_LATERAL_S`` and
-    ``LANE_CHANGE_TAU_HEADING_S`` (highway-env's controller reads its gains from the vehicle)."""
+    """Give a lane-changing car the steering time constants ``LANE_CHANGE_TAU_LATERAL_S`` and
+    ``LANE_CHANGE_TAU_HEADING_S`` (highway-env's controller reads its gains from the vehicle); its class should be
+    ``people_paced``."""
     # KP = 1 / tau
     v.KP_LATERAL = 1.0 / LANE_CHANGE_TAU_LATERAL_S
     v.KP_HEADING = 1.0 / LANE_CHANGE_TAU_HEADING_S
@@ -65,8 +99,9 @@ def drive_like_people(v) -> None:
 def place_idm(road, idx, s: float, speed: float, cls=IDMVehicle, lane_change: bool = False, **kw):
     """A vehicle of class ``cls`` (highway-env's IDMVehicle or a subclass) on lane ``idx`` at longitudinal s [m],
     driving at ``speed`` [m/s], which is also its target speed; lane_change: MOBIL lane changes on, at a driver's
-    pace (``drive_like_people``)."""
+    pace (``people_paced``, ``drive_like_people``)."""
     lane = road.network.get_lane(idx)
+    cls = people_paced(cls) if lane_change else cls
     v = cls(road, lane.position(s, 0.0), lane.heading_at(s), speed, target_lane_index=idx, target_speed=speed,
             **kw)
     v.enable_lane_change = lane_change
