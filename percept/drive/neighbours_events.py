@@ -57,7 +57,7 @@ class CutInEvents:
         self.missed = 0
         self.false_warnings = 0
         self._lanes: dict = {}  # vehicle id -> its relative lane on the previous frame
-        self._lane_index = None  # the ego's lane on the previous frame
+        self._lane_id = None  # the ego's lane id on the previous frame
         self._since: dict = {}  # track id -> onset of its warning run going on at the previous frame [s]
         self._matched: dict = {}  # track id -> vehicle id, on the previous frame
         self._pending: list[_Onset] = []
@@ -68,9 +68,12 @@ class CutInEvents:
 
     def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict, width_m: float) -> None:
         """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
-        ``matched`` track id -> vehicle id; ``width_m`` the true ego lane's width [m]. When the ego's own lane changes, the relative lanes jump: no crossing."""
+        ``matched`` track id -> vehicle id; ``width_m`` the true ego lane's width [m]. When the ego's own lane changes
+        (the lane id of ``lane_index``; the road's segment changes at every node), the relative lanes jump: no
+        crossing."""
         # into the ego lane anywhere (a warning for any of them is justified); ahead within CUT_IN_GAP_M: cut-ins
-        entered = [] if lane_index != self._lane_index else [
+        lane_id = lane_index[-1]
+        entered = [] if lane_id != self._lane_id else [
             v for v, n in truth.items() if n.lane == 0 and self._lanes.get(v) in (-1, 1)]
         crossed = [v for v in entered if truth[v].zone is Zone.AHEAD and truth[v].gap_m <= CUT_IN_GAP_M
                    and v in self._clear]
@@ -87,7 +90,7 @@ class CutInEvents:
                 self._score_crossing(time_s, v, matched)
             self._follow_warnings(time_s, tracks, matched, entered)
         self._lanes = {v: n.lane for v, n in truth.items()}
-        self._lane_index = lane_index
+        self._lane_id = lane_id
         self._matched = dict(matched)
 
     def _follow_clear(self, truth: dict, width_m: float) -> None:

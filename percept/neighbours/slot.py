@@ -4,10 +4,10 @@ lanes beside it, ahead, beside and behind, out (``Neighbours``).
 Each frame each rig's vehicles are found (``finder``: band stereo, ground-grid groups, the face's subpixel range) in
 the ego lane's coordinates, tracked (``tracker``), and each confirmed track reported with its lane, gap, relative
 speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside whose lateral
-speed (beyond three sigma of its estimate) takes its centre to the ego lane's boundary within ``horizon_s``, and which
-was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row: a car changing into it
-from the lane beyond is not cutting in to the ego's), is flagged as cutting in, with the predicted time to that crossing, so the following law can treat it as a lead before
-it arrives.
+speed (beyond ``speed_sigmas`` of its estimate) takes its centre to the ego lane's boundary within ``horizon_s``, and
+which was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row: a car changing into
+it from the lane beyond is not cutting in to the ego's), is flagged as cutting in, with the predicted
+time to that crossing, so the following law can treat it as a lead before it arrives.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ class NeighbourConfig:
     rear_near_m: float = -3.0  # the nearest face the rear rig measures [m]
     horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]
     min_lateral_speed_mps: float = 0.3  # and the lateral speed towards it at least this [m/s]
+    speed_sigmas: float = 3.0  # and at least this many sigmas of its estimate [-]
     min_shift_m: float = 0.25  # and it has moved at least this from its lane's centre towards the ego lane [m]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
 
@@ -82,7 +83,7 @@ class NeighbourSlot:
                 ) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
         track, settled in its lane and not cut off by the image's edge, moves towards the ego lane faster than both
-        ``min_lateral_speed_mps`` and three sigma as a rig measures it, has left its lane's centre by ``min_shift_m`` towards it and will
+        ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's centre by ``min_shift_m`` towards it and will
         reach the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back
         (a merging car may pause on the line)."""
         c = self.cfg
@@ -94,7 +95,7 @@ class NeighbourSlot:
         else:
             holds = (t.settled >= self.tracker.cfg.min_settled and t.camera is not None and not t.cut_off
                      and shift >= c.min_shift_m
-                     and toward > max(c.min_lateral_speed_mps, 3 * sig_vl))
+                     and toward > max(c.min_lateral_speed_mps, c.speed_sigmas * sig_vl))
         if not holds:
             return False, None
         # its centre reaches the boundary |l| = w/2 after t = (|l| - w/2) / max(-sign(l) l', v_min)

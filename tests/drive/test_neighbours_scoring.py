@@ -133,6 +133,14 @@ def test_the_lead_counts_from_the_last_warning_run_before_the_crossing(vehicle, 
     assert r["cut_in_warning_lead_s_min"] == pytest.approx(0.6) and r["false_warnings"] == 0
 
 
+def test_a_cut_in_as_the_ego_passes_a_node_of_the_road_still_counts(vehicle, truth):
+    # the ego's lane keeps its id while the road's segment changes under it, on the frame the car crosses
+    frames = [(replace(gt, lane=replace(gt.lane, lane_index=("b", "c", 1))) if gt.time_s >= 2.55 else gt, est)
+              for gt, est in cut_in_run(vehicle, truth, lambda t: t >= 1.1)]
+    r = run(frames)
+    assert r["cut_ins"] == 1 and r["cut_in_leads_s"] == [pytest.approx(1.5)]
+
+
 def test_a_cut_in_never_warned_scores_no_lead_and_is_missed(vehicle, truth):
     for warned in (lambda t: False, lambda t: 0.5 <= t <= 1.0, lambda t: t >= 2.6):
         r = run(cut_in_run(vehicle, truth, warned))
