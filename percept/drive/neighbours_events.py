@@ -3,10 +3,11 @@ when the ego collides with a vehicle.
 
 A cut-in is a true vehicle whose lane relative to the ego's goes from +-1 to 0 while it is ahead within
 ``CUT_IN_GAP_M``, having been clear of the ego lane (all of its width beyond the boundary) since it was last in it:
-the frame its centre crosses the ego lane's boundary. A car that turns back halfway out of the ego lane never left it. Its warning lead is the crossing time less
-the onset of the warning run, on a track matched to that vehicle, still going on the frame before (0 when there is
-none: a missed cut-in). A warning onset is false when its track's vehicle does not cross into the ego lane (ahead,
-beside or behind, at any gap) within ``FALSE_WARNING_S``; onsets whose window outlasts the run are not judged.
+the frame its centre crosses the ego lane's boundary. A car that turns back halfway out of the ego lane never left
+it. Its warning lead is the crossing time less the onset of the warning run, on a track matched to that vehicle,
+still going on the frame before (0 when there is none: a missed cut-in). A warning onset is false when its track's
+vehicle does not cross into the ego lane (ahead, beside or behind, at any gap) within ``FALSE_WARNING_S``; onsets
+whose window outlasts the run are not judged.
 """
 
 from __future__ import annotations

@@ -84,7 +84,8 @@ def lane_coordinates(pts: StandingPoints, lane: LaneEstimate | None) -> tuple[np
 def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x_hi: float, face: FaceRange,
                   cfg: ClusterConfig = ClusterConfig(), camera_height_m: float = np.inf) -> list[Detection]:
     """The vehicles among ``pts`` with centres in the ego lane or a lane beside it and faces between ``x_lo`` and
-    ``x_hi`` along the lane [m], each face's range from ``face``; camera_height_m: the rig's height, which bounds what the band shows of a car [m]."""
+    ``x_hi`` along the lane [m], each face's range from ``face``; camera_height_m: the rig's height, which bounds what
+    the band shows of a car [m]."""
     x, lat, width = lane_coordinates(pts, lane)
     half = 1.5 * width + 1.0
     keep = (x >= x_lo) & (x <= x_hi) & (np.abs(lat) <= half)
@@ -118,9 +119,10 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
 def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarray, ahead: bool, width: float,
              face_range: FaceRange, cfg: ClusterConfig, camera_height_m: float = np.inf) -> Detection | None:
     """One group's detection, or None when it does not reach down to the road and up to a car's height, is too narrow
-    or its centre is outside the three lanes. The face is what is left of the group without its inner side (the points within ``side_m`` of
-    the edge nearest the ego lane's centre line, which a car in a lane beside shows along its length); the face's
-    range is ``face_range`` of those points, its lateral extent runs from that inner edge to the face's outer edge."""
+    or its centre is outside the three lanes. The face is what is left of the group without its inner side (the points
+    within ``side_m`` of the edge nearest the ego lane's centre line, which a car in a lane beside shows along its
+    length); the face's range is ``face_range`` of those points, its lateral extent runs from that inner edge to the
+    face's outer edge."""
     low, top = np.quantile(pts.z[idx], [0.1, 0.9])
     # near by the band holds only a car's lower part; farther, up to a little above the camera's height
     if low > cfg.max_low_m or (top < min(cfg.min_top_m, camera_height_m - 0.1)

@@ -83,9 +83,9 @@ class NeighbourSlot:
                 ) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
         track, settled in its lane and not cut off by the image's edge, moves towards the ego lane faster than both
-        ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's centre by ``min_shift_m`` towards it and will
-        reach the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back
-        (a merging car may pause on the line)."""
+        ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's centre by
+        ``min_shift_m`` towards it and will reach the boundary within ``horizon_s``; it holds while the car stays
+        shifted that way and does not move back (a merging car may pause on the line)."""
         c = self.cfg
         # towards the ego lane: -sign(l) l' > 0; shift from its lane's centre towards it: -sign(l) (l - lane w)
         toward = -math.copysign(1.0, lat) * vl

@@ -94,7 +94,8 @@ class NeighbourTracker:
         kf.Q[:2, :2] = block * c.accel_noise_mps2 ** 2
         kf.Q[2:, 2:] = block * c.lateral_accel_noise_mps2 ** 2
         kf.x = np.array([[det.x_m], [0.0], [det.lat_m], [0.0]])
-        kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, c.lateral_sigma_m ** 2 + det.sigma_lat_m ** 2, 1.0 ** 2])
+        sigma_l2 = c.lateral_sigma_m ** 2 + det.sigma_lat_m ** 2
+        kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, sigma_l2, 1.0 ** 2])
         return kf
 
     def in_blind_band(self, x_m: float, lat_m: float, width_m: float) -> bool:

@@ -1,5 +1,7 @@
 """Neighbour tracks on synthetic detections: speeds, the blind band, hand-over between the rigs, cut-in warnings."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -91,6 +93,79 @@ def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
     assert flagged_at is not None and crossed_at is not None
     assert (crossed_at - flagged_at) * DT >= 1.0
     assert NeighbourConfig().horizon_s >= 1.0
+
+
+def test_a_face_far_away_is_placed_less_surely_across_the_lane():
+    from percept.neighbours.finder import EDGE_SIGMA_PX, RigFinder
+
+    rig = StereoRig()
+    finder = RigFinder(rig, 3.0, 90.0)
+    near, far = finder.lateral_sigma(det(12.5, W)), finder.lateral_sigma(det(62.5, W))
+    # sigma_l = Z sigma_u / f, Z the face's range from the camera
+    cam_x = float(rig.camera_position()[0])
+    assert far.sigma_lat_m == pytest.approx((60.0 - cam_x) * EDGE_SIGMA_PX / rig.camera.fx)
+    assert near.sigma_lat_m < far.sigma_lat_m
+
+
+def test_a_lone_sideways_jump_of_a_face_barely_moves_the_track():
+    tr = NeighbourTracker(DT)
+    for k in range(30):
+        tr.step({"front": [det(30.0, W)]}, W)
+    tr.step({"front": [det(30.0, W - 1.3)]}, W)  # the face took in the car's side for a frame
+    (t,) = tr.tracks
+    assert abs(t.lat - W) < 0.3 and abs(t.kf.x[3, 0]) < 0.5
+    # the same jump kept up is followed
+    for k in range(20):
+        tr.step({"front": [det(30.0, W - 1.3)]}, W)
+    assert abs(t.lat - (W - 1.3)) < 0.2
+
+
+def _held_track() -> NeighbourTracker:
+    """A tracker with one track held in the blind band, beside the ego on the left, stopped at its front end (it
+    came in from behind 4 m/s faster than the ego, and no rig saw it come out)."""
+    tr = NeighbourTracker(DT)
+    for k in range(30):
+        tr.step({"rear": [det(-20.0 + 4.0 * k * DT, W)]}, W)
+    for _ in range(90):
+        tr.step({}, W)
+    (t,) = tr.tracks
+    assert t.blind_s > 0
+    return tr
+
+
+def test_a_lone_detection_farther_along_the_lane_does_not_carry_a_held_track_off():
+    cfg = TrackerConfig()
+    tr = _held_track()
+    # a side seen alone 7.5 m beyond the band's end: within the gate of a track stopped at that end
+    far = replace(det(cfg.blind_ahead_m + 7.5, W, sigma=2.5), cut_off=True)
+    tr.step({"front": [far]}, W)
+    tr.step({}, W)
+    held = [t for t in tr.tracks if t.confirmed]
+    assert len(held) == 1 and cfg.blind_behind_m <= held[0].x <= cfg.blind_ahead_m and held[0].blind_s > 0
+    # seen three times in a row, it has come out
+    for _ in range(cfg.confirm_hits):
+        tr.step({"front": [far]}, W)
+    assert held[0].blind_s == 0.0 and held[0].x > cfg.blind_ahead_m
+
+
+def test_a_track_heading_for_the_band_coasts_unseen_from_its_fringe():
+    cfg = TrackerConfig()
+    tr = NeighbourTracker(DT)
+    x = 36.0
+    for _ in range(60):  # seen from 36 m down to 20 m ahead, 4 m/s slower than the ego
+        tr.step({"front": [det(x, -W)]}, W)
+        x -= 4.0 * DT
+    for _ in range(int(3.0 / DT)):  # then unseen, more than max_misses frames, across the fringe into the band
+        tr.step({}, W)
+    (t,) = tr.tracks
+    assert t.blind_s > 0 and cfg.blind_behind_m <= t.x <= cfg.blind_ahead_m
+    # one moving away from the band is dropped
+    tr = NeighbourTracker(DT)
+    for k in range(60):
+        tr.step({"front": [det(16.0 + 4.0 * k * DT, -W)]}, W)
+    for _ in range(cfg.max_misses + 1):
+        tr.step({}, W)
+    assert tr.tracks == []
 
 
 def test_bad_points_config_is_refused():

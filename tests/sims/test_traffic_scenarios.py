@@ -204,7 +204,8 @@ def test_renders_at_night_and_in_rain(name):
 
 @pytest.mark.slow
 def test_lane_changing_cars_move_over_at_a_drivers_pace():
-    # highway-env's own steering crosses the boundary about 1.3 s (Linear vehicles: under 1 s) after a car begins to move
+    # highway-env's own steering crosses the boundary about 1.3 s (Linear vehicles: under 1 s) after a car begins to
+    # move over; paced like a driver it crosses about 2.3 s after
     e = _env("dense", 0)
     dt = 1 / e.config["policy_frequency"]
     began, leads, peak = {}, [], 0.0

@@ -48,15 +48,15 @@ def new_road(env, net, connected: bool = False) -> Road:
 
 
 LANE_CHANGE_TAU_LATERAL_S = 1.5
-"""Lateral time constant of a lane-changing car's steering (highway-env's ControlledVehicle.TAU_LATERAL is 0.6 s) [s]."""
+"""Lateral time constant of a lane-changing car's steering (highway-env's ControlledVehicle.TAU_LATERAL: 0.6 s) [s]."""
 LANE_CHANGE_TAU_HEADING_S = 0.4
 """Heading time constant of a lane-changing car's steering (highway-env's TAU_HEADING is 0.2 s) [s]."""
 LANE_CHANGE_LATERAL_SPEED_MPS = 1.0
-"""The largest lateral speed a lane-changing car's steering asks for [m/s]: with the time constants above a lane
-change takes about 5 s at highway speed, as drivers' do (4-6 s; Toledo and Zohar, "Modeling duration of lane
-changes", TRR 1999, 2007), and the car crosses the boundary about half way through. highway-env's proportional law
-alone asks for its largest lateral speed at the start, so its car crosses the boundary about 1.3 s after it begins
-to move over, and its defaults take 1.7 s in all."""
+"""The largest lateral speed a lane-changing car's steering asks for [m/s]: with the time constants above, a car
+crosses the boundary about 2.3 s after it begins to move over and is within 0.2 m of its new lane's centre after
+about 6 s, as drivers' lane changes last 4-6 s and more (Toledo and Zohar, "Modeling duration of lane changes", TRR
+1999, 2007). highway-env's proportional law alone asks for its largest lateral speed at the start, so its car crosses
+the boundary about 1.3 s after it begins to move over; with its default gains the whole change takes 1.7 s."""
 
 
 class PeoplePaced:
