@@ -30,6 +30,9 @@ SEEN_BEFORE_S = 2.0
 """A cut-in's warning lead is scored when a rig had seen its car at least this long before it crossed; one that
 crossed sooner after it came into view (a car already moving over as the run begins) is counted apart, in
 ``cut_ins_unscored`` [s]."""
+CROSSED_FIRST_S = 1.0
+"""A warning run goes on for up to this long after its track has crossed into the ego lane in the estimate (the flag
+ends there: the car is now a lead) while the true car has not yet [s]."""
 CAR_HALF_WIDTH_M = 1.0
 """Half a car's width (highway-env's Vehicle.WIDTH / 2): a car whose centre is this far beyond the ego lane's boundary
 is clear of the lane [m]."""
@@ -66,6 +69,7 @@ class CutInEvents:
         self._first_seen: dict = {}  # vehicle id -> when a rig first saw it at least half [s]
         self.unscored = 0  # cut-ins whose car crossed less than SEEN_BEFORE_S after a rig first saw it
         self._clear: set = set()  # vehicles clear of the ego lane since they were last in it
+        self._in_lane: dict = {}  # track id -> when its warning run's track came into the ego lane (estimate) [s]
 
     def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict, width_m: float) -> None:
         """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
@@ -114,8 +118,15 @@ class CutInEvents:
         self.missed += int(not onsets)
 
     def _follow_warnings(self, time_s: float, tracks, matched: dict, entered: list) -> None:
-        """Onsets of warning runs, and the judgement of each FALSE_WARNING_S after it."""
+        """Onsets of warning runs, and the judgement of each FALSE_WARNING_S after it. A run goes on while its track
+        is flagged, and for CROSSED_FIRST_S once its track is in the ego lane (the estimate may see the car cross a
+        frame or two before the truth does)."""
         warning = {n.track_id for n in tracks if n.cut_in}
+        in_lane = {n.track_id for n in tracks if n.lane == 0} & self._since.keys()
+        for t in in_lane - warning:
+            self._in_lane.setdefault(t, time_s)
+        self._in_lane = {t: s for t, s in self._in_lane.items() if t in in_lane - warning}
+        warning |= {t for t, s in self._in_lane.items() if time_s - s <= CROSSED_FIRST_S}
         for t in sorted(warning - self._since.keys()):
             self._since[t] = time_s
             self._pending.append(_Onset(time_s, t, matched.get(t)))

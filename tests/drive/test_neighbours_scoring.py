@@ -141,6 +141,24 @@ def test_a_cut_in_as_the_ego_passes_a_node_of_the_road_still_counts(vehicle, tru
     assert r["cut_ins"] == 1 and r["cut_in_leads_s"] == [pytest.approx(1.5)]
 
 
+def test_a_warned_car_seen_in_the_ego_lane_a_frame_before_it_crosses_keeps_its_lead(vehicle, truth):
+    # warned from 1.1 s; at 2.5 s its track is already in the ego lane (no longer flagged), the truth crosses at 2.6 s
+    frames = []
+    for gt, est in cut_in_run(vehicle, truth, lambda t: t >= 1.1):
+        if gt.time_s >= 2.45:
+            est = [replace(n, lane=0, lateral_m=n.lateral_m + 4.0, cut_in=False, time_to_cross_s=None) for n in est]
+        frames.append((gt, est))
+    r = run(frames)
+    assert r["cut_ins_missed"] == 0 and r["cut_in_leads_s"] == [pytest.approx(1.5)]
+    # one that stays in the ego lane in the estimate while the car never crosses is still a false warning
+    frames = []
+    for gt, est in cut_in_run(vehicle, truth, lambda t: t >= 1.1, seconds=8.0, cross=False):
+        if gt.time_s >= 2.45:
+            est = [replace(n, lane=0, lateral_m=n.lateral_m + 4.0, cut_in=False, time_to_cross_s=None) for n in est]
+        frames.append((gt, est))
+    assert run(frames)["false_warnings"] == 1
+
+
 def test_a_cut_in_never_warned_scores_no_lead_and_is_missed(vehicle, truth):
     for warned in (lambda t: False, lambda t: 0.5 <= t <= 1.0, lambda t: t >= 2.6):
         r = run(cut_in_run(vehicle, truth, warned))
