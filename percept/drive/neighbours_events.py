@@ -33,9 +33,6 @@ crossed sooner after it came into view (a car already moving over as the run beg
 CROSSED_FIRST_S = 1.0
 """A warning run goes on for up to this long after its track has crossed into the ego lane in the estimate (the flag
 ends there: the car is now a lead) while the true car has not yet [s]."""
-CAR_HALF_WIDTH_M = 1.0
-"""Half a car's width (highway-env's Vehicle.WIDTH / 2): a car whose centre is this far beyond the ego lane's boundary
-is clear of the lane [m]."""
 COLLISION_WINDOW_S = 1.0
 """Lateral speeds before a collision are averaged over this [s]."""
 LATERAL_MOVE_MPS = 0.3
@@ -71,18 +68,18 @@ class CutInEvents:
         self._clear: set = set()  # vehicles clear of the ego lane since they were last in it
         self._in_lane: dict = {}  # track id -> when its warning run's track came into the ego lane (estimate) [s]
 
-    def update(self, time_s: float, lane_index, truth: dict, tracks, matched: dict, width_m: float) -> None:
-        """One frame: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated ``Neighbour``s;
-        ``matched`` track id -> vehicle id; ``width_m`` the true ego lane's width [m]. When the ego's own lane changes
-        (the lane id of ``lane_index``; the road's segment changes at every node), the relative lanes jump: no
-        crossing."""
+    def update(self, gt, truth: dict, tracks, matched: dict) -> None:
+        """One frame of ground truth ``gt``: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated
+        ``Neighbour``s; ``matched`` track id -> vehicle id. When the ego's own lane changes (the lane id of its lane
+        index; the road's segment changes at every node), the relative lanes jump: no crossing."""
+        time_s = gt.time_s
         # into the ego lane anywhere (a warning for any of them is justified); ahead within CUT_IN_GAP_M: cut-ins
-        lane_id = lane_index[-1]
+        lane_id = gt.lane.lane_index[-1]
         entered = [] if lane_id != self._lane_id else [
             v for v, n in truth.items() if n.lane == 0 and self._lanes.get(v) in (-1, 1)]
         crossed = [v for v in entered if truth[v].zone is Zone.AHEAD and truth[v].gap_m <= CUT_IN_GAP_M
                    and v in self._clear]
-        self._follow_clear(truth, width_m)
+        self._follow_clear(gt, truth)
         self.crossings += len(crossed)
         for v, n in truth.items():
             if n.camera is not None:
@@ -98,11 +95,13 @@ class CutInEvents:
         self._lane_id = lane_id
         self._matched = dict(matched)
 
-    def _follow_clear(self, truth: dict, width_m: float) -> None:
-        """Which vehicles are clear of the ego lane since they were last in it."""
+    def _follow_clear(self, gt, truth: dict) -> None:
+        """Which vehicles are clear of the ego lane since they were last in it (all of their width beyond it)."""
+        w = gt.lane.width_m
+        car_width = {o.obj_id: float(o.size_m[1]) for o in gt.objects}
         for v, n in truth.items():
             # clear: |l_ego| >= w/2 + W/2, l_ego = lane w + l its offset from the ego lane's centre line
-            if abs(n.lane * width_m + n.lateral_m) >= width_m / 2 + CAR_HALF_WIDTH_M:
+            if abs(n.lane * w + n.lateral_m) >= (w + car_width[v]) / 2:
                 self._clear.add(v)
             elif n.lane == 0:
                 self._clear.discard(v)
@@ -122,10 +121,9 @@ class CutInEvents:
         is flagged, and for CROSSED_FIRST_S once its track is in the ego lane (the estimate may see the car cross a
         frame or two before the truth does)."""
         warning = {n.track_id for n in tracks if n.cut_in}
-        in_lane = {n.track_id for n in tracks if n.lane == 0} & self._since.keys()
-        for t in in_lane - warning:
-            self._in_lane.setdefault(t, time_s)
-        self._in_lane = {t: s for t, s in self._in_lane.items() if t in in_lane - warning}
+        # runs whose track the estimate already has in the ego lane: since when
+        crossed = ({n.track_id for n in tracks if n.lane == 0} & self._since.keys()) - warning
+        self._in_lane = {t: self._in_lane.get(t, time_s) for t in crossed}
         warning |= {t for t, s in self._in_lane.items() if time_s - s <= CROSSED_FIRST_S}
         for t in sorted(warning - self._since.keys()):
             self._since[t] = time_s

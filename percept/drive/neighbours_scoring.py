@@ -125,8 +125,7 @@ class NeighbourScorer:
         if self.ctx.vision:
             self._score_pairs(tracks, truth, pairs)
         matched = {tracks[i].track_id: truth[j].track_id for i, j in pairs}
-        self.cut_ins.update(gt.time_s, gt.lane.lane_index, {n.track_id: n for n in truth}, tracks, matched,
-                            gt.lane.width_m)
+        self.cut_ins.update(gt, {n.track_id: n for n in truth}, tracks, matched)
         self.collisions.update(gt)
 
     def _score_pairs(self, tracks, truth, pairs) -> None:

@@ -129,7 +129,10 @@ def in_frame_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:
     inside = (np.maximum(np.minimum(u1, camera.width) - np.maximum(u0, 0.0), 0.0)
               * np.maximum(np.minimum(v1, camera.height) - np.maximum(v0, 0.0), 0.0))
     ok = ~behind & ~(area <= 0)
-    return np.where(ok, inside / np.where(ok, area, 1.0), _angle_share(camera, points_c))
+    share = inside / np.where(ok, area, 1.0)
+    if not ok.all():
+        share[~ok] = _angle_share(camera, points_c[~ok])
+    return share
 
 
 def _angle_share(camera: PinholeCamera, points_c: np.ndarray) -> np.ndarray:

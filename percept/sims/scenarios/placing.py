@@ -89,23 +89,26 @@ def people_paced(cls: type) -> type:
 
 def drive_like_people(v) -> None:
     """Give a lane-changing car the steering time constants ``LANE_CHANGE_TAU_LATERAL_S`` and
-    ``LANE_CHANGE_TAU_HEADING_S`` (highway-env's controller reads its gains from the vehicle); its class should be
-    ``people_paced``."""
+    ``LANE_CHANGE_TAU_HEADING_S`` (highway-env's controller reads its gains from the vehicle); ``place_idm`` gives it
+    a ``people_paced`` class too."""
     # KP = 1 / tau
     v.KP_LATERAL = 1.0 / LANE_CHANGE_TAU_LATERAL_S
     v.KP_HEADING = 1.0 / LANE_CHANGE_TAU_HEADING_S
 
 
-def place_idm(road, idx, s: float, speed: float, cls=IDMVehicle, lane_change: bool = False, **kw):
+def place_idm(road, idx, s: float, speed: float, cls=IDMVehicle, lane_change: bool = False,
+              paced: bool | None = None, **kw):
     """A vehicle of class ``cls`` (highway-env's IDMVehicle or a subclass) on lane ``idx`` at longitudinal s [m],
-    driving at ``speed`` [m/s], which is also its target speed; lane_change: MOBIL lane changes on, at a driver's
-    pace (``people_paced``, ``drive_like_people``)."""
+    driving at ``speed`` [m/s], which is also its target speed; lane_change: MOBIL lane changes on; paced: it changes
+    lanes at a driver's pace (``people_paced``, ``drive_like_people``; by default when ``lane_change``, and for a car
+    whose own script turns its lane changes on later)."""
     lane = road.network.get_lane(idx)
-    cls = people_paced(cls) if lane_change else cls
+    paced = lane_change if paced is None else paced
+    cls = people_paced(cls) if paced else cls
     v = cls(road, lane.position(s, 0.0), lane.heading_at(s), speed, target_lane_index=idx, target_speed=speed,
             **kw)
     v.enable_lane_change = lane_change
-    if lane_change:
+    if paced:
         drive_like_people(v)
     if isinstance(v, LinearVehicle):
         v.collecting_data = False  # its regression data would grow every step and is never read

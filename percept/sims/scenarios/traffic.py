@@ -14,7 +14,7 @@ from highway_env.road.road import Road
 from highway_env.vehicle.behavior import AggressiveVehicle, DefensiveVehicle, IDMVehicle, LinearVehicle
 
 from ..actors import LaneEnd, ScriptedVehicle
-from .placing import drive_like_people, new_road, people_paced, place_idm, place_traffic
+from .placing import new_road, place_idm, place_traffic
 from .roads import merge_road, straight_road
 
 HIGHWAY_V0_SPACING = np.exp(-5 / 40 * 4)
@@ -46,7 +46,8 @@ def highway_v0_traffic(road, rng, lanes: int, s0: float, count: int, speeds: tup
         if lane == keep_clear[0] and keep_clear[1] <= s <= keep_clear[2]:
             continue
         v = place_idm(road, ("0", "1", lane), s, speed, cls=_mixed_class(rng), lane_change=True)
-        if not isinstance(v, LinearVehicle):  # highway-v0 draws each IDM's acceleration exponent (the Linear ones keep theirs)
+        # highway-v0 draws each IDM's acceleration exponent (the Linear ones keep theirs)
+        if not isinstance(v, LinearVehicle):
             v.randomize_behavior()
         count -= 1
 
@@ -110,10 +111,8 @@ def build_merge(env, rng) -> Road:
     v = float(rng.uniform(28.0, 30.0))
     s_first = x_join - v * t_join - (MERGE_LEAD_IN_M - MERGE_RAMP_M)
     for s, speed_r in ((s_first, v), (s_first - float(rng.uniform(60.0, 80.0)), float(rng.uniform(26.5, 27.5)))):
-        car = place_idm(road, ("0", "1", 2), s, speed_r, cls=people_paced(ScriptedVehicle),
-                        merge_road=("2", "3"))
+        car = place_idm(road, ("0", "1", 2), s, speed_r, cls=ScriptedVehicle, paced=True, merge_road=("2", "3"))
         car.LANE_CHANGE_MAX_BRAKING_IMPOSED = RAMP_B_SAFE_MPS2
-        drive_like_people(car)
     road.objects.append(LaneEnd(road, net.get_lane(("2", "3", 2)).position(MERGE_LANE_M, 0.0)))
     place_traffic(road, rng, [0], ego_s - 150.0, ego_s + 500.0, 6, (24.0, 29.0), [], lane_change=True)
     place_traffic(road, rng, [1], ego_s + 220.0, ego_s + 500.0, 2, (25.0, 28.0), [], lane_change=True)
