@@ -47,6 +47,8 @@ class ClusterConfig:
     side_reach_m: float = 20.0  # a side is seen alone only this near the ego [m]
     side_sigma_x_m: float = 2.0  # the along-lane 1-sigma of a side seen alone: one end is where the image ends [m]
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
+    max_width_m: float = 3.0  # a group or face wider than this is no one vehicle: rain streaks or noise matched by
+    # chance across the image, or cars run together [m]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
     min_top_m: float = 1.0  # and, beyond side_reach_m, up to this height (a guard rail, 0.45-0.77 m, does not) [m]
 
@@ -66,11 +68,21 @@ class Detection:
     sigma_lat_m: float = 0.0  # 1-sigma of lat_m from the face's edges' pixel noise at its range [m]
 
 
-class FaceRange(Protocol):
-    """Measures a face: (the points, the indices of the face's points) -> (its along-lane position [m], its 1-sigma
-    [m]), or None when it cannot be measured."""
+@dataclass(frozen=True)
+class Face:
+    """A face measured at its refined range."""
 
-    def __call__(self, pts: StandingPoints, idx: np.ndarray) -> tuple[float, float] | None: ...
+    x_m: float  # its along-lane position [m]
+    sigma_x_m: float  # 1-sigma of x_m [m]
+    lat_m: tuple[float, float] | None  # its lateral extent (low, high) from the ego lane's centre line, from the
+    # group's points at the face's range lifted at that range; None when too few are [m]
+
+
+class FaceRange(Protocol):
+    """Measures a face: (the points, the indices of the face's points, the indices of its whole group) -> its
+    ``Face``, or None when it cannot be measured."""
+
+    def __call__(self, pts: StandingPoints, idx: np.ndarray, group: np.ndarray) -> Face | None: ...
 
 
 def lane_coordinates(pts: StandingPoints, lane: LaneEstimate | None) -> tuple[np.ndarray, np.ndarray, float]:
@@ -132,7 +144,7 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     if side is not None:
         return side
     l0, l1 = np.quantile(lat, [0.05, 0.95])
-    if l1 - l0 < cfg.min_width_m:
+    if not cfg.min_width_m <= l1 - l0 <= cfg.max_width_m:
         return None
     beside = abs(0.5 * (l0 + l1)) > 0.5 * width
     # the inner edge is the one nearer the ego lane's centre line; the outer one is the face's
@@ -140,13 +152,16 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     face = sign * (lat - inner) > cfg.side_m if beside else np.ones(len(lat), bool)
     if face.sum() < cfg.min_group_points:
         face = np.ones(len(lat), bool)
-    measured = face_range(pts, idx[face])
+    measured = face_range(pts, idx[face], idx)
     if measured is None:
         return None
-    fx, sigma = measured
-    outer = np.quantile(lat[face], 0.95 if sign > 0 else 0.05)
+    fx, sigma = measured.x_m, measured.sigma_x_m
+    if measured.lat_m is not None:
+        inner, outer = measured.lat_m if sign > 0 else measured.lat_m[::-1]
+    else:
+        outer = np.quantile(lat[face], 0.95 if sign > 0 else 0.05)
     centre_lat = float(0.5 * (inner + outer))
-    if abs(centre_lat) > 1.5 * width:
+    if abs(centre_lat) > 1.5 * width or abs(outer - inner) > cfg.max_width_m:
         return None
     u, v = pts.u[idx], pts.v[idx]
     box = (int(u.min()), int(v.min()), int(u.max()) + 1, int(v.max()) + 1)
@@ -164,7 +179,7 @@ def _side_view(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndar
             or np.mean(np.abs(lat - mid) <= cfg.side_band_m) < cfg.side_share):
         return None
     on_side = np.abs(lat - mid) <= cfg.side_band_m
-    measured = face_range(pts, idx[on_side])
+    measured = face_range(pts, idx[on_side], idx[on_side])
     if measured is None:
         return None
     centre_lat = mid + float(np.sign(mid)) * VEHICLE_WIDTH_M / 2
@@ -172,5 +187,5 @@ def _side_view(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndar
         return None
     u, v = pts.u[idx[on_side]], pts.v[idx[on_side]]
     box = (int(u.min()), int(v.min()), int(u.max()) + 1, int(v.max()) + 1)
-    return Detection(measured[0], centre_lat, measured[0], 0.0, box, int(on_side.sum()), cfg.side_sigma_x_m,
+    return Detection(measured.x_m, centre_lat, measured.x_m, 0.0, box, int(on_side.sum()), cfg.side_sigma_x_m,
                      cut_off=True)

@@ -5,9 +5,10 @@ Each frame each rig's vehicles are found (``finder``: band stereo, ground-grid g
 the ego lane's coordinates, tracked (``tracker``), and each confirmed track reported with its lane, gap, relative
 speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside whose lateral
 speed (beyond ``speed_sigmas`` of its estimate) takes its centre to the ego lane's boundary within ``horizon_s``, and
-which was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row: a car changing into
-it from the lane beyond is not cutting in to the ego's), is flagged as cutting in, with the predicted
-time to that crossing, so the following law can treat it as a lead before it arrives.
+which was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row since it was
+laterally still there: a car changing into it from the lane beyond, or a ramp's car arriving in the acceleration lane,
+is not cutting in to the ego's), is flagged as cutting in, with the predicted time to that crossing, so the following
+law can treat it as a lead before it arrives.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ class NeighbourConfig:
     rear_near_m: float = -3.0  # the nearest face the rear rig measures [m]
     horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]
     min_lateral_speed_mps: float = 0.3  # and the lateral speed towards it at least this [m/s]
-    speed_sigmas: float = 3.0  # and at least this many sigmas of its estimate [-]
+    speed_sigmas: float = 2.0  # and at least this many sigmas of its estimate [-]
     min_shift_m: float = 0.25  # and it has moved at least this from its lane's centre towards the ego lane [m]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
 
@@ -82,10 +83,10 @@ class NeighbourSlot:
     def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float
                 ) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
-        track, settled in its lane and not cut off by the image's edge, moves towards the ego lane faster than both
-        ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's centre by
-        ``min_shift_m`` towards it and will reach the boundary within ``horizon_s``; it holds while the car stays
-        shifted that way and does not move back (a merging car may pause on the line)."""
+        track, settled in its lane, measured this frame and not cut off by the image's edge, moves towards the ego
+        lane faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's
+        centre by ``min_shift_m`` towards it and will reach the boundary within ``horizon_s``; it holds while the car
+        stays shifted that way and does not move back (a merging car may pause on the line)."""
         c = self.cfg
         # towards the ego lane: -sign(l) l' > 0; shift from its lane's centre towards it: -sign(l) (l - lane w)
         toward = -math.copysign(1.0, lat) * vl

@@ -38,7 +38,10 @@ class TrackerConfig:
     fringe_m: float = 10.0  # beyond each end of the band, where a rig sees a car beside only in part (cut off by the
     # image's edge): an established track there heading for the band coasts unseen instead of counting misses [m]
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
-    min_settled: int = 10  # detections in a row in one lane that make a track a settled neighbour there [-]
+    min_settled: int = 10  # detections in a row in one lane, since the track was laterally still in it, that make it
+    # a settled neighbour there (a car still moving over from the lane beyond is not) [-]
+    still_mps: float = 0.3  # a track is laterally still when its lateral speed and that speed's 1-sigma are both
+    # below this [m/s]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
 
 
@@ -57,7 +60,8 @@ class Track:
     confirmed: bool = False
     cut_off: bool = False  # its last detection was cut off by the image's edge
     lane: int | None = None  # the lane its centre was in at its last detection (-1, 0, +1 ...)
-    settled: int = 0  # detections in a row in that lane
+    settled: int = 0  # detections in a row in that lane since it was laterally still there
+    still: bool = False  # it has been laterally still in that lane
     warning: bool = False  # flagged as cutting in at the last report
 
     @property
@@ -140,7 +144,10 @@ class NeighbourTracker:
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
             # its lane: round(l / w)
             lane = int(round(t.lat / self.width))
-            t.settled = t.settled + 1 if lane == t.lane else 1
+            # still: |l'| and its 1-sigma both under still_mps (a new track's l' = 0 is not yet known)
+            t.still = lane == t.lane and t.still or (abs(float(t.kf.x[3, 0])) < c.still_mps
+                                                    and float(t.kf.P[3, 3]) < c.still_mps ** 2)
+            t.settled = t.settled + 1 if lane == t.lane and t.still else int(t.still)
             t.lane = lane
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
         for j, d in enumerate(dets):

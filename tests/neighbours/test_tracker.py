@@ -95,16 +95,38 @@ def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
     assert NeighbourConfig().horizon_s >= 1.0
 
 
+def test_a_car_coming_over_from_the_lane_beyond_is_not_cutting_in():
+    slot = NeighbourSlot(StereoRig(), None, DT)
+    # 30 m ahead two lanes to the left, moving right at 1 m/s into the next lane and half a metre past its centre (a
+    # ramp's car arriving in the acceleration lane), then keeping there
+    lat = [1.6 * W - 1.0 * k * DT for k in range(int((0.6 * W + 0.5) / DT))]
+    lat += [lat[-1]] * 45
+    slot.front = _FakeFinder([det(32.0, y) for y in lat])
+    frame = type("F", (), {"dropped": False, "has_rear": False, "left_gray": None, "right_gray": None})()
+    for _ in lat:
+        nb, _ = slot.step(frame, {EgoPath: EgoPath.straight(25.0)})
+        assert nb.cutting_in() is None
+    # it is a settled neighbour in its lane once it has kept still there
+    (track,) = slot.tracker.tracks
+    assert track.lane == 1 and track.settled >= TrackerConfig().min_settled
+
+
 def test_a_face_far_away_is_placed_less_surely_across_the_lane():
+    from percept.neighbours.clusters import VEHICLE_WIDTH_M
     from percept.neighbours.finder import EDGE_SIGMA_PX, RigFinder
 
     rig = StereoRig()
     finder = RigFinder(rig, 3.0, 90.0)
-    near, far = finder.lateral_sigma(det(12.5, W)), finder.lateral_sigma(det(62.5, W))
+    whole = lambda x: replace(det(x, W), width_m=VEHICLE_WIDTH_M)
+    near, far = finder.lateral_sigma(whole(12.5)), finder.lateral_sigma(whole(62.5))
     # sigma_l = Z sigma_u / f, Z the face's range from the camera
     cam_x = float(rig.camera_position()[0])
-    assert far.sigma_lat_m == pytest.approx((60.0 - cam_x) * EDGE_SIGMA_PX / rig.camera.fx)
+    edges = (60.0 - cam_x) * EDGE_SIGMA_PX / rig.camera.fx
+    assert far.sigma_lat_m == pytest.approx(edges)
     assert near.sigma_lat_m < far.sigma_lat_m
+    # a face seen over half its width: the half it lacks, (W_v - w) / 2, in quadrature
+    half = finder.lateral_sigma(replace(det(62.5, W), width_m=VEHICLE_WIDTH_M / 2))
+    assert half.sigma_lat_m == pytest.approx(np.hypot(edges, VEHICLE_WIDTH_M / 4))
 
 
 def test_a_lone_sideways_jump_of_a_face_barely_moves_the_track():
