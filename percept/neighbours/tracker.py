@@ -40,8 +40,7 @@ class TrackerConfig:
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
     min_settled: int = 10  # detections in a row in one lane, since the track was laterally still in it, that make it
     # a settled neighbour there (a car still moving over from the lane beyond is not) [-]
-    still_mps: float = 0.3  # a track is laterally still when its lateral speed and that speed's 1-sigma are both
-    # below this [m/s]
+    still_mps: float = 0.3  # a track is laterally still when its lateral speed is below this [m/s]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
 
 
@@ -144,9 +143,7 @@ class NeighbourTracker:
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
             # its lane: round(l / w)
             lane = int(round(t.lat / self.width))
-            # still: |l'| and its 1-sigma both under still_mps (a new track's l' = 0 is not yet known)
-            t.still = lane == t.lane and t.still or (abs(float(t.kf.x[3, 0])) < c.still_mps
-                                                    and float(t.kf.P[3, 3]) < c.still_mps ** 2)
+            t.still = lane == t.lane and t.still or abs(float(t.kf.x[3, 0])) < c.still_mps
             t.settled = t.settled + 1 if lane == t.lane and t.still else int(t.still)
             t.lane = lane
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
