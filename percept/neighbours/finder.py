@@ -53,12 +53,23 @@ class RigFinder:
         found = find_vehicles(pts, lane, self.x_lo, self.x_hi, self.face_range, self.clusters,
                               self.rig.mount_height_m)
         found = [self.cut_off(d) for d in found]
-        return [self.lateral_sigma(self.occluded(d, found)) for d in found], pts
+        shadows = [self.shadow(d) for d in found]
+        return [self.lateral_sigma(self.occluded(d, shadows)) for d in found], pts
 
-    def occluded(self, det: Detection, found: list[Detection]) -> Detection:
+    def shadow(self, det: Detection) -> tuple[float, float, float]:
+        """(range of its face along the lane [m], least and greatest bearing [-]) of the corners of a detected car's
+        footprint, a whole car's width at least: its face and its length away from the rig, as the rig sees them,
+        widened by ``OCCLUSION_PX``."""
+        w = max(det.width_m, VEHICLE_WIDTH_M)
+        away = math.copysign(VEHICLE_LENGTH_M, det.face_x_m - self.cam_x)
+        b = [self._bearing(det.face_x_m + a, det.lat_m + s * w / 2) for s in (-1, 1) for a in (0.0, away)]
+        tol = OCCLUSION_PX / self.rig.camera.fx
+        return abs(det.face_x_m), min(b) - tol, max(b) + tol
+
+    def occluded(self, det: Detection, shadows: list[tuple[float, float, float]]) -> Detection:
         """``det`` with its lateral centre put half a car's width beyond its free edge when its face is narrower than
-        a whole one and a nearer car in ``found`` hides, as the rig sees it, at least ``HIDDEN_SHARE`` of what the
-        rest of a whole car's face would span beyond its other edge, and more than beyond the free one (a car seen
+        a whole one and a nearer car (``shadows``: each detection's ``shadow``) hides, as the rig sees it, at least
+        ``HIDDEN_SHARE`` of what the rest of a whole car's face would span beyond its other edge, and more than beyond the free one (a car seen
         past another shows only the part the nearer one leaves, and a dark face's points are only at its edges: the
         middle of the part seen is off by up to half a car's width)."""
         if det.cut_off or det.width_m >= FULL_FACE_M:
@@ -67,16 +78,10 @@ class RigFinder:
         # where the face would end on each side, were it a whole car's width with its other edge where it is seen
         lo_whole, hi_whole = (self._bearing(det.face_x_m, det.lat_m - s * (det.width_m / 2 - VEHICLE_WIDTH_M))
                               for s in (-1, 1))
-        tol = OCCLUSION_PX / self.rig.camera.fx
         hidden_lo = hidden_hi = 0.0
-        for o in found:
-            if abs(o.face_x_m) >= abs(det.face_x_m):
+        for near, b0, b1 in shadows:
+            if near >= abs(det.face_x_m):
                 continue
-            # the corners of the nearer car's footprint, a whole car's width: its face and its length away from the rig
-            w = max(o.width_m, VEHICLE_WIDTH_M)
-            away = math.copysign(VEHICLE_LENGTH_M, o.face_x_m - self.cam_x)
-            b = [self._bearing(o.face_x_m + a, o.lat_m + s * w / 2) for s in (-1, 1) for a in (0.0, away)]
-            b0, b1 = min(b) - tol, max(b) + tol
             # the share of what a whole car's face would span beyond each edge that the nearer car hides
             hidden_lo = max(hidden_lo, max(min(b1, lo) - max(b0, lo_whole), 0.0) / max(lo - lo_whole, 1e-9))
             hidden_hi = max(hidden_hi, max(min(b1, hi_whole) - max(b0, hi), 0.0) / max(hi_whole - hi, 1e-9))

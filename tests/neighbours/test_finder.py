@@ -24,13 +24,14 @@ def test_a_car_seen_past_a_nearer_one_is_centred_from_its_free_edge():
     # 0.6 m is seen, from its inner edge W - W_v / 2
     inner = W - VEHICLE_WIDTH_M / 2
     far, near = face(40.0, inner + 0.3, 0.6), face(25.0, W, VEHICLE_WIDTH_M)
-    placed = finder.occluded(far, [near, far])
+    shadows = lambda *dets: [finder.shadow(d) for d in dets]
+    placed = finder.occluded(far, shadows(near, far))
     # centre = the free (inner) edge + W_v / 2
     assert placed.lat_m == pytest.approx(W)
     # nothing nearer: the part seen stays where it is; a whole face is never moved
-    assert finder.occluded(far, [far]).lat_m == far.lat_m
+    assert finder.occluded(far, shadows(far)).lat_m == far.lat_m
     whole = face(40.0, W, VEHICLE_WIDTH_M)
-    assert finder.occluded(whole, [near, whole]) is whole
+    assert finder.occluded(whole, shadows(near, whole)) is whole
 
 
 def _slab(x: float, y0: float, y1: float) -> StandingPoints:
