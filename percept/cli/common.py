@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import os
 import re
 import signal
 import sys
@@ -280,4 +281,15 @@ def run_cli(app: Callable[..., None]) -> None:
             err.print(escape(_interrupt_line()), style="yellow", highlight=False, soft_wrap=True)
             code = 128 + int(_interrupt["signal"])
         restore()
+    if _streams_abandoned():  # nothing else is left to finish: end without the finalisers that would wait for good
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code if isinstance(code, int) else int(code is not None))
     sys.exit(code)
+
+
+def _streams_abandoned() -> bool:
+    """Whether a recording was given up on a full disk (``percept.review.recorder.ABANDONED``); looked up only if
+    the recorder was imported, so that commands without one do not load Rerun."""
+    recorder = sys.modules.get("percept.review.recorder")
+    return recorder is not None and bool(recorder.ABANDONED)

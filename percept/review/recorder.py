@@ -58,6 +58,9 @@ FLUSH_TIMEOUT_S = 30.0
 """Longest wait for the stream's last chunks to reach the disk when the run ends [s]."""
 WATCH_S = 1.0
 """Wall time between two looks at the free space of the recording's disk [s]."""
+ABANDONED: list[rr.RecordingStream] = []
+"""Streams given up on a full disk (``RunRecorder._drop``), kept from their finaliser for as long as the process
+lives."""
 
 
 def resolve_part(spec):
@@ -209,8 +212,12 @@ class RunRecorder:
 
     def _drop(self) -> None:
         """Abandon the stream without flushing or disconnecting it (either, into a full disk, can block for good):
-        the part file is removed, and its space comes back once Rerun's writer lets go of it."""
+        the part file is removed, and its space comes back once Rerun's writer lets go of it. The stream is held in
+        ``ABANDONED`` and Rerun's exit hook withdrawn: both its finaliser and that hook flush and wait for a writer
+        that never returns, so the command line ends the process without them (``cli.common.run_cli``)."""
         self.tmp.unlink(missing_ok=True)
+        ABANDONED.append(self.rec)
+        rr.unregister_shutdown()
 
     def _log_objects(self, objects, image: bool, rear: bool) -> None:
         """True boxes: 3D in the vehicle frame (under the ego's transform) and, on each image stored this frame (the
