@@ -35,6 +35,9 @@ class NeighbourConfig:
     min_lateral_speed_mps: float = 0.3  # and the lateral speed towards it at least this [m/s]
     speed_sigmas: float = 2.0  # and at least this many sigmas of its estimate [-]
     min_shift_m: float = 0.25  # and it has moved at least this from its lane's centre towards the ego lane [m]
+    min_seen_share: float = 0.5  # and a rig found it on at least this share of the last TrackerConfig.recent_s (a
+    # car in view is found on nearly every frame; stereo's phantoms, from edges on the road or a guard rail, come
+    # and go) [-]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
 
 
@@ -83,10 +86,11 @@ class NeighbourSlot:
     def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float
                 ) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
-        track, settled in its lane, measured this frame and not cut off by the image's edge, moves towards the ego
-        lane faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's
-        centre by ``min_shift_m`` towards it and will reach the boundary within ``horizon_s``; it holds while the car
-        stays shifted that way and does not move back (a merging car may pause on the line)."""
+        track, settled in its lane, measured this frame (not cut off by the image's edge) and on ``min_seen_share``
+        of the recent ones, moves towards the ego lane faster than both ``min_lateral_speed_mps`` and
+        ``speed_sigmas`` as a rig measures it, has left its lane's centre by ``min_shift_m`` towards it and will reach
+        the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back (a
+        merging car may pause on the line)."""
         c = self.cfg
         # towards the ego lane: -sign(l) l' > 0; shift from its lane's centre towards it: -sign(l) (l - lane w)
         toward = -math.copysign(1.0, lat) * vl
@@ -95,6 +99,7 @@ class NeighbourSlot:
             holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
         else:
             holds = (t.settled >= self.tracker.cfg.min_settled and t.camera is not None and not t.cut_off
+                     and t.seen >= c.min_seen_share * self.tracker.recent_frames
                      and shift >= c.min_shift_m
                      and toward > max(c.min_lateral_speed_mps, c.speed_sigmas * sig_vl))
         if not holds:

@@ -42,6 +42,7 @@ class TrackerConfig:
     # a settled neighbour there (a car still moving over from the lane beyond is not) [-]
     still_mps: float = 0.3  # a track is laterally still when its lateral speed is below this [m/s]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
+    recent_s: float = 1.0  # the window over which a track's detections are counted (Track.seen) [s]
 
 
 @dataclass
@@ -62,6 +63,7 @@ class Track:
     settled: int = 0  # detections in a row in that lane since it was laterally still there
     still: bool = False  # it has been laterally still in that lane
     warning: bool = False  # flagged as cutting in at the last report
+    seen_bits: int = 1  # one bit a frame, the newest lowest: whether a rig found it (the last TrackerConfig.recent_s)
 
     @property
     def x(self) -> float:
@@ -70,6 +72,11 @@ class Track:
     @property
     def lat(self) -> float:
         return float(self.kf.x[2, 0])
+
+    @property
+    def seen(self) -> int:
+        """On how many of the last ``TrackerConfig.recent_s`` of frames a rig found it."""
+        return self.seen_bits.bit_count()
 
 
 class NeighbourTracker:
@@ -101,6 +108,11 @@ class NeighbourTracker:
         kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, sigma_l2, 1.0 ** 2])
         return kf
 
+    @property
+    def recent_frames(self) -> int:
+        """How many frames ``TrackerConfig.recent_s`` spans (``Track.seen`` counts over them)."""
+        return max(round(self.cfg.recent_s / self.dt), 1)
+
     def in_blind_band(self, x_m: float, lat_m: float, width_m: float) -> bool:
         """Whether a centre at (x_m, lat_m) lies where neither rig sees: beside the ego in a lane beside it."""
         return self.cfg.blind_behind_m <= x_m <= self.cfg.blind_ahead_m and abs(lat_m) >= 0.5 * width_m
@@ -108,9 +120,11 @@ class NeighbourTracker:
     def step(self, detections: dict[str, list[Detection]], width_m: float) -> None:
         """One frame: predict every track, associate each rig's detections (``detections``: rig name -> its
         detections), make new tracks, keep the blind band's tracks and drop the lost ones."""
+        window = (1 << self.recent_frames) - 1
         for t in self.tracks:
             t.kf.predict()
             t.camera, t.box_px = None, None
+            t.seen_bits = (t.seen_bits << 1) & window
         self.width = width_m
         for rig, dets in detections.items():
             self._associate(rig, dets)
@@ -135,6 +149,7 @@ class NeighbourTracker:
             t, d = self.tracks[i], dets[j]
             t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=self._noise(t, d))
             t.hits, t.misses = t.hits + 1, 0
+            t.seen_bits |= 1
             # a held track leaves the band once a rig has seen it confirm_hits times in a row: a lone detection of
             # something else does not carry it off (the next unseen frame puts it back in the band)
             t.takeover = t.takeover + 1 if t.blind_s > 0 else 0
