@@ -72,6 +72,7 @@ class EvalPlan:
     detector: str = "sim"  # people model of the vision pedestrian slot
     default: Source = Source.VISION  # the source of a task not in slots (as in DriveConfig)
     rear: bool | None = None  # the rear stereo rig: True on, False off, None each scenario's default (DriveConfig.rear)
+    lane_changes: bool = True  # the car changes lanes (DriveConfig.lane_changes)
 
     def __post_init__(self) -> None:
         if not self.scenarios or not self.conditions or not self.seeds:
@@ -84,7 +85,8 @@ class EvalPlan:
     def config(self, job: Job) -> DriveConfig:
         """The drive configuration of one job."""
         return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
-                           dict(self.slots), detector=self.detector, default=self.default, rear=self.rear)
+                           dict(self.slots), detector=self.detector, default=self.default, rear=self.rear,
+                           lane_changes=self.lane_changes)
 
     @property
     def tasks(self) -> tuple:

@@ -58,6 +58,8 @@ def reproduce_command(run: dict, settings: dict) -> str:
         cmd.append(f"--detector {settings['detector']}")
     if settings.get("rear") is not None:
         cmd.append("--rear" if settings["rear"] else "--no-rear")
+    if settings.get("lane_changes") is False:
+        cmd.append("--lane-changes off")
     return " ".join(cmd)
 
 

@@ -77,7 +77,7 @@ class LaneDetector:
             fresh = fit_lane(ev, None, self.cfg.fit)
             if fresh is not None and (fit is None or fresh.estimate.confidence > fit.estimate.confidence):
                 fit = fresh
-                self.tracker.reset()
+                self.tracker.reset(index=self.tracker.index)
         if fit is not None:
             self.tracker.update(fit)
         return self.tracker.estimate, LaneDebug(ev, fit)

@@ -1,0 +1,105 @@
+"""Progress and lane changes against ground truth: the run JSON's ``progress`` and ``lane_changes`` groups.
+
+Progress is the mean true speed, its ratio to the set speed, and the distance driven. A lane change is started,
+completed or aborted as the lane-change law's debug record says. It is **unsafe** when, on the frame the ego's true
+lane changes during a commanded change, the new follower would have to brake harder than ``UNSAFE_BRAKING_MPS2``
+by highway-env's IDM (its own ``IDMVehicle`` parameters; the follower taken to want its own speed, so that only the
+ego's arrival brakes it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under
+``UNSAFE_TIME_GAP_S`` at the ego's speed. Peak lateral acceleration and jerk are the true ones (the IMU's lateral
+axis without noise) over the frames of a change.
+"""
+
+from __future__ import annotations
+
+import math
+
+from highway_env.vehicle.behavior import IDMVehicle
+from highway_env.vehicle.kinematics import Vehicle
+
+from percept.sensors import Zone
+
+from .neighbours_truth import truth_neighbours
+
+UNSAFE_BRAKING_MPS2 = 2.0
+"""A change that makes its new follower brake harder than this is unsafe [m/s²]."""
+UNSAFE_TIME_GAP_S = 0.5
+"""A change that leaves a gap ahead or behind shorter than this at the ego's speed is unsafe [s]."""
+
+
+def imposed_braking(follower_speed_mps: float, gap_m: float, closing_mps: float) -> float:
+    """The acceleration [m/s²] highway-env's IDM gives a follower at ``follower_speed_mps``, ``gap_m`` (bumper to
+    bumper) behind a car it closes on at ``closing_mps``, wanting its own speed: -a (s* / s)^2 with
+    s* = d0 + v T + v dv / (2 sqrt(a b)) (``IDMVehicle.desired_gap``; its d0 is centre to centre)."""
+    v = follower_speed_mps
+    a, b = IDMVehicle.COMFORT_ACC_MAX, -IDMVehicle.COMFORT_ACC_MIN
+    s_star = IDMVehicle.DISTANCE_WANTED + v * IDMVehicle.TIME_WANTED + v * closing_mps / (2 * math.sqrt(a * b))
+    # highway-env's gap is centre to centre: the bumper gap plus a car's length
+    return -a * (s_star / max(gap_m + Vehicle.LENGTH, 0.1)) ** 2
+
+
+class ProgressScorer:
+    """Mean speed, its ratio to the set speed and the distance driven."""
+
+    def __init__(self, set_speed_mps: float, dt_s: float):
+        self.set_speed, self.dt = set_speed_mps, dt_s
+        self.speeds: list[float] = []
+
+    def update(self, gt) -> None:
+        self.speeds.append(float(gt.speed_mps))
+
+    def result(self) -> dict:
+        if not self.speeds:
+            return {"mean_speed_mps": None, "set_speed_ratio": None, "distance_m": None}
+        mean = sum(self.speeds) / len(self.speeds)
+        return {"mean_speed_mps": mean, "set_speed_ratio": mean / self.set_speed if self.set_speed > 0 else None,
+                "distance_m": sum(self.speeds) * self.dt}
+
+
+class LaneChangeScorer:
+    """Lane changes started, completed, aborted and unsafe, and the peak lateral acceleration and jerk in them."""
+
+    def __init__(self, dt_s: float):
+        self.dt = dt_s
+        self.counts = {"started": 0, "completed": 0, "aborted": 0, "unsafe": 0}
+        self.crossings: list[dict] = []  # per boundary crossing of a change: the new follower's braking, the gaps
+        self.peak_accel = None  # [m/s²]
+        self.peak_jerk = None  # [m/s³]
+        self._lane = None  # the ego's true lane id on the previous frame
+        self._accel = None  # the lateral acceleration on the previous frame of a change [m/s²]
+
+    def update(self, gt, debug) -> None:
+        """One frame: ``gt`` the ground truth, ``debug`` the lane-change law's record (None: lane changes off)."""
+        lane = gt.lane.lane_index[2]
+        changing = debug is not None and debug.phase.value != "keep"
+        if debug is not None and debug.event in self.counts:
+            self.counts[debug.event] += 1
+        if changing and self._lane is not None and lane != self._lane:
+            self._judge_crossing(gt)
+        self._lane = lane
+        accel = float(gt.imu.accel_mps2[1])
+        if changing:
+            self.peak_accel = max(self.peak_accel or 0.0, abs(accel))
+            if self._accel is not None:
+                jerk = abs(accel - self._accel) / self.dt
+                self.peak_jerk = max(self.peak_jerk or 0.0, jerk)
+        self._accel = accel if changing else None
+
+    def _judge_crossing(self, gt) -> None:
+        """The new lane's follower and gaps on the frame the ego's centre entered it."""
+        v = gt.speed_mps
+        mine = truth_neighbours(gt).in_lane(0)
+        ahead = next((n for n in mine if n.zone is Zone.AHEAD), None)
+        behind = next((n for n in mine if n.zone is Zone.BEHIND), None)
+        braking = None if behind is None else imposed_braking(v + behind.rel_speed_mps, behind.gap_m,
+                                                              behind.rel_speed_mps)
+        short = [g for g in (ahead, behind) if g is not None and g.gap_m < UNSAFE_TIME_GAP_S * v]
+        beside = any(n.zone is Zone.BESIDE for n in mine)
+        unsafe = bool(short) or beside or (braking is not None and braking < -UNSAFE_BRAKING_MPS2)
+        self.counts["unsafe"] += int(unsafe)
+        self.crossings.append({"time_s": round(gt.time_s, 3), "follower_braking_mps2": braking,
+                               "gap_ahead_m": None if ahead is None else ahead.gap_m,
+                               "gap_behind_m": None if behind is None else behind.gap_m, "unsafe": unsafe})
+
+    def result(self) -> dict:
+        return {**self.counts, "peak_lateral_accel_mps2": self.peak_accel, "peak_lateral_jerk_mps3": self.peak_jerk,
+                "crossings": self.crossings}
