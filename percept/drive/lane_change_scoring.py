@@ -1,12 +1,13 @@
 """Progress and lane changes against ground truth: the run JSON's ``progress`` and ``lane_changes`` groups.
 
 Progress is the mean true speed, its ratio to the set speed, and the distance driven. A lane change is started,
-completed or aborted as the lane-change law's debug record says. It is **unsafe** when, on the frame the ego's true
-lane changes during a commanded change, the new follower would have to brake harder than ``UNSAFE_BRAKING_MPS2``
+completed or aborted as the lane-change law's debug record says (null where no law commands the car: lane changes
+off, or highway-env's MOBIL driving it). A change is **unsafe** when, on the frame the ego's true lane changes, the
+new follower would have to brake harder than ``UNSAFE_BRAKING_MPS2``
 by highway-env's IDM (its own ``IDMVehicle`` parameters; the follower taken to want its own speed, so that only the
 ego's arrival brakes it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under
-``UNSAFE_TIME_GAP_S`` at the ego's speed. Peak lateral acceleration and jerk are the true ones (the IMU's lateral
-axis without noise) over the frames of a change.
+``UNSAFE_TIME_GAP_S`` at the ego's speed, or a car is beside the ego in it. Peak lateral acceleration and jerk are
+the true ones (the IMU's lateral axis without noise) over the frames of a commanded change.
 """
 
 from __future__ import annotations
@@ -58,8 +59,9 @@ class ProgressScorer:
 class LaneChangeScorer:
     """Lane changes started, completed, aborted and unsafe, and the peak lateral acceleration and jerk in them."""
 
-    def __init__(self, dt_s: float):
-        self.dt = dt_s
+    def __init__(self, dt_s: float, commanded: bool = True):
+        """dt_s: the frame period [s]; commanded: the lane-change law drives the car's changes (its counts apply)."""
+        self.dt, self.commanded = dt_s, commanded
         self.counts = {"started": 0, "completed": 0, "aborted": 0, "unsafe": 0}
         self.crossings: list[dict] = []  # per boundary crossing of a change: the new follower's braking, the gaps
         self.peak_accel = None  # [m/s²]
@@ -73,7 +75,7 @@ class LaneChangeScorer:
         changing = debug is not None and debug.phase.value != "keep"
         if debug is not None and debug.event in self.counts:
             self.counts[debug.event] += 1
-        if changing and self._lane is not None and lane != self._lane:
+        if self._lane is not None and lane != self._lane:
             self._judge_crossing(gt)
         self._lane = lane
         accel = float(gt.imu.accel_mps2[1])
@@ -101,5 +103,6 @@ class LaneChangeScorer:
                                "gap_behind_m": None if behind is None else behind.gap_m, "unsafe": unsafe})
 
     def result(self) -> dict:
-        return {**self.counts, "peak_lateral_accel_mps2": self.peak_accel, "peak_lateral_jerk_mps3": self.peak_jerk,
-                "crossings": self.crossings}
+        law = {k: self.counts[k] if self.commanded else None for k in ("started", "completed", "aborted")}
+        return {**law, "unsafe": self.counts["unsafe"], "peak_lateral_accel_mps2": self.peak_accel,
+                "peak_lateral_jerk_mps3": self.peak_jerk, "crossings": self.crossings}

@@ -36,7 +36,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
                                              world.crossing_pedestrians, agent.following.time_gap,
                                              rig.camera.fx * rig.baseline_m, cfg.detector))
                for t in cfg.tasks}
-    safety, pace, changes = SafetyScorer(), ProgressScorer(world.cruise_speed_mps, world.dt), LaneChangeScorer(world.dt)
+    safety, pace, changes = SafetyScorer(), ProgressScorer(world.cruise_speed_mps, world.dt), LaneChangeScorer(world.dt, cfg.lane_changes)
     recorder = recorder_factory(world) if recorder_factory else None
     duration = cfg.duration_s if cfg.duration_s is not None else world.scenario.duration_s
     n = max(int(round(duration / world.dt)), 1)
@@ -50,8 +50,10 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         step = agent.step(frame)
         ahead = feed.ahead()
         change = step.control["lane_change"]
-        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad,
-                          change is not None and change.phase is not Phase.KEEP)
+        # a boundary crossed by a commanded change, or by highway-env's MOBIL driving in the ego's place, is no
+        # departure
+        changing = change is not None and change.phase is not Phase.KEEP or cfg.world.autopilot_lane_changes
+        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad, changing)
         safety.update(truth)
         pace.update(gt)
         changes.update(gt, change)

@@ -37,7 +37,8 @@ def run_settings(plan: EvalPlan) -> dict:
             "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
             "detector": cfg.detector if cfg.uses_detector else None,
             "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
-                      "autopilot": cfg.world.autopilot}, "rear": plan.rear, "lane_changes": plan.lane_changes}
+                      "autopilot": cfg.world.autopilot}, "rear": plan.rear, "lane_changes": plan.lane_changes,
+            "ego": plan.ego}
 
 
 def differences(now: dict, then) -> list[str]:
