@@ -50,12 +50,15 @@ class LaneChangeDebug:
 
     phase: Phase  # what it is doing
     side: int  # the side of the change under way (+1 left, -1 right; 0 none)
-    reason: str  # why: MOBIL's reason for the side it favours, or "too soon", "no lane estimate"
+    reason: str  # why, in words: MOBIL's gain for the side taken, its reasons for those not taken, or "too soon",
+    # "no lane estimate", "on the path", "arrived", "not across" (a path that ended short of the target lane)
     judgements: tuple[Judgement, ...]  # MOBIL's verdicts this frame
     event: str | None  # "started", "completed" or "aborted" on the frame it happened, else None
     ref: LateralRef | None  # the lateral reference handed to lane keeping (None: keep the lane's centre)
     plan_m: tuple = ()  # the rest of the path as (ahead [m], offset from the current lane's centre [m]) points at
     # the ego's speed (PLAN_POINTS of them; empty outside a change)
+    into_lane: int = 0  # the target lane relative to the current one while the car is not yet across it (+1 left,
+    # -1 right), else 0: the following law watches that lane's nearest car ahead as well
 
 
 class LaneChange(Controller):
@@ -73,11 +76,13 @@ class LaneChange(Controller):
         self.favour, self.favour_s = 0, 0.0  # the side MOBIL favours, and for how long [s]
         self.path: MinJerkPath | None = None  # in the start lane's frame
         self.index0 = 0  # the lane index the change started from
+        self.width0 = 0.0  # the lane width it was planned with [m]
 
     def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
                dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
-        """The reference (None: the lane's centre) and the debug record; ``neighbours`` None: nothing is known around
-        the car, so no change starts (one under way goes on)."""
+        """The reference (None: the lane's centre) and the debug record, from the ego path, the neighbours (None:
+        nothing is known around the car, so no change starts; one under way goes on), the speed [m/s] and the frame
+        period ``dt`` [s]. Without a view behind (``Neighbours.rear`` False) no change starts either."""
         if not path.follows_lane:  # nothing to steer along: a path under way runs on unseen
             self.favour, self.favour_s = 0, 0.0
             self.t_s += dt if self.phase is not Phase.KEEP else 0.0
@@ -91,31 +96,34 @@ class LaneChange(Controller):
         """Keeping the lane: MOBIL on both sides; a change starts on the side favoured for ``settle_s``."""
         self.since_end_s += dt
         lane = path.lane
+        seen = neighbours is not None and neighbours.rear
         verdicts = tuple(judge(s, lane.lane_beside(s), neighbours, speed_mps, self.set_speed, self.cfg.mobil)
-                         for s in (1, -1)) if neighbours is not None else ()
+                         for s in (1, -1)) if seen else ()
         best = max((j for j in verdicts if j.go), key=lambda j: j.gain_mps2, default=None)
         side = best.side if best is not None else 0
         self.favour_s = self.favour_s + dt if side == self.favour and side else 0.0
         self.favour = side
-        reason = best.reason if best is not None else _why_not(verdicts)
+        reason = (f"gain {best.gain_mps2:.2f} m/s², new follower {best.imposed_mps2:+.2f} m/s²" if best is not None
+                  else _why_not(verdicts))
         if best is None or self.favour_s < self.cfg.settle_s:
             return None, LaneChangeDebug(self.phase, 0, reason, verdicts, None, None)
         if self.since_end_s < self.cfg.min_interval_s:
             return None, LaneChangeDebug(self.phase, 0, "too soon", verdicts, None, None)
-        self.phase, self.side, self.t_s, self.index0 = Phase.CHANGE, side, 0.0, lane.index
+        self.phase, self.side, self.t_s, self.index0, self.width0 = Phase.CHANGE, side, 0.0, lane.index, lane.width_m
         self.path = MinJerkPath.between(lane.offset_m, 0.0, 0.0, side * lane.width_m, self.cfg.duration_s)
         ref = self.path.at(0.0)
-        return ref, LaneChangeDebug(self.phase, side, reason, verdicts, "started", ref)
+        return ref, LaneChangeDebug(self.phase, side, reason, verdicts, "started", ref, into_lane=side)
 
     def _follow(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
                 dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
         """On a path: its point in the current lane's frame; a change not yet across returns when MOBIL's safety
         fails on its side; the path's end ends the manoeuvre."""
         self.t_s += dt
-        lane = path.lane
-        crossed = lane.index - self.index0
+        crossed = path.lane.index - self.index0
         planned = self.path.at(self.t_s)
         event, verdicts, reason = None, (), "on the path"
+        if self.t_s >= self.path.duration_s:
+            return self._end(crossed)
         if self.phase is Phase.CHANGE and not crossed and neighbours is not None:
             verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
             verdicts, reason = (verdict,), verdict.reason
@@ -123,16 +131,22 @@ class LaneChange(Controller):
                 self.phase, event, self.t_s = Phase.RETURN, "aborted", 0.0
                 self.path = MinJerkPath.between(planned.offset_m, planned.rate_mps, planned.accel_mps2, 0.0,
                                                 self.cfg.duration_s)
-        elif self.t_s >= self.path.duration_s:
-            event = "completed" if self.phase is Phase.CHANGE else None
-            self.phase, self.side, self.since_end_s = Phase.KEEP, 0, 0.0
-            return None, LaneChangeDebug(self.phase, 0, "arrived", verdicts, event, None)
-        # offset in the current lane = offset in the start lane - (index - index_start) w
-        shift = crossed * lane.width_m
+        # offset in the current lane = offset in the start lane - (index - index_start) w (the width planned with)
+        shift = crossed * self.width0
         ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2)
         ahead = [self.t_s + k * (self.path.duration_s - self.t_s) / (PLAN_POINTS - 1) for k in range(PLAN_POINTS)]
         plan = tuple((speed_mps * (t - self.t_s), self.path.at(t).offset_m - shift) for t in ahead)
-        return ref, LaneChangeDebug(self.phase, self.side, reason, verdicts, event, ref, plan)
+        into = self.side if self.phase is Phase.CHANGE and not crossed else 0
+        return ref, LaneChangeDebug(self.phase, self.side, reason, verdicts, event, ref, plan, into)
+
+    def _end(self, crossed: int) -> tuple[None, LaneChangeDebug]:
+        """The path's end: a change is completed when the lane estimate has moved to the target lane, else (it never
+        got across) it counts as aborted; a return just ends."""
+        side, changing = self.side, self.phase is Phase.CHANGE
+        event = ("completed" if crossed == side else "aborted") if changing else None
+        self.phase, self.side, self.since_end_s = Phase.KEEP, 0, 0.0
+        reason = "arrived" if event != "aborted" else "not across"
+        return None, LaneChangeDebug(self.phase, side, reason, (), event, None)
 
 
 def _why_not(verdicts: tuple[Judgement, ...]) -> str:

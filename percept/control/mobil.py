@@ -69,11 +69,6 @@ class Judgement:
         return self.reason == "ok"
 
 
-def _nearest(tracks: tuple[Neighbour, ...], zone: Zone) -> Neighbour | None:
-    """The nearest track of ``tracks`` in ``zone`` (they come nearest first)."""
-    return next((n for n in tracks if n.zone is zone), None)
-
-
 def _gap(n: Neighbour, k: float) -> float:
     """A track's bumper gap, ``k`` of its sigmas shorter [m]."""
     return max(n.gap_m - k * n.sigma_x_m, 0.0)
@@ -92,11 +87,10 @@ def judge(side: int, lane_there: bool | None, neighbours: Neighbours, speed_mps:
     k, v = cfg.sigmas, speed_mps
     if lane_there is not True:
         return Judgement(side, 0.0, 0.0, "no lane")
-    target, own = neighbours.in_lane(side), neighbours.in_lane(0)
-    if _nearest(target, Zone.BESIDE) is not None:
+    if neighbours.nearest(side, Zone.BESIDE) is not None:
         return Judgement(side, 0.0, 0.0, "beside")
-    lead_new, follow_new = _nearest(target, Zone.AHEAD), _nearest(target, Zone.BEHIND)
-    lead_old, follow_old = _nearest(own, Zone.AHEAD), _nearest(own, Zone.BEHIND)
+    lead_new, follow_new = neighbours.nearest(side, Zone.AHEAD), neighbours.nearest(side, Zone.BEHIND)
+    lead_old, follow_old = neighbours.nearest(0, Zone.AHEAD), neighbours.nearest(0, Zone.BEHIND)
 
     def ego_behind(lead: Neighbour | None) -> float:
         """The ego's acceleration behind ``lead`` (None: a free lane)."""

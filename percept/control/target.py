@@ -32,9 +32,9 @@ def nearest_target(lead: Lead | None, request: BrakingRequest | None,
     cut_in = neighbours.cutting_in() if neighbours is not None else None
     if cut_in is not None:
         cands.append(Target(cut_in.gap_m, -cut_in.rel_speed_mps, ObjectKind.VEHICLE, "cut-in"))
-    ahead = [n for n in neighbours.in_lane(into_lane) if n.zone is Zone.AHEAD] if into_lane and neighbours else []
-    if ahead:
-        cands.append(Target(ahead[0].gap_m, -ahead[0].rel_speed_mps, ObjectKind.VEHICLE, "target lane"))
+    ahead = neighbours.nearest(into_lane, Zone.AHEAD) if into_lane and neighbours is not None else None
+    if ahead is not None:
+        cands.append(Target(ahead.gap_m, -ahead.rel_speed_mps, ObjectKind.VEHICLE, "target lane"))
     if lead is not None:
         cands.append(Target(bumper_gap_m(lead.range_m), -lead.range_rate_mps, lead.kind, "lead"))
     if BrakingRequest.asking(request) is not None:

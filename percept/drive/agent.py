@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from percept.control import EmergencyBraking, Following, LaneChange, LaneKeeping, Phase, nearest_target
+from percept.control import EmergencyBraking, Following, LaneChange, LaneKeeping, nearest_target
 from percept.sensors import BrakingRequest, EgoPath, Frame, Lead, Neighbours, PoseEstimate, Source
 
 from .tasks import SlotContext, Task, task_order, upstream_of
@@ -33,7 +33,7 @@ class Agent:
     ego path or the pose."""
 
     def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float,
-                 lane_changes: bool = False):
+                 lane_changes: bool = True):
         self.order = task_order(tasks)
         provided = {t.provides for t in self.order}
         for role in (EgoPath, PoseEstimate):
@@ -67,8 +67,7 @@ class Agent:
         ref, change = self.changing.update(path, neighbours, speed, self.dt_s) if self.changing else (None, None)
         steer, keeping = self.keeping.update(path, ref)
         request = by_record.get(BrakingRequest)
-        into = change.side if change is not None and change.phase is Phase.CHANGE else 0
-        target = nearest_target(by_record.get(Lead), request, neighbours, into)
+        target = nearest_target(by_record.get(Lead), request, neighbours, change.into_lane if change else 0)
         follow, following = self.following.update(target, speed)
         accel, braking = self.braking.update(target, speed, follow, self.dt_s,
                                              withdrawn=request is not None and request.withdrawn)

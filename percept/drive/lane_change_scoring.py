@@ -4,19 +4,16 @@ Progress is the mean true speed, its ratio to the set speed, and the distance dr
 completed or aborted as the lane-change law's debug record says (null where no law commands the car: lane changes
 off, or highway-env's MOBIL driving it). A change is **unsafe** when, on the frame the ego's true lane changes, the
 new follower would have to brake harder than ``UNSAFE_BRAKING_MPS2``
-by highway-env's IDM (its own ``IDMVehicle`` parameters; the follower taken to want its own speed, so that only the
-ego's arrival brakes it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under
+by IDM with highway-env's own ``IDMVehicle`` parameters (``control.idm_accel``; the follower taken to want its own
+speed, so that only the ego's arrival brakes it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under
 ``UNSAFE_TIME_GAP_S`` at the ego's speed, or a car is beside the ego in it. Peak lateral acceleration and jerk are
-the true ones (the IMU's lateral axis without noise) over the frames of a commanded change.
+the true ones (the IMU's lateral axis without noise, less the lane's own centripetal v^2 kappa) over the frames of
+a commanded change.
 """
 
 from __future__ import annotations
 
-import math
-
-from highway_env.vehicle.behavior import IDMVehicle
-from highway_env.vehicle.kinematics import Vehicle
-
+from percept.control import idm_accel
 from percept.sensors import Zone
 
 from .neighbours_truth import truth_neighbours
@@ -25,17 +22,6 @@ UNSAFE_BRAKING_MPS2 = 2.0
 """A change that makes its new follower brake harder than this is unsafe [m/s²]."""
 UNSAFE_TIME_GAP_S = 0.5
 """A change that leaves a gap ahead or behind shorter than this at the ego's speed is unsafe [s]."""
-
-
-def imposed_braking(follower_speed_mps: float, gap_m: float, closing_mps: float) -> float:
-    """The acceleration [m/s²] highway-env's IDM gives a follower at ``follower_speed_mps``, ``gap_m`` (bumper to
-    bumper) behind a car it closes on at ``closing_mps``, wanting its own speed: -a (s* / s)^2 with
-    s* = d0 + v T + v dv / (2 sqrt(a b)) (``IDMVehicle.desired_gap``; its d0 is centre to centre)."""
-    v = follower_speed_mps
-    a, b = IDMVehicle.COMFORT_ACC_MAX, -IDMVehicle.COMFORT_ACC_MIN
-    s_star = IDMVehicle.DISTANCE_WANTED + v * IDMVehicle.TIME_WANTED + v * closing_mps / (2 * math.sqrt(a * b))
-    # highway-env's gap is centre to centre: the bumper gap plus a car's length
-    return -a * (s_star / max(gap_m + Vehicle.LENGTH, 0.1)) ** 2
 
 
 class ProgressScorer:
@@ -78,7 +64,8 @@ class LaneChangeScorer:
         if self._lane is not None and lane != self._lane:
             self._judge_crossing(gt)
         self._lane = lane
-        accel = float(gt.imu.accel_mps2[1])
+        # the manoeuvre's own lateral acceleration: the IMU's less the lane's centripetal v^2 kappa
+        accel = float(gt.imu.accel_mps2[1]) - gt.speed_mps ** 2 * gt.lane.curvature_1pm
         if changing:
             self.peak_accel = max(self.peak_accel or 0.0, abs(accel))
             if self._accel is not None:
@@ -89,13 +76,13 @@ class LaneChangeScorer:
     def _judge_crossing(self, gt) -> None:
         """The new lane's follower and gaps on the frame the ego's centre entered it."""
         v = gt.speed_mps
-        mine = truth_neighbours(gt).in_lane(0)
-        ahead = next((n for n in mine if n.zone is Zone.AHEAD), None)
-        behind = next((n for n in mine if n.zone is Zone.BEHIND), None)
-        braking = None if behind is None else imposed_braking(v + behind.rel_speed_mps, behind.gap_m,
-                                                              behind.rel_speed_mps)
+        around = truth_neighbours(gt)
+        ahead, behind = around.nearest(0, Zone.AHEAD), around.nearest(0, Zone.BEHIND)
+        # the follower wants its own speed: only the ego's arrival brakes it
+        vf = v + behind.rel_speed_mps if behind is not None else 0.0
+        braking = None if behind is None else idm_accel(vf, vf, behind.gap_m, behind.rel_speed_mps)
         short = [g for g in (ahead, behind) if g is not None and g.gap_m < UNSAFE_TIME_GAP_S * v]
-        beside = any(n.zone is Zone.BESIDE for n in mine)
+        beside = around.nearest(0, Zone.BESIDE) is not None
         unsafe = bool(short) or beside or (braking is not None and braking < -UNSAFE_BRAKING_MPS2)
         self.counts["unsafe"] += int(unsafe)
         self.crossings.append({"time_s": round(gt.time_s, 3), "follower_braking_mps2": braking,

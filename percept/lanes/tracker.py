@@ -27,6 +27,9 @@ KIND_GAIN = 0.2
 """How much one frame's broken-or-solid verdict moves a boundary's vote (an exponential average over about 5 frames)."""
 KIND_VOTE = 0.5
 """A boundary is broken (solid) once its vote passes +this (-this); between the two it is not known."""
+SHIFT_MARGIN_M = 0.1
+"""The car's centre must be this far past a boundary before the track moves to the lane beyond [m]: a centre on the
+line, its offset jittering by centimetres, does not move the track back and forth."""
 
 
 class LaneTracker:
@@ -97,9 +100,10 @@ class LaneTracker:
         self._follow_the_centre()
 
     def _follow_the_centre(self) -> None:
-        """Once the car's centre is past a boundary (|offset| > w / 2), track the lane beyond (``shift``)."""
+        """Once the car's centre is past a boundary (|offset| > w / 2 + SHIFT_MARGIN_M), track the lane beyond
+        (``shift``)."""
         offset, width = float(self.kf.x[0]), float(self.kf.x[4])
-        if self.initialised and abs(offset) > width / 2:
+        if self.initialised and abs(offset) > width / 2 + SHIFT_MARGIN_M:
             self.shift(1 if offset > 0 else -1)
 
     def shift(self, side: int) -> None:

@@ -101,6 +101,13 @@ class NeighbourTracker:
         kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, sigma_l2, 1.0 ** 2])
         return kf
 
+    def shift_lanes(self, moved_m: float) -> None:
+        """The lane coordinates moved ``moved_m`` [m] to the left (the ego changed lanes): each track's lateral
+        position is taken from the new centre line, l' = l - moved, and its lane follows."""
+        for t in self.tracks:
+            t.kf.x[2, 0] -= moved_m
+            t.lane = None if t.lane is None else int(round(t.lat / self.width))
+
     def in_blind_band(self, x_m: float, lat_m: float, width_m: float) -> bool:
         """Whether a centre at (x_m, lat_m) lies where neither rig sees: beside the ego in a lane beside it."""
         return self.cfg.blind_behind_m <= x_m <= self.cfg.blind_ahead_m and abs(lat_m) >= 0.5 * width_m

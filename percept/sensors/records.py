@@ -246,6 +246,10 @@ class Neighbours:
         return not any(n.lane == lane and -behind_m - 3 * n.sigma_x_m <= n.x_m <= ahead_m + 3 * n.sigma_x_m
                        for n in self.tracks)
 
+    def nearest(self, lane: int, zone: Zone) -> Neighbour | None:
+        """The nearest track in ``lane`` (-1, 0, +1) and ``zone``; None when there is none."""
+        return next((n for n in self.tracks if n.lane == lane and n.zone is zone), None)
+
     def cutting_in(self) -> Neighbour | None:
         """The nearest neighbour ahead in a lane beside flagged as cutting in (the following law treats it as a lead
         before it arrives); None when none is."""

@@ -111,6 +111,38 @@ def test_a_change_starts_once_favoured_long_enough_and_ends_in_the_lane_beside()
     assert ys[-1] == pytest.approx(W, abs=1e-3) and dbgs[-1].phase is Phase.KEEP
 
 
+def test_a_change_to_the_right_counts_the_lane_index_down():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=5.0, settle_s=0.2))
+    # a slow lead, and no lane to the left
+    for _ in range(int(7.0 / DT)):
+        ref, dbg = law.update(path(0.0, 0, beside=(False, True)), around(car(0, 35.0, rel=-6.0)), V, DT)
+        if dbg.event == "started":
+            assert dbg.side == -1 and dbg.into_lane == -1
+            break
+    offset, index, events = 0.0, 0, []
+    for _ in range(int(6.0 / DT)):
+        ref, dbg = law.update(path(offset, index, beside=(True, True)), around(car(0, 35.0, rel=-6.0)), V, DT)
+        events.append(dbg.event)
+        offset = ref.offset_m if ref is not None else offset
+        if offset < -W / 2 - 0.1:
+            index, offset = index - 1, offset + W
+            assert dbg.into_lane == -1  # this frame's debug was made before the move
+    assert "completed" in events and index == -1 and offset == pytest.approx(0.0, abs=1e-3)
+
+
+def test_a_path_that_ends_short_of_the_target_lane_is_aborted():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=2.0, settle_s=0.2))
+    events = [law.update(path(0.0, 0), around(car(0, 35.0, rel=-6.0)), V, DT)[1].event for _ in range(60)]
+    # the lane estimate never moved to the target lane
+    assert events.count("started") == 1 and "completed" not in events and events.count("aborted") == 1
+
+
+def test_no_change_without_a_view_behind():
+    law = LaneChange(30.0, LaneChangeConfig(settle_s=0.2))
+    blind = Neighbours((car(0, 35.0, rel=-6.0),), rear=False)
+    assert all(law.update(path(), blind, V, DT)[1].event is None for _ in range(60))
+
+
 def test_no_second_change_before_the_interval():
     law = LaneChange(30.0, LaneChangeConfig(duration_s=2.0, settle_s=0.2, min_interval_s=8.0))
     dbgs, _ = run_law(law, int(6.0 / DT), around(car(0, 35.0, rel=-6.0)))

@@ -5,7 +5,7 @@ import pytest
 
 from percept.control import Phase
 from percept.drive import DriveConfig, run_drive
-from percept.drive.lane_change_scoring import LaneChangeScorer, ProgressScorer, imposed_braking
+from percept.drive.lane_change_scoring import LaneChangeScorer, ProgressScorer
 from percept.drive.scoring import SafetyScorer, StepTruth
 from percept.sensors import ImuSample
 from percept.sims import WorldConfig
@@ -27,20 +27,28 @@ def test_a_boundary_crossed_in_a_commanded_change_is_no_departure(truth):
     assert quiet.result()["lane_departures"] == 1 and changing.result()["lane_departures"] == 0
 
 
-def test_highway_envs_idm_brakes_a_close_follower_harder_than_a_far_one():
-    # at 25 m/s and no closing, IDM wants d0 + v T = 10 + 37.5 m centre to centre
-    assert imposed_braking(25.0, 42.5, 0.0) == pytest.approx(-3.0)
-    assert imposed_braking(25.0, 20.0, 0.0) < -2.0 < imposed_braking(25.0, 60.0, 0.0)
+def test_the_laws_idm_is_highway_envs():
+    from highway_env.vehicle.behavior import IDMVehicle
+    from highway_env.vehicle.kinematics import Vehicle
+
+    from percept.control import mobil
+
+    assert (mobil.ACCEL_MPS2, mobil.DECEL_MPS2, mobil.TIME_GAP_S, mobil.DELTA) == (
+        IDMVehicle.COMFORT_ACC_MAX, -IDMVehicle.COMFORT_ACC_MIN, IDMVehicle.TIME_WANTED, IDMVehicle.DELTA)
+    # highway-env's desired distance is centre to centre, ours bumper to bumper
+    assert mobil.JAM_GAP_M == IDMVehicle.DISTANCE_WANTED - Vehicle.LENGTH
 
 
-def test_a_change_onto_a_close_follower_is_unsafe(truth, vehicle):
+@pytest.mark.parametrize("behind_m, unsafe", [(12.0, True), (65.0, False)])
+def test_a_change_onto_a_close_follower_is_unsafe_onto_a_far_one_not(truth, vehicle, behind_m, unsafe):
     s = LaneChangeScorer(1 / 15)
     s.update(truth(lane_index=("a", "b", 1)), Changing(event="started"))
-    # the ego's centre now in lane 0, a car 12 m behind it there (gap 7 m)
-    s.update(truth([vehicle(5, -12.0, 0.0, speed=27.0)], lane_index=("a", "b", 0)), Changing())
+    # the ego's centre now in lane 0, a car at the ego's speed behind it there
+    s.update(truth([vehicle(5, -behind_m, 0.0, speed=25.0)], lane_index=("a", "b", 0)), Changing())
     r = s.result()
-    assert r["started"] == 1 and r["unsafe"] == 1
-    assert r["crossings"][0]["gap_behind_m"] == pytest.approx(7.0) and r["crossings"][0]["unsafe"]
+    assert r["started"] == 1 and r["unsafe"] == int(unsafe)
+    crossing = r["crossings"][0]
+    assert crossing["gap_behind_m"] == pytest.approx(behind_m - 5.0) and crossing["unsafe"] is unsafe
 
 
 def test_lateral_acceleration_and_jerk_are_taken_over_the_change_only(truth):
@@ -69,7 +77,7 @@ def test_on_truth_the_car_overtakes_in_dense_traffic_and_keeps_its_lane_when_tol
     assert lc["completed"] >= 1 and lc["unsafe"] == 0 and on["lane_changes_on"]
     assert on["collisions"] == 0 and on["lane_departures"] == 0
     assert lc["peak_lateral_accel_mps2"] <= 2.0 and lc["peak_lateral_jerk_mps3"] <= 3.0
-    assert off["lane_changes"]["started"] == 0 and not off["lane_changes_on"]
+    assert off["lane_changes"]["started"] is None and not off["lane_changes_on"]
     assert on["progress"]["mean_speed_mps"] > off["progress"]["mean_speed_mps"]
 
 
