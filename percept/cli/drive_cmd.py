@@ -22,6 +22,7 @@ def drive(
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
     rear: opt.Rear = None,
+    lane_changes: opt.LaneChanges = "on",
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
                                          "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,
@@ -43,7 +44,8 @@ def drive(
     opt.check_number("--duration", duration, 1e-3, opt.MAX_DURATION_S)
     try:
         cfg = DriveConfig(WorldConfig(scenario=scenario, seed=seed, condition=condition), duration,
-                          opt.slot_sources(sources, privileged), detector=detector, rear=rear)
+                          opt.slot_sources(sources, privileged), detector=detector, rear=rear,
+                          lane_changes=opt.lane_changes_on(lane_changes))
     except ValueError as e:
         fail(str(e))
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
@@ -121,6 +123,12 @@ def summary_table(cfg, result: dict) -> Table:
 
     for k in SAFETY_COUNTS:
         t.add_row("run", k.replace("_", " "), fmt(result[k], "{}"))
+    t.add_row("progress", "mean speed [m/s]", fmt(result["progress"]["mean_speed_mps"], "{:.2f}"))
+    t.add_row("", "of the set speed", fmt(result["progress"]["set_speed_ratio"], "{:.3f}"))
+    changes = result["lane_changes"]
+    t.add_row("lane changes" + ("" if result["lane_changes_on"] else " (off)"),
+              "started / completed / aborted / unsafe",
+              " / ".join(str(changes[k]) for k in ("started", "completed", "aborted", "unsafe")))
     for task in cfg.tasks:
         group = result[task.name]
         name = f"{task.name} ({cfg.source(task.name).value})"

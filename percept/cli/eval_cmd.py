@@ -35,12 +35,17 @@ def eval_(
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
     rear: opt.Rear = None,
+    lane_changes: opt.LaneChanges = "on",
+    ego: Annotated[str, typer.Option("--ego", help="Who drives: percept (its agent on its slots) or mobil "
+                                                   "(highway-env's IDM car changing lanes by MOBIL in the ego's place, "
+                                                   "on truth: the anchor for progress).")] = "percept",
     json_path: opt.JsonOut = None,
     redo: Annotated[bool, opt.flag("--redo", help="Drive again the runs in --out that were made with other "
                                                       "settings (other slots, duration or percept version).")] = False,
     strict: Annotated[bool, opt.flag("--strict", help="Exit 1 when any run has a collision, a pedestrian "
-                                                          "collision or a lane departure (listed, each with the "
-                                                          "command that reproduces it).")] = False,
+                                                          "collision, a lane departure or an unsafe lane change "
+                                                          "(listed, each with the command that reproduces "
+                                                          "it).")] = False,
 ):
     """Drive every (scenario, condition, seed) and summarise the metrics per scenario and condition.
 
@@ -55,7 +60,7 @@ def eval_(
     second command writing there is refused at once, and a lock left by a process that no longer runs is taken over.
     """
     plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector,
-                      opt.slot_sources(sources, privileged), rear)
+                      opt.slot_sources(sources, privileged), rear, opt.lane_changes_on(lane_changes), ego)
     with only_writer(out, "percept eval"):
         files = _scan(plan, out, redo)
         check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
@@ -71,7 +76,8 @@ def eval_(
             _strict(summary)
 
 
-def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources, rear=None):
+def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources, rear=None, lane_changes=True,
+          ego="percept"):
     """The checked options as (EvalPlan, Engine), the model file included; one-line exit 2 otherwise."""
     from percept.evaluate.plan import Engine, EvalPlan, parse_seeds
     from percept.sims import SCENARIOS
@@ -87,7 +93,7 @@ def _plan(scenario, condition, seeds, workers, engine, duration, detector, sourc
         fail(f"--engine must be local or ray, got '{engine}'")
     try:
         plan = EvalPlan(tuple(dict.fromkeys(names)), tuple(dict.fromkeys(condition)), tuple(parse_seeds(seeds)),
-                        sources, duration, detector, rear=rear)
+                        sources, duration, detector, rear=rear, lane_changes=lane_changes, ego=ego)
     except ValueError as e:
         fail(str(e))
     return plan, eng
@@ -108,13 +114,15 @@ def _scan(plan, out: Path, redo: bool):
 
 
 def _strict(summary: dict) -> None:
-    """--strict: list every run with a collision, a pedestrian collision or a lane departure and exit 1."""
+    """--strict: list every run with a collision, a pedestrian collision, a lane departure or an unsafe lane change
+    and exit 1."""
     for u in summary["unsafe"]:
         console.print(f"[red]unsafe[/] {escape(u['scenario'])}/{u['condition']}/seed {u['seed']}: {u['what']}; "
                       f"reproduce: {escape(u['reproduce'])}", soft_wrap=True)
     if summary["unsafe"]:
         err.print(f"[bold red]error:[/] --strict: {len(summary['unsafe'])} run(s) had a collision, a pedestrian "
-                  "collision or a lane departure (listed above)", highlight=False, soft_wrap=True)
+                  "collision, a lane departure or an unsafe lane change (listed above)", highlight=False,
+                  soft_wrap=True)
         raise typer.Exit(1)
 
 
@@ -166,11 +174,13 @@ def summary_tables(summary: dict, tasks) -> Group:
     groups = summary["groups"]
     title = (f"{sum(len(g['seeds']) for g in groups)} runs; slots: "
              + ", ".join(f"{k} {v}" for k, v in summary["settings"]["slots"].items()))
-    safety = _cells_table(title, ("runs", "collisions", "pedestrian collisions", "lane departures"))
+    safety = _cells_table(title, ("runs", "collisions", "pedestrian collisions", "lane departures",
+                                  "unsafe lane changes"))
     for g in groups:
-        safety.add_row(g["scenario"], g["condition"], str(len(g["seeds"])), fmt(g["collisions"], "{}"),
-                       fmt(g["pedestrian_collisions"], "{}"), fmt(g["lane_departures"], "{}"))
-    tables = [safety]
+        safety.add_row(g["scenario"], g["condition"], str(len(g["seeds"])),
+                       *(fmt(g.get(k), "{}") for k in ("collisions", "pedestrian_collisions", "lane_departures",
+                                                       "unsafe_lane_changes")))
+    tables = [safety] + ([_run_table(groups)] if any(g.get("progress") for g in groups) else [])
     for task in tasks:
         heads = [h for h in task.headline if any((g[task.name].get(h.key) or None) is not None for g in groups)]
         if not heads:
@@ -181,6 +191,20 @@ def summary_tables(summary: dict, tasks) -> Group:
                                                            h.fmt.replace("{}", "{:.1f}")) for h in heads))
         tables.append(t)
     return Group(*tables)
+
+
+def _run_table(groups: list[dict]) -> Table:
+    """Progress and lane changes per scenario and condition (means over seeds)."""
+    from percept.evaluate.metrics import RUN_HEADLINES
+
+    t = _cells_table("progress and lane changes (means over seeds)", [label for _, label, _ in RUN_HEADLINES])
+    for g in groups:
+        cells = []
+        for key, _, spec in RUN_HEADLINES:
+            grp, name = key.split(".")
+            cells.append(fmt(((g.get(grp) or {}).get(name) or {}).get("mean"), spec))
+        t.add_row(g["scenario"], g["condition"], *cells)
+    return t
 
 
 def _cells_table(title: str, columns) -> Table:

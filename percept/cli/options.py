@@ -30,6 +30,19 @@ Detector = Annotated[str, typer.Option("--detector", help="People model of the v
 Rear = Annotated[Optional[bool], typer.Option("--rear/--no-rear", help="The rear stereo rig, looking back from the rear "
                                               "bumper, on or off (default: on where the scenario's traffic changes "
                                               "lanes).", show_default=False)]
+LaneChanges = Annotated[str, typer.Option("--lane-changes", help="on: the car changes lanes when MOBIL on what it "
+                                          "sees favours it and it is safe; off: it keeps its lane.")]
+
+
+def lane_changes_on(value: str) -> bool:
+    """--lane-changes as a bool; a one-line exit 2 on anything but on or off."""
+    if value not in ("on", "off"):
+        from .common import fail
+
+        fail(f"--lane-changes must be on or off, got '{value}'")
+    return value == "on"
+
+
 JsonOut = Annotated[Optional[Path], typer.Option("--json", help="Also write the results to this JSON file.",
                                                  dir_okay=False)]
 

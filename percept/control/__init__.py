@@ -4,8 +4,13 @@
 from .base import Controller, sideslip_for_curvature, steering_for_curvature
 from .emergency_braking import EmergencyBraking, EmergencyBrakingDebug
 from .following import Following, FollowingDebug
+from .lane_change import LaneChange, LaneChangeConfig, LaneChangeDebug, Phase
 from .lane_keeping import LaneKeeping, LaneKeepingDebug
+from .lateral_path import LateralRef, MinJerkPath
+from .mobil import Judgement, MobilConfig, idm_accel, judge
 from .target import Target, nearest_target
 
-__all__ = ["Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Following", "FollowingDebug", "LaneKeeping",
-           "LaneKeepingDebug", "Target", "nearest_target", "sideslip_for_curvature", "steering_for_curvature"]
+__all__ = ["Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Following", "FollowingDebug", "Judgement",
+           "LaneChange", "LaneChangeConfig", "LaneChangeDebug", "LaneKeeping", "LaneKeepingDebug", "LateralRef",
+           "MinJerkPath", "MobilConfig", "Phase", "Target", "idm_accel", "judge", "nearest_target",
+           "sideslip_for_curvature", "steering_for_curvature"]

@@ -3,6 +3,8 @@
 Lateral error dynamics of a path-following car: y' = v sin(theta), theta' = v (kappa_cmd - kappa_lane).
 Choosing kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2 gives y'' + 2 w y' + w^2 y = 0:
 critically damped with time constant T = 1/w (Rajamani, *Vehicle Dynamics and Control*, 2nd ed., ch. 3).
+Following a lateral reference r(t) (a lane change's path, ``lateral_path``) the error e = y - r obeys the same
+equation with kappa_cmd = kappa_lane + (r'' - 2 w (v sin(theta) - r') - w^2 (y - r)) / v^2.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from percept.sensors import EgoPath
 from percept.sensors.vehicle import STEER_RANGE_RAD
 
 from .base import Controller, sideslip_for_curvature, steering_for_curvature
+from .lateral_path import LateralRef
 
 
 @dataclass(frozen=True)
@@ -21,10 +24,11 @@ class LaneKeepingDebug:
     """How the lane-keeping law made its command: the curvature terms it adds up and the steering they give."""
 
     feedforward_1pm: float  # the lane's own curvature [1/m]
-    offset_1pm: float  # the offset feedback term, -w^2 y / v^2 [1/m]
-    heading_1pm: float  # the heading feedback term, -2 w sin(theta) / v [1/m]
+    offset_1pm: float  # the offset feedback term, -w^2 (y - r) / v^2 [1/m]
+    heading_1pm: float  # the heading feedback term, -2 w (v sin(theta) - r') / v^2 [1/m]
     steering_rad: float  # the front-wheel angle asked for, before the vehicle's steering range [rad]
     limited_by: str  # "path" (no lane: hold straight), "steer_limit" (outside the steering range) or "none"
+    reference_1pm: float = 0.0  # the reference's own term, r'' / v^2 (0 without one) [1/m]
 
 
 class LaneKeeping(Controller):
@@ -38,19 +42,22 @@ class LaneKeeping(Controller):
         self.T = time_constant_s
         self.v_min = min_speed_mps
 
-    def update(self, path: EgoPath) -> tuple[float, LaneKeepingDebug]:
-        """Front-wheel angle [rad], ISO 8855 (positive turns left), and how it was made."""
+    def update(self, path: EgoPath, ref: LateralRef | None = None) -> tuple[float, LaneKeepingDebug]:
+        """Front-wheel angle [rad], ISO 8855 (positive turns left), and how it was made; ``ref``: where across the
+        lane to hold the car (None: its centre)."""
         if path.lane is None:
             return 0.0, LaneKeepingDebug(0.0, 0.0, 0.0, 0.0, "path")
         lane = path.lane
+        r = ref or LateralRef(0.0, 0.0, 0.0)
         v = max(path.speed_mps, self.v_min)
         w = 1.0 / self.T
         # path heading relative to the lane: body heading plus the sideslip of the steady turn
         theta = lane.heading_rad + sideslip_for_curvature(lane.curvature_1pm)
-        k_heading = 2 * w * math.sin(theta) / v
-        k_offset = w * w * lane.offset_m / (v * v)
-        # kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2
-        kappa = lane.curvature_1pm - k_heading - k_offset
+        k_heading = 2 * w * (v * math.sin(theta) - r.rate_mps) / (v * v)
+        k_offset = w * w * (lane.offset_m - r.offset_m) / (v * v)
+        k_ref = r.accel_mps2 / (v * v)
+        # kappa_cmd = kappa_lane + (r'' - 2 w (v sin(theta) - r') - w^2 (y - r)) / v^2
+        kappa = lane.curvature_1pm + k_ref - k_heading - k_offset
         steer = steering_for_curvature(kappa)
         limited = "steer_limit" if not STEER_RANGE_RAD[0] <= steer <= STEER_RANGE_RAD[1] else "none"
-        return steer, LaneKeepingDebug(lane.curvature_1pm, -k_offset, -k_heading, steer, limited)
+        return steer, LaneKeepingDebug(lane.curvature_1pm, -k_offset, -k_heading, steer, limited, k_ref)

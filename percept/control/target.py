@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from percept.sensors import BrakingRequest, Lead, Neighbours, ObjectKind
+from percept.sensors import BrakingRequest, Lead, Neighbours, ObjectKind, Zone
 from percept.sensors.vehicle import bumper_gap_m
 
 
@@ -16,7 +16,7 @@ class Target:
     gap_m: float  # free distance from the front bumper [m]
     closing_mps: float  # how fast the gap shrinks, -range rate [m/s]
     kind: ObjectKind  # what is there
-    source: str  # the record it comes from: "lead", "request" or "cut-in"
+    source: str  # the record it comes from: "lead", "request", "cut-in" or "target lane"
 
     @property
     def is_pedestrian(self) -> bool:
@@ -24,13 +24,17 @@ class Target:
 
 
 def nearest_target(lead: Lead | None, request: BrakingRequest | None,
-                   neighbours: Neighbours | None = None) -> Target | None:
-    """The nearest of the lead (longitudinal slot), the braking request (pedestrian slot) and the neighbour flagged
-    as cutting in (neighbours slot); None when there is none."""
+                   neighbours: Neighbours | None = None, into_lane: int = 0) -> Target | None:
+    """The nearest of the lead (longitudinal slot), the braking request (pedestrian slot), the neighbour flagged
+    as cutting in (neighbours slot) and, while the car changes into the lane ``into_lane`` (+1 left, -1 right; 0
+    none), the nearest neighbour ahead in that lane; None when there is none."""
     cands = []
     cut_in = neighbours.cutting_in() if neighbours is not None else None
     if cut_in is not None:
         cands.append(Target(cut_in.gap_m, -cut_in.rel_speed_mps, ObjectKind.VEHICLE, "cut-in"))
+    ahead = neighbours.nearest(into_lane, Zone.AHEAD) if into_lane and neighbours is not None else None
+    if ahead is not None:
+        cands.append(Target(ahead.gap_m, -ahead.rel_speed_mps, ObjectKind.VEHICLE, "target lane"))
     if lead is not None:
         cands.append(Target(bumper_gap_m(lead.range_m), -lead.range_rate_mps, lead.kind, "lead"))
     if BrakingRequest.asking(request) is not None:

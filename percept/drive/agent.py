@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from percept.control import EmergencyBraking, Following, LaneKeeping, nearest_target
+from percept.control import EmergencyBraking, Following, LaneChange, LaneKeeping, nearest_target
 from percept.sensors import BrakingRequest, EgoPath, Frame, Lead, Neighbours, PoseEstimate, Source
 
 from .tasks import SlotContext, Task, task_order, upstream_of
@@ -20,17 +20,20 @@ class AgentStep:
     estimates: dict  # task name -> the record its slot returned (or None)
     debug: dict  # task name -> its slot's debug object (or None)
     timing_ms: dict  # task name -> the wall time of its slot's step [ms]
-    control: dict  # law name (lane_keeping, following, emergency_braking) -> its debug record
+    control: dict  # law name (lane_change, lane_keeping, following, emergency_braking) -> its debug record (the
+    # lane-change law's None when lane changes are off)
 
 
 class Agent:
     """Slots from the table (vision or privileged per task), and the shared laws, each fed by the record that plays
     its role, whichever task provides it: lane keeping on the ego path (``EgoPath``); following and emergency
     braking on the lead (``Lead``), the braking request (``BrakingRequest``) and a neighbour cutting in
-    (``Neighbours``), at the speed of the pose estimate
-    (``PoseEstimate``). ValueError when no task provides the ego path or the pose."""
+    (``Neighbours``), at the speed of the pose estimate (``PoseEstimate``); when ``lane_changes``, the lane-change
+    law on the ego path and the neighbours hands lane keeping its reference. ValueError when no task provides the
+    ego path or the pose."""
 
-    def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float):
+    def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float,
+                 lane_changes: bool = True):
         self.order = task_order(tasks)
         provided = {t.provides for t in self.order}
         for role in (EgoPath, PoseEstimate):
@@ -42,13 +45,15 @@ class Agent:
         self.keeping = LaneKeeping()
         self.following = Following(set_speed_mps)
         self.braking = EmergencyBraking()
+        self.changing = LaneChange(set_speed_mps) if lane_changes else None
 
     def reset(self) -> None:
         """Every slot and law forgets the past."""
         for slot in self.slots.values():
             slot.reset()
-        for law in (self.keeping, self.following, self.braking):
-            law.reset()
+        for law in (self.keeping, self.following, self.braking, self.changing):
+            if law is not None:
+                law.reset()
 
     def step(self, frame: Frame) -> AgentStep:
         """Each slot on ``frame`` in dependency order (timed), then the laws on the records they produced."""
@@ -58,12 +63,14 @@ class Agent:
             estimates[task.name], debug[task.name] = self.slots[task.name].step(frame, upstream_of(task, by_record))
             timing[task.name] = (time.perf_counter() - t0) * 1e3
             by_record[task.provides] = estimates[task.name]
-        steer, keeping = self.keeping.update(by_record[EgoPath])
-        speed = by_record[PoseEstimate].speed_mps
+        path, speed, neighbours = by_record[EgoPath], by_record[PoseEstimate].speed_mps, by_record.get(Neighbours)
+        ref, change = self.changing.update(path, neighbours, speed, self.dt_s) if self.changing else (None, None)
+        steer, keeping = self.keeping.update(path, ref)
         request = by_record.get(BrakingRequest)
-        target = nearest_target(by_record.get(Lead), request, by_record.get(Neighbours))
+        target = nearest_target(by_record.get(Lead), request, neighbours, change.into_lane if change else 0)
         follow, following = self.following.update(target, speed)
         accel, braking = self.braking.update(target, speed, follow, self.dt_s,
                                              withdrawn=request is not None and request.withdrawn)
         return AgentStep(accel, steer, estimates, debug, timing,
-                         {"lane_keeping": keeping, "following": following, "emergency_braking": braking})
+                         {"lane_change": change, "lane_keeping": keeping, "following": following,
+                          "emergency_braking": braking})

@@ -5,12 +5,14 @@ from __future__ import annotations
 import time
 from typing import Callable
 
+from percept.control import Phase
 from percept.sensors import Source
 from percept.sims import SimWorld
 from percept.sims.coords import hw_pose
 
 from .agent import Agent
 from .config import DriveConfig
+from .lane_change_scoring import LaneChangeScorer, ProgressScorer
 from .privileged import TruthFeed, in_path_obstacle
 from .scoring import SafetyScorer, ScoreContext, StepTruth
 from .tasks import SlotContext
@@ -27,13 +29,14 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         raise ValueError("vision slots need the cameras (render=True)")
     world = SimWorld(cfg.world)
     feed = TruthFeed()
-    agent = Agent(cfg.tasks, cfg.sources, slot_context(world, feed, cfg.detector), world.cruise_speed_mps)
+    agent = Agent(cfg.tasks, cfg.sources, slot_context(world, feed, cfg.detector), world.cruise_speed_mps,
+                  cfg.lane_changes)
     rig = world.cfg.rig
     scorers = {t.name: t.scorer(ScoreContext(cfg.source(t.name) is Source.VISION, world.pedestrians,
                                              world.crossing_pedestrians, agent.following.time_gap,
                                              rig.camera.fx * rig.baseline_m, cfg.detector))
                for t in cfg.tasks}
-    safety = SafetyScorer()
+    safety, pace, changes = SafetyScorer(), ProgressScorer(world.cruise_speed_mps, world.dt), LaneChangeScorer(world.dt, cfg.lane_changes)
     recorder = recorder_factory(world) if recorder_factory else None
     duration = cfg.duration_s if cfg.duration_s is not None else world.scenario.duration_s
     n = max(int(round(duration / world.dt)), 1)
@@ -46,8 +49,14 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         feed.truth = gt
         step = agent.step(frame)
         ahead = feed.ahead()
-        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad)
+        change = step.control["lane_change"]
+        # a boundary crossed by a commanded change, or by highway-env's MOBIL driving in the ego's place, is no
+        # departure
+        changing = change is not None and change.phase is not Phase.KEEP or cfg.world.autopilot_lane_changes
+        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad, changing)
         safety.update(truth)
+        pace.update(gt)
+        changes.update(gt, change)
         for name, scorer in scorers.items():
             scorer.update(step.estimates[name], step.debug[name], truth)
             slot_ms[name] += step.timing_ms[name]
@@ -61,7 +70,9 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
     sim_s = frames * world.dt
     result = {"scenario": cfg.world.scenario, "condition": cfg.world.condition.value, "seed": cfg.world.seed,
               "duration_s": round(sim_s, 4), "frames": frames, "realtime_factor": sim_s / wall if wall > 0 else None,
-              "slots": {name: src.value for name, src in cfg.sources.items()}, "rear": cfg.rear, **safety.result()}
+              "slots": {name: src.value for name, src in cfg.sources.items()}, "rear": cfg.rear,
+              "lane_changes_on": cfg.lane_changes, **safety.result(changes.counts["unsafe"]), "progress": pace.result(),
+              "lane_changes": changes.result()}
     result.update({t.name: scorers[t.name].result() for t in cfg.tasks})
     result["timing_ms"] = timing_json(cfg, slot_ms, render_ms if render else None, frames)
     return result

@@ -123,13 +123,14 @@ class TruthSlot:
 
 
 class PrivilegedLanes(TruthSlot):
-    """The true lane as the ego path, at the true speed."""
+    """The true lane as the ego path, at the true speed: its index is highway-env's lane id negated (ids count from
+    the left; a change to the left adds one to the index), and the road says which lanes are beside."""
 
     def step(self, frame: Frame, upstream: dict) -> tuple[EgoPath, None]:
         gt = self.truth.get()
         lane = gt.lane
-        return EgoPath(LaneEstimate(lane.offset_m, lane.heading_rad, lane.curvature_1pm, lane.width_m, 1.0),
-                       gt.speed_mps), None
+        return EgoPath(LaneEstimate(lane.offset_m, lane.heading_rad, lane.curvature_1pm, lane.width_m, 1.0,
+                                    index=-int(lane.lane_index[2]), beside=tuple(lane.beside)), gt.speed_mps), None
 
 
 class PrivilegedLongitudinal(TruthSlot):

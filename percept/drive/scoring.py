@@ -21,8 +21,9 @@ from percept.sensors.vehicle import EGO_WIDTH_M
 from .privileged import InPath, Obstacle, true_centre_y
 from .rows import Rows
 
-SAFETY_COUNTS = ("collisions", "pedestrian_collisions", "lane_departures")
-"""The safety counts every run JSON has (integers); any of them makes a run unsafe."""
+SAFETY_COUNTS = ("collisions", "pedestrian_collisions", "lane_departures", "unsafe_lane_changes")
+"""The safety counts every run JSON has (integers); any of them makes a run unsafe (the last is the lane-change
+scorer's ``lane_changes.unsafe``)."""
 STOP_SPEED_MPS = 0.5
 """Below this speed the car has stopped [m/s]."""
 HALTING_VEHICLE_MPS = 2.0
@@ -61,6 +62,7 @@ class StepTruth:
     in_path: Obstacle | None  # the true obstacle the ego must respect (None: nothing)
     accel_mps2: float  # the commanded acceleration [m/s²]
     steering_rad: float  # the commanded front-wheel angle [rad]
+    changing_lanes: bool = False  # a lane change (or its return) is commanded this frame
 
 
 def hard_braking(step: StepTruth) -> bool:
@@ -70,9 +72,10 @@ def hard_braking(step: StepTruth) -> bool:
 
 @dataclass
 class SafetyScorer:
-    """Run-level counts: collisions, pedestrians hit, lane departures (no lane change is ever commanded)."""
+    """Run-level counts: collisions, pedestrians hit, lane departures (a body edge crossing a lane boundary while no
+    lane change is commanded)."""
 
-    departures: int = 0  # times a body edge crossed a lane boundary
+    departures: int = 0  # times a body edge crossed a lane boundary outside a commanded lane change
     crashed: bool = False  # the ego hit something other than a pedestrian (those count in ped_hits)
     ped_hits: set = field(default_factory=set)  # ids of the pedestrians hit
     _outside: bool = False  # a body edge is over a lane boundary this frame
@@ -80,19 +83,21 @@ class SafetyScorer:
     def update(self, step: StepTruth) -> None:
         gt = step.truth
         outside = abs(gt.lane.offset_m) + EGO_WIDTH_M / 2 > gt.lane.width_m / 2
-        if outside and not self._outside:
+        if outside and not self._outside and not step.changing_lanes:
             self.departures += 1
         self._outside = outside
         self.crashed |= gt.crashed and not gt.pedestrians_hit
         self.ped_hits.update(gt.pedestrians_hit)
 
-    def result(self) -> dict:
-        """The run's safety counts, under the names in ``SAFETY_COUNTS``."""
-        return dict(zip(SAFETY_COUNTS, (int(self.crashed), len(self.ped_hits), self.departures)))
+    def result(self, unsafe_lane_changes: int = 0) -> dict:
+        """The run's safety counts, under the names in ``SAFETY_COUNTS``; ``unsafe_lane_changes`` as the lane-change
+        scorer counted them."""
+        return dict(zip(SAFETY_COUNTS, (int(self.crashed), len(self.ped_hits), self.departures, unsafe_lane_changes)))
 
 
 class LaneScorer:
-    """Lane estimate errors (vision) and centering (always: the true offset from the lane centre)."""
+    """Lane estimate errors (vision) and centering (always: the true offset from the lane centre, outside lane
+    changes)."""
 
     def __init__(self, ctx: ScoreContext):
         self.ctx = ctx
@@ -101,7 +106,8 @@ class LaneScorer:
 
     def update(self, path, debug, step: StepTruth) -> None:
         lane = step.truth.lane
-        self.offsets_m.append((lane.offset_m,))
+        if not step.changing_lanes:  # centering is of keeping a lane, not of leaving it
+            self.offsets_m.append((lane.offset_m,))
         est = path.lane if path is not None else None
         if self.ctx.vision and est is not None and est.valid:
             self.errors.append((est.offset_m - lane.offset_m, est.heading_rad - lane.heading_rad,

@@ -7,6 +7,13 @@ from .resume import COUNTS, groups
 
 UNSAFE = COUNTS
 """What makes a run fail ``--strict``: any of the run-level safety counts."""
+RUN_HEADLINES = (("progress.mean_speed_mps", "mean speed [m/s]", "{:.2f}"),
+                 ("progress.set_speed_ratio", "of the set speed", "{:.3f}"),
+                 ("lane_changes.completed", "changes completed", "{:.2f}"),
+                 ("lane_changes.aborted", "changes aborted", "{:.2f}"),
+                 ("lane_changes.peak_lateral_accel_mps2", "peak lateral accel [m/s²]", "{:.2f}"),
+                 ("lane_changes.peak_lateral_jerk_mps3", "peak lateral jerk [m/s³]", "{:.2f}"))
+"""The run-level figures the summaries show beside the tasks' headlines: (metric, label, format)."""
 
 
 def safety_counts(tasks) -> list[tuple[str, str]]:
@@ -22,7 +29,8 @@ def safety_counts(tasks) -> list[tuple[str, str]]:
 
 def higher_is_better(tasks) -> frozenset[str]:
     """The metrics (``<group>.<key>``) where more is better: the realtime factor and those the tasks name."""
-    return frozenset({"realtime_factor"} | {f"{t.name}.{k}" for t in tasks for k in t.higher_is_better})
+    return frozenset({"realtime_factor", "progress.mean_speed_mps", "progress.set_speed_ratio", "progress.distance_m"}
+                     | {f"{t.name}.{k}" for t in tasks for k in t.higher_is_better})
 
 
 def run_metrics(run: dict, tasks) -> dict[str, float]:

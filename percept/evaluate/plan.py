@@ -46,6 +46,10 @@ def parse_seeds(text: str, option: str = "--seeds") -> list[int]:
     return sorted({s for lo, hi in spans for s in range(lo, hi + 1)})
 
 
+EGOS = ("percept", "mobil")
+"""Who may drive a batch's runs (``EvalPlan.ego``)."""
+
+
 @dataclass(frozen=True)
 class Job:
     """One run of the batch."""
@@ -72,10 +76,15 @@ class EvalPlan:
     detector: str = "sim"  # people model of the vision pedestrian slot
     default: Source = Source.VISION  # the source of a task not in slots (as in DriveConfig)
     rear: bool | None = None  # the rear stereo rig: True on, False off, None each scenario's default (DriveConfig.rear)
+    lane_changes: bool = True  # the car changes lanes (DriveConfig.lane_changes)
+    ego: str = "percept"  # who drives: "percept" (its agent) or "mobil" (highway-env's IDM with MOBIL lane changes in
+    # the ego's place, every slot privileged: the anchor for progress)
 
     def __post_init__(self) -> None:
         if not self.scenarios or not self.conditions or not self.seeds:
             raise ValueError("a batch needs at least one scenario, one condition and one seed")
+        if self.ego not in EGOS:
+            raise ValueError(f"--ego must be {' or '.join(EGOS)}, got '{self.ego}'")
         for sc in self.scenarios:
             for c in self.conditions:
                 # builds and validates the whole configuration of one run (names, condition, slots, duration)
@@ -83,8 +92,12 @@ class EvalPlan:
 
     def config(self, job: Job) -> DriveConfig:
         """The drive configuration of one job."""
-        return DriveConfig(WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition), self.duration_s,
-                           dict(self.slots), detector=self.detector, default=self.default, rear=self.rear)
+        mobil = self.ego == "mobil"
+        world = WorldConfig(scenario=job.scenario, seed=job.seed, condition=job.condition, autopilot=mobil,
+                            autopilot_lane_changes=mobil)
+        return DriveConfig(world, self.duration_s, {} if mobil else dict(self.slots), detector=self.detector,
+                           default=Source.PRIVILEGED if mobil else self.default, rear=self.rear,
+                           lane_changes=self.lane_changes and not mobil)
 
     @property
     def tasks(self) -> tuple:

@@ -17,7 +17,7 @@ import numpy as np
 from percept.outputs import write_text_atomic
 
 from .environment import environments
-from .metrics import UNSAFE, higher_is_better, run_metrics, safety_counts
+from .metrics import RUN_HEADLINES, UNSAFE, higher_is_better, run_metrics, safety_counts
 
 
 def _stat_row(name: str, values: list[float], up: bool, total: bool) -> dict:
@@ -43,7 +43,8 @@ def metric_rows(plan, results: list[dict], tasks) -> list[dict]:
 
 
 def reproduce_command(run: dict, settings: dict) -> str:
-    """The ``percept drive`` command that drives this run again with the batch's settings."""
+    """The ``percept drive`` command that drives this run again with the batch's settings (``percept eval`` of that
+    one run when another driver than percept's was in the ego's place)."""
     cmd = ["percept drive", f"--scenario {run['scenario']}", f"--seed {run['seed']}",
            f"--condition {run['condition']}"]
     # every slot is on vision unless told otherwise: --privileged when none is, else each privileged slot
@@ -58,6 +59,11 @@ def reproduce_command(run: dict, settings: dict) -> str:
         cmd.append(f"--detector {settings['detector']}")
     if settings.get("rear") is not None:
         cmd.append("--rear" if settings["rear"] else "--no-rear")
+    if settings.get("lane_changes") is False:
+        cmd.append("--lane-changes off")
+    if settings.get("ego", "percept") != "percept":  # another driver: only evaluation puts it in the ego's place
+        cmd = [f"percept eval --ego {settings['ego']}", f"--scenario {run['scenario']}", f"--seeds {run['seed']}",
+               f"--condition {run['condition']}"] + cmd[4:]
     return " ".join(cmd)
 
 
@@ -133,7 +139,8 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
             cells = [_fmt((rows.get((sc, c, k)) or {}).get("total"), "{:.0f}") for k, _ in safety]
             lines.append(f"| {sc} | {c} | {n} | {failed} | " + " | ".join(cells) + " |")
     lines += ["", "## Headline metrics (mean / p95 / worst over the seeds)", ""]
-    heads = [(f"{t.name}.{h.key}", f"{t.name}: {h.label}") for t in tasks for h in t.headline]
+    heads = [(k, label) for k, label, _ in RUN_HEADLINES] + [(f"{t.name}.{h.key}", f"{t.name}: {h.label}")
+                                                            for t in tasks for h in t.headline]
     heads = [(k, label) for k, label in heads if any(key[2] == k for key in rows)]
     if heads:
         lines += ["| scenario | condition | " + " | ".join(label for _, label in heads) + " |",

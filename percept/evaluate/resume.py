@@ -21,15 +21,15 @@ if TYPE_CHECKING:
 
 
 def groups(tasks=None) -> tuple[str, ...]:
-    """Metric groups every run JSON has (objects): one per task (of the slot table unless given), and
-    ``timing_ms``."""
-    return tuple(t.name for t in (tasks or tasks_module.TASKS)) + ("timing_ms",)
+    """Metric groups every run JSON has (objects): one per task (of the slot table unless given), ``timing_ms``,
+    ``progress`` and ``lane_changes``."""
+    return tuple(t.name for t in (tasks or tasks_module.TASKS)) + ("timing_ms", "progress", "lane_changes")
 
 
 def run_settings(plan: EvalPlan) -> dict:
     """Everything besides the scenario, condition and seed that changes a run's result (a JSON object; two runs
     are comparable only if theirs are equal): percept version, duration, slot sources, rendering, world options, the
-    rear rig option (None: each scenario's default; a run file without it was made so)."""
+    rear rig option (None: each scenario's default; a run file without it was made so), lane changes on or off."""
     from importlib.metadata import version
 
     cfg = plan.config(plan.jobs[0])
@@ -37,7 +37,8 @@ def run_settings(plan: EvalPlan) -> dict:
             "slots": {name: src.value for name, src in cfg.sources.items()}, "render": cfg.needs_cameras,
             "detector": cfg.detector if cfg.uses_detector else None,
             "world": {"rig": cfg.world.rig.to_dict(), "scenery": cfg.world.scenery,
-                      "autopilot": cfg.world.autopilot}, "rear": plan.rear}
+                      "autopilot": cfg.world.autopilot}, "rear": plan.rear, "lane_changes": plan.lane_changes,
+            "ego": plan.ego}
 
 
 def differences(now: dict, then) -> list[str]:

@@ -77,7 +77,9 @@ class LaneDetector:
             fresh = fit_lane(ev, None, self.cfg.fit)
             if fresh is not None and (fit is None or fresh.estimate.confidence > fit.estimate.confidence):
                 fit = fresh
-                self.tracker.reset()
+                # the fresh lane may be another than the one tracked: index + round((offset_pred - offset_new) / w)
+                moved = round((prior.offset_m - fresh.estimate.offset_m) / max(prior.width_m, 1.0))
+                self.tracker.reset(index=self.tracker.index + moved)
         if fit is not None:
             self.tracker.update(fit)
         return self.tracker.estimate, LaneDebug(ev, fit)

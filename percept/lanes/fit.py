@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .line_kind import line_kind
 from .types import LaneEstimate, LaneFit, MarkingEvidence
 
 
@@ -260,4 +261,8 @@ def fit_lane(ev: MarkingEvidence, prior: LaneEstimate | None, cfg: FitConfig = F
     # (a0, a1, a2, w, a3) -> (offset, heading, curvature, curvature_rate, width): rows of the Jacobian
     J = np.zeros((5, 5))
     J[0, 0], J[1, 1], J[2, 2], J[3, 4], J[4, 3] = -1.0, -1.0 / (1 + a1 * a1), 2.0, 6.0, 1.0
-    return LaneFit(est, np.where(best.used, best.sides, 0), res, nl, nr, J @ best.cov @ J.T, ambiguity)
+    side = np.where(best.used, best.sides, 0)
+    inlier = np.zeros(len(side), bool)
+    inlier[np.flatnonzero(best.used)[inl]] = True
+    broken = tuple(line_kind(ev.points_m[inlier & (side == s), 0]) for s in (1, -1))
+    return LaneFit(est, side, res, nl, nr, J @ best.cov @ J.T, ambiguity, broken)

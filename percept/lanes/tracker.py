@@ -6,7 +6,9 @@ fixed in the world; the curvature under the car changes along a clothoid at the 
     heading'   = heading + r dt - d (curvature + c1 d / 2)
     curvature' = curvature + c1 d
 with the curvature rate and the width as random walks. The measurement is the frame's fit with its covariance.
-Confidence decays while evidence is missing.
+Confidence decays while evidence is missing. The lane tracked is the one the car's centre is in: once the centre
+crosses a boundary the track moves to the lane beyond (``shift``), as highway-env's own lane index does, and counts
+the move in ``index``. Whether each boundary is a broken line (a lane beyond) is a vote over the frames' fits.
 Reference: Dickmanns & Mysliwetz, "Recursive 3-D road and relative ego-state recognition", PAMI 1992 (the
 clothoid road model with curvature rate in the state).
 """
@@ -21,6 +23,15 @@ from percept.sensors import plausible_speed, plausible_yaw_rate
 from .types import LaneEstimate, LaneFit
 
 
+KIND_GAIN = 0.2
+"""How much one frame's broken-or-solid verdict moves a boundary's vote (an exponential average over about 5 frames)."""
+KIND_VOTE = 0.5
+"""A boundary is broken (solid) once its vote passes +this (-this); between the two it is not known."""
+SHIFT_MARGIN_M = 0.1
+"""The car's centre must be this far past a boundary before the track moves to the lane beyond [m]: a centre on the
+line, its offset jittering by centimetres, does not move the track back and forth."""
+
+
 class LaneTracker:
     """Tracks the ego lane; ``predict`` every frame, ``update`` when a fit exists."""
 
@@ -29,7 +40,10 @@ class LaneTracker:
         self.rate_sigma = curvature_rate_sigma_1pm2
         self.reset()
 
-    def reset(self) -> None:
+    def reset(self, index: int = 0) -> None:
+        """Forget the lane; ``index``: the lane count to go on from (a fresh search keeps it)."""
+        self.index = index  # lanes moved to the left since the first one tracked
+        self.votes = np.zeros(2)  # (left, right) boundary: +1 broken ... -1 solid
         kf = KalmanFilter(dim_x=5, dim_z=5)
         kf.x = np.array([0.0, 0.0, 0.0, 0.0, self.width_prior])
         kf.P = np.diag([1.0, 0.05, 1e-4, 1e-8, 0.25])
@@ -80,10 +94,33 @@ class LaneTracker:
                 return
             self.kf.update(z, R=R)
         self.confidence = min(1.0, 0.5 * self.confidence + 0.5 * e.confidence + 0.2)
+        for i, broken in enumerate(fit.broken):
+            if broken is not None:
+                self.votes[i] += KIND_GAIN * ((1.0 if broken else -1.0) - self.votes[i])
+        self._follow_the_centre()
+
+    def _follow_the_centre(self) -> None:
+        """Once the car's centre is past a boundary (|offset| > w / 2 + SHIFT_MARGIN_M), track the lane beyond
+        (``shift``)."""
+        offset, width = float(self.kf.x[0]), float(self.kf.x[4])
+        if self.initialised and abs(offset) > width / 2 + SHIFT_MARGIN_M:
+            self.shift(1 if offset > 0 else -1)
+
+    def shift(self, side: int) -> None:
+        """Track the lane beside, on ``side`` (+1 left, -1 right): offset' = offset - side w (the covariance moved
+        with it), the boundary crossed now on the other side, the one beyond not yet known."""
+        J = np.eye(5)
+        J[0, 4] = -side
+        self.kf.x = J @ self.kf.x
+        self.kf.P = J @ self.kf.P @ J.T
+        crossed = self.votes[0 if side > 0 else 1]
+        self.votes = np.array([0.0, crossed]) if side > 0 else np.array([crossed, 0.0])
+        self.index += side
 
     @property
     def estimate(self) -> LaneEstimate:
         """The tracked lane (invalid until the first fit) with the tracker's confidence."""
         x = self.kf.x
+        beside = tuple(True if v > KIND_VOTE else False if v < -KIND_VOTE else None for v in self.votes)
         return LaneEstimate(float(x[0]), float(x[1]), float(x[2]), float(x[4]), float(self.confidence),
-                            valid=self.initialised, curvature_rate_1pm2=float(x[3]))
+                            valid=self.initialised, curvature_rate_1pm2=float(x[3]), index=self.index, beside=beside)

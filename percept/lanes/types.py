@@ -29,7 +29,7 @@ class LaneFit:
     -1 right, 0 outlier, per evidence point; residual_m: RMS residual of the inliers [m]; cov: (5, 5)
     covariance of (offset, heading, curvature, curvature_rate, width) from the least-squares normal equations;
     ambiguity: the support of the best rival lane (other boundaries, also about the car) as a share of both, 0..0.5
-    (0: no rival)."""
+    (0: no rival); broken: whether each boundary's paint is a broken line (``line_kind``)."""
 
     estimate: LaneEstimate
     side: np.ndarray
@@ -38,3 +38,5 @@ class LaneFit:
     inliers_right: int
     cov: np.ndarray
     ambiguity: float = 0.0
+    broken: tuple = (None, None)  # (left, right): each boundary's paint broken (True), solid (False) or not known
+    # (None), ``line_kind.line_kind`` of its inlier points

@@ -60,14 +60,21 @@ class NeighbourSlot:
         self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m + reach)
         self.rear = RigFinder(rear_rig, -cfg.behind_m - reach, cfg.rear_near_m) if rear_rig else None
         self.tracker = NeighbourTracker(dt_s, tracker)
+        self._index: int | None = None  # the lane estimate's index on the last frame with one
 
     def reset(self) -> None:
         self.tracker.reset()
+        self._index = None
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Neighbours, NeighbourDebug]:
         path: EgoPath = upstream[EgoPath]
         lane = path.lane if path.follows_lane else None
         width = float(lane.width_m) if lane is not None else DEFAULT_LANE_WIDTH_M
+        if lane is not None:
+            # the ego's lane moved (a lane change): every track's lateral position is now from the new lane's centre
+            if self._index is not None and lane.index != self._index:
+                self.tracker.shift_lanes((lane.index - self._index) * width)
+            self._index = lane.index
         detections: dict[str, list[Detection]] = {}
         points = {}
         if not frame.dropped:

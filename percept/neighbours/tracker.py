@@ -113,6 +113,13 @@ class NeighbourTracker:
         """How many frames ``TrackerConfig.recent_s`` spans (``Track.seen`` counts over them)."""
         return max(round(self.cfg.recent_s / self.dt), 1)
 
+    def shift_lanes(self, moved_m: float) -> None:
+        """The lane coordinates moved ``moved_m`` [m] to the left (the ego changed lanes): each track's lateral
+        position is taken from the new centre line, l' = l - moved, and its lane follows."""
+        for t in self.tracks:
+            t.kf.x[2, 0] -= moved_m
+            t.lane = None if t.lane is None else int(round(t.lat / self.width))
+
     def in_blind_band(self, x_m: float, lat_m: float, width_m: float) -> bool:
         """Whether a centre at (x_m, lat_m) lies where neither rig sees: beside the ego in a lane beside it."""
         return self.cfg.blind_behind_m <= x_m <= self.cfg.blind_ahead_m and abs(lat_m) >= 0.5 * width_m
@@ -136,7 +143,8 @@ class NeighbourTracker:
         for i, t in enumerate(self.tracks):
             for j, d in enumerate(dets):
                 # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
-                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m
+                # and the track's (a car held unseen in the blind band may come out anywhere along it)
+                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m + 2 * self.sigma_x(t)
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
                 if dx <= gate_x and dl <= c.gate_l_m and self._may_take_over(t, d):
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))

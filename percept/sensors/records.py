@@ -41,6 +41,13 @@ class LaneEstimate:
     confidence: float  # 0..1; 0: no evidence, the values are a prediction
     valid: bool = True  # False before the first fit
     curvature_rate_1pm2: float = 0.0  # change of the curvature per metre ahead [1/m^2] (a clothoid)
+    index: int = 0  # lanes the ego lane lies to the left of the first one tracked (+1 each change to the left)
+    beside: tuple = (None, None)  # (left, right): is there a lane beyond that boundary: True (a broken line), False
+    # (a solid line: the road's edge), None (not known)
+
+    def lane_beside(self, side: int) -> bool | None:
+        """Whether there is a lane beyond the boundary on ``side`` (+1 left, -1 right); None when not known."""
+        return self.beside[0 if side > 0 else 1]
 
     def centre_y(self, x_m: np.ndarray) -> np.ndarray:
         """Lateral position of the lane centre at distances x_m ahead [m]."""
@@ -238,6 +245,10 @@ class Neighbours:
         track may be in it."""
         return not any(n.lane == lane and -behind_m - 3 * n.sigma_x_m <= n.x_m <= ahead_m + 3 * n.sigma_x_m
                        for n in self.tracks)
+
+    def nearest(self, lane: int, zone: Zone) -> Neighbour | None:
+        """The nearest track in ``lane`` (-1, 0, +1) and ``zone``; None when there is none."""
+        return next((n for n in self.tracks if n.lane == lane and n.zone is zone), None)
 
     def cutting_in(self) -> Neighbour | None:
         """The nearest neighbour ahead in a lane beside flagged as cutting in (the following law treats it as a lead

@@ -31,7 +31,8 @@ class NoObservation(ObservationType):
 
 
 class AutopilotVehicle(IDMVehicle):
-    """highway-env's IDM car, kept in its lane, that brakes to a standstill but never reverses."""
+    """highway-env's IDM car (changing lanes by its MOBIL where enabled) that brakes to a standstill but never
+    reverses."""
 
     def step(self, dt: float) -> None:
         super().step(dt)
@@ -39,7 +40,8 @@ class AutopilotVehicle(IDMVehicle):
 
 
 class PerceptEnv(AbstractEnv):
-    """Config keys beyond highway-env's: ``scenario`` (a Scenario), ``scenario_seed`` (int), ``autopilot`` (bool)."""
+    """Config keys beyond highway-env's: ``scenario`` (a Scenario), ``scenario_seed`` (int), ``autopilot`` (bool),
+    ``autopilot_lane_changes`` (bool: the autopilot changes lanes by MOBIL)."""
 
     @classmethod
     def default_config(cls) -> dict:
@@ -55,6 +57,7 @@ class PerceptEnv(AbstractEnv):
             "scenario": None,
             "scenario_seed": 0,
             "autopilot": False,
+            "autopilot_lane_changes": False,
         })
         return cfg
 
@@ -80,12 +83,13 @@ class PerceptEnv(AbstractEnv):
         self.scripted = [v for v in self.road.vehicles if isinstance(v, ScriptedVehicle)]
 
     def make_ego(self, lane_index, longitudinal: float, speed: float):
-        """The controlled vehicle: highway-env's kinematic Vehicle, or an IDM autopilot that keeps its lane."""
+        """The controlled vehicle: highway-env's kinematic Vehicle, or an IDM autopilot (keeping its lane, or changing
+        lanes by MOBIL with ``autopilot_lane_changes``)."""
         lane = self.road.network.get_lane(lane_index)
         pos, heading = lane.position(longitudinal, 0.0), lane.heading_at(longitudinal)
         if self.config["autopilot"]:
             ego = AutopilotVehicle(self.road, pos, heading, speed, target_lane_index=lane_index, target_speed=speed,
-                             enable_lane_change=False)
+                             enable_lane_change=bool(self.config["autopilot_lane_changes"]))
         else:
             ego = self.action_type.vehicle_class(self.road, pos, heading, speed)
         self.cruise_speed_mps = float(speed)

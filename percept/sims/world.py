@@ -48,6 +48,8 @@ class WorldConfig:
     rig: StereoRig = field(default_factory=StereoRig)  # the stereo rig on the ego
     # True for rendering data sets: highway-env's IDM drives the ego instead of the actions passed to ``step``
     autopilot: bool = False
+    # with the autopilot: it also changes lanes by highway-env's own MOBIL (the anchor for lane-change progress)
+    autopilot_lane_changes: bool = False
     scenery: bool = True  # roadside clutter (rails, poles, trees, buildings) on or off
     # the rear-facing rig (looking straight back, e.g. ``percept.sensors.rear_rig(rig)``), rendered beside the
     # forward one; None: the car has none
@@ -83,7 +85,8 @@ class SimWorld:
         self.cfg = cfg
         self.scenario = SCENARIOS[cfg.scenario]
         self.env = PerceptEnv(config={"scenario": self.scenario, "scenario_seed": cfg.seed,
-                                      "autopilot": cfg.autopilot})
+                                      "autopilot": cfg.autopilot,
+                                      "autopilot_lane_changes": cfg.autopilot_lane_changes})
         self.env.reset(seed=cfg.seed)
         self.dt = 1.0 / self.env.config["simulation_frequency"]
         self.road_geometry = build_road_geometry(self.env.road.network)

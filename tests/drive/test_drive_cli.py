@@ -12,7 +12,8 @@ from percept.cli.view_cmd import rerun_executable
 
 runner = CliRunner()
 KEYS = ["scenario", "condition", "seed", "duration_s", "frames", "realtime_factor", "collisions",
-        "pedestrian_collisions", "lane_departures", "lanes", "longitudinal", "pedestrians", "odometry", "timing_ms"]
+        "pedestrian_collisions", "lane_departures", "unsafe_lane_changes", "lanes", "longitudinal", "pedestrians",
+        "odometry", "timing_ms", "progress", "lane_changes"]
 
 
 def rerun_bin() -> str:

@@ -154,7 +154,8 @@ def test_drive_config_names_the_bad_task_or_source():
 
 
 @pytest.mark.parametrize("scenario, seed, group, key, value", [
-    # the privileged closed loop's metrics, pinned: any change of behaviour must be deliberate
+    # the privileged closed loop's metrics with the car keeping its lane, pinned: any change of behaviour must be
+    # deliberate
     ("lead-brake", 0, "longitudinal", "time_gap_min_s", 1.5985146569594249),
     ("lead-brake", 0, "longitudinal", "time_gap_steady_s", 1.8062480963572944),
     ("cut-in", 1, "longitudinal", "time_gap_min_s", 0.5011582284823995),
@@ -163,7 +164,7 @@ def test_drive_config_names_the_bad_task_or_source():
     ("crossing", 2, "pedestrians", "stops", [True, True, True]),
 ])
 def test_privileged_metrics_are_pinned(scenario, seed, group, key, value):
-    r = run_drive(DriveConfig(WorldConfig(scenario, seed), default="privileged"), render=False)
+    r = run_drive(DriveConfig(WorldConfig(scenario, seed), default="privileged", lane_changes=False), render=False)
     # to a millionth: numpy picks its SIMD kernels by the CPU, so sums round differently on another machine (in the
     # 16th digit); a change of behaviour moves these figures by far more
     assert r[group][key] == (pytest.approx(value, rel=1e-6, abs=0) if isinstance(value, float) else value)

@@ -27,7 +27,7 @@ def run(seed, collisions=0, recall=None, offset=0.01, stops=None, phantom=0, tra
                "trajectory": {"every_frames": 15, "true": [[0, 0], [10, 0], [20, 1]],
                               "estimate": [[0, 0], [10, 0.1], [20, 1.2]]}}
     return {"scenario": "highway", "condition": "clear", "seed": seed, "frames": 10, "collisions": collisions,
-            "pedestrian_collisions": 0, "lane_departures": 0, "realtime_factor": 2.0 + seed,
+            "pedestrian_collisions": 0, "lane_departures": 0, "unsafe_lane_changes": 0, "realtime_factor": 2.0 + seed,
             "lanes": {"offset_rmse_m": offset, "centering_rms_m": 0.05},
             "longitudinal": {"phantom_brakes": phantom, "range_abs_rel_err_by_bin": {"0-20": 0.01, "20-40": 0.02}},
             "pedestrians": {"recall": recall, "stops": stops}, "odometry": odo, "timing_ms": {"lanes": 1.0}}
@@ -76,7 +76,7 @@ def test_stops_for_no_one_are_listed_and_summed_but_do_not_fail_strict(tmp_path)
     assert rows["false_stops"]["total"] == 1 and rows["brakes_for_no_one"]["total"] == 2
     write_reports(PLAN, runs, SETTINGS, tmp_path, TASKS)
     md = (tmp_path / "summary.md").read_text()
-    assert "| highway | clear | 2 | 0 | 0 | 0 | 0 | 0 | 0 | 1 | 2 |" in md
+    assert "| highway | clear | 2 | 0 | 0 | 0 | 0 | 0 | 0 | 0 | 1 | 2 |" in md
     assert "seed 1: 1 false stops, 2 brakes for no one — `percept drive --scenario highway --seed 1" in md
 
 

@@ -21,6 +21,13 @@ def segments(net, lane_id: int):
     return [net.graph[a][b][lane_id] for a, b in zip(nodes, nodes[1:] + ["0"]) if b in net.graph.get(a, {})]
 
 
+def probe(net, lane, s: float):
+    """A stand-in ego on ``lane`` of ``net`` at ``s`` along it, as ``lane_truth`` reads one."""
+    position = lane.position(s, 0.0)
+    return types.SimpleNamespace(lane=lane, position=position, heading=lane.heading_at(s),
+                                 lane_index=net.get_closest_lane_index(position), road=types.SimpleNamespace(network=net))
+
+
 def test_curves_radii_and_curvature_sign_of_every_arc(scenario_env):
     for seed in range(3):
         e = scenario_env("curves", seed)
@@ -34,9 +41,7 @@ def test_curves_radii_and_curvature_sign_of_every_arc(scenario_env):
         # highway-env's clockwise arcs (y down) turn right
         for lane in segments(net, 1):
             s = lane.length / 2
-            probe = types.SimpleNamespace(lane=lane, position=lane.position(s, 0.0), heading=lane.heading_at(s),
-                                          lane_index=("?", "?", 1))
-            k = lane_truth(probe).curvature_1pm
+            k = lane_truth(probe(net, lane, s)).curvature_1pm
             if isinstance(lane, CircularLane):
                 expect = (-1.0 if lane.clockwise else 1.0) / lane.radius
             elif isinstance(lane, ClothoidLane):
@@ -55,9 +60,7 @@ def test_curves_curvature_is_continuous_through_clothoid_transitions(scenario_en
     ks = []
     for lane in lanes:
         for s in np.arange(0.0, lane.length, 1.0):
-            probe = types.SimpleNamespace(lane=lane, position=lane.position(s, 0.0), heading=lane.heading_at(s),
-                                          lane_index=("?", "?", 1))
-            ks.append(lane_truth(probe).curvature_1pm)
+            ks.append(lane_truth(probe(e.road.network, lane, s)).curvature_1pm)
     # steepest spiral: 1/150 m over 50 m (reverse curves: 2/150 over 100 m); with 1 m steps and the ±1 m
     # central difference, one sample may straddle a join
     assert np.max(np.abs(np.diff(ks))) < 2.5 * (1 / 150) / 50

@@ -1,0 +1,154 @@
+"""Lane changes: when MOBIL favours a lane beside (``mobil.judge``), a minimum-jerk path into it that lane keeping
+follows, and a return to the lane it left when the target gap closes before the car is across.
+
+The law reads records only: the ego path (its lane, the lane's ``index`` and which boundaries have a lane beyond
+them) and the neighbours. A change starts once MOBIL has favoured the same side for ``settle_s`` (a verdict that
+flickers with perception's noise starts nothing) and ``min_interval_s`` after the last one ended. The path is planned
+in the frame of the lane the change started from; the lane estimate moves to the target lane as the car's centre
+crosses the boundary (its ``index`` changes), and the reference moves with it: offset in the current lane =
+offset in the start lane - (index - index_start) w.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+
+from percept.sensors import EgoPath, Neighbours
+
+from .base import Controller
+from .lateral_path import LateralRef, MinJerkPath
+from .mobil import Judgement, MobilConfig, judge
+
+PLAN_POINTS = 12
+"""Points of the rest of the path in the debug record (the review draws them)."""
+UNSAFE = ("beside", "gap ahead", "gap behind", "follower brakes")
+"""MOBIL's reasons that end a change not yet across the boundary (the gain may fade without ending it)."""
+
+
+class Phase(str, Enum):
+    """What the law is doing."""
+
+    KEEP = "keep"  # keeping the lane
+    CHANGE = "change"  # on the path into the lane beside
+    RETURN = "return"  # on the path back into the lane it left (an aborted change)
+
+
+@dataclass(frozen=True)
+class LaneChangeConfig:
+    """When to change lanes and how."""
+
+    duration_s: float = 5.0  # T: how long a change (or a return) takes [s]
+    settle_s: float = 1.0  # how long MOBIL must favour the same side before a change starts [s]
+    min_interval_s: float = 8.0  # least time from the end of one change to the start of the next [s]
+    mobil: MobilConfig = field(default_factory=MobilConfig)  # the decision's parameters
+
+
+@dataclass(frozen=True)
+class LaneChangeDebug:
+    """How the lane-change law decided this frame."""
+
+    phase: Phase  # what it is doing
+    side: int  # the side of the change under way (+1 left, -1 right; 0 none)
+    reason: str  # why, in words: MOBIL's gain for the side taken, its reasons for those not taken, or "too soon",
+    # "no lane estimate", "on the path", "arrived", "not across" (a path that ended short of the target lane)
+    judgements: tuple[Judgement, ...]  # MOBIL's verdicts this frame
+    event: str | None  # "started", "completed" or "aborted" on the frame it happened, else None
+    ref: LateralRef | None  # the lateral reference handed to lane keeping (None: keep the lane's centre)
+    plan_m: tuple = ()  # the rest of the path as (ahead [m], offset from the current lane's centre [m]) points at
+    # the ego's speed (PLAN_POINTS of them; empty outside a change)
+    into_lane: int = 0  # the target lane relative to the current one while the car is not yet across it (+1 left,
+    # -1 right), else 0: the following law watches that lane's nearest car ahead as well
+
+
+class LaneChange(Controller):
+    """The lateral reference for lane keeping: None while keeping the lane, the path's point during a change."""
+
+    def __init__(self, set_speed_mps: float, cfg: LaneChangeConfig = LaneChangeConfig()):
+        """set_speed_mps: the speed the car wants [m/s] (MOBIL's desired speed for the ego)."""
+        self.set_speed, self.cfg = set_speed_mps, cfg
+        self.reset()
+
+    def reset(self) -> None:
+        self.phase, self.side = Phase.KEEP, 0
+        self.t_s = 0.0  # time on the current path [s]
+        self.since_end_s = self.cfg.min_interval_s  # time since the last change ended [s]
+        self.favour, self.favour_s = 0, 0.0  # the side MOBIL favours, and for how long [s]
+        self.path: MinJerkPath | None = None  # in the start lane's frame
+        self.index0 = 0  # the lane index the change started from
+        self.width0 = 0.0  # the lane width it was planned with [m]
+
+    def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
+               dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
+        """The reference (None: the lane's centre) and the debug record, from the ego path, the neighbours (None:
+        nothing is known around the car, so no change starts; one under way goes on), the speed [m/s] and the frame
+        period ``dt`` [s]. Without a view behind (``Neighbours.rear`` False) no change starts either."""
+        if not path.follows_lane:  # nothing to steer along: a path under way runs on unseen
+            self.favour, self.favour_s = 0, 0.0
+            self.t_s += dt if self.phase is not Phase.KEEP else 0.0
+            return None, LaneChangeDebug(self.phase, self.side, "no lane estimate", (), None, None)
+        if self.phase is Phase.KEEP:
+            return self._keep(path, neighbours, speed_mps, dt)
+        return self._follow(path, neighbours, speed_mps, dt)
+
+    def _keep(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
+              dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
+        """Keeping the lane: MOBIL on both sides; a change starts on the side favoured for ``settle_s``."""
+        self.since_end_s += dt
+        lane = path.lane
+        seen = neighbours is not None and neighbours.rear
+        verdicts = tuple(judge(s, lane.lane_beside(s), neighbours, speed_mps, self.set_speed, self.cfg.mobil)
+                         for s in (1, -1)) if seen else ()
+        best = max((j for j in verdicts if j.go), key=lambda j: j.gain_mps2, default=None)
+        side = best.side if best is not None else 0
+        self.favour_s = self.favour_s + dt if side == self.favour and side else 0.0
+        self.favour = side
+        reason = (f"gain {best.gain_mps2:.2f} m/s², new follower {best.imposed_mps2:+.2f} m/s²" if best is not None
+                  else _why_not(verdicts))
+        if best is None or self.favour_s < self.cfg.settle_s:
+            return None, LaneChangeDebug(self.phase, 0, reason, verdicts, None, None)
+        if self.since_end_s < self.cfg.min_interval_s:
+            return None, LaneChangeDebug(self.phase, 0, "too soon", verdicts, None, None)
+        self.phase, self.side, self.t_s, self.index0, self.width0 = Phase.CHANGE, side, 0.0, lane.index, lane.width_m
+        self.path = MinJerkPath.between(lane.offset_m, 0.0, 0.0, side * lane.width_m, self.cfg.duration_s)
+        ref = self.path.at(0.0)
+        return ref, LaneChangeDebug(self.phase, side, reason, verdicts, "started", ref, into_lane=side)
+
+    def _follow(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
+                dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
+        """On a path: its point in the current lane's frame; a change not yet across returns when MOBIL's safety
+        fails on its side; the path's end ends the manoeuvre."""
+        self.t_s += dt
+        crossed = path.lane.index - self.index0
+        planned = self.path.at(self.t_s)
+        event, verdicts, reason = None, (), "on the path"
+        if self.t_s >= self.path.duration_s:
+            return self._end(crossed)
+        if self.phase is Phase.CHANGE and not crossed and neighbours is not None:
+            verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
+            verdicts, reason = (verdict,), verdict.reason
+            if verdict.reason in UNSAFE:
+                self.phase, event, self.t_s = Phase.RETURN, "aborted", 0.0
+                self.path = MinJerkPath.between(planned.offset_m, planned.rate_mps, planned.accel_mps2, 0.0,
+                                                self.cfg.duration_s)
+        # offset in the current lane = offset in the start lane - (index - index_start) w (the width planned with)
+        shift = crossed * self.width0
+        ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2)
+        ahead = [self.t_s + k * (self.path.duration_s - self.t_s) / (PLAN_POINTS - 1) for k in range(PLAN_POINTS)]
+        plan = tuple((speed_mps * (t - self.t_s), self.path.at(t).offset_m - shift) for t in ahead)
+        into = self.side if self.phase is Phase.CHANGE and not crossed else 0
+        return ref, LaneChangeDebug(self.phase, self.side, reason, verdicts, event, ref, plan, into)
+
+    def _end(self, crossed: int) -> tuple[None, LaneChangeDebug]:
+        """The path's end: a change is completed when the lane estimate has moved to the target lane, else (it never
+        got across) it counts as aborted; a return just ends."""
+        side, changing = self.side, self.phase is Phase.CHANGE
+        event = ("completed" if crossed == side else "aborted") if changing else None
+        self.phase, self.side, self.since_end_s = Phase.KEEP, 0, 0.0
+        reason = "arrived" if event != "aborted" else "not across"
+        return None, LaneChangeDebug(self.phase, side, reason, (), event, None)
+
+
+def _why_not(verdicts: tuple[Judgement, ...]) -> str:
+    """The reasons no side is taken, left's then right's."""
+    return "; ".join(f"{'left' if j.side > 0 else 'right'}: {j.reason}" for j in verdicts) or "no neighbours"

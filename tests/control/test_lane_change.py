@@ -1,0 +1,175 @@
+"""Analytic checks of the lane-change laws: the minimum-jerk path, MOBIL on neighbours records, the decision and the
+manoeuvre, and lane keeping on a lateral reference."""
+
+import math
+
+import numpy as np
+import pytest
+
+from percept.control import (LaneChange, LaneChangeConfig, LaneKeeping, LateralRef, MinJerkPath, MobilConfig, Phase,
+                             idm_accel, judge, nearest_target)
+from percept.sensors import EgoPath, LaneEstimate, Neighbour, Neighbours, Zone, zone_and_gap
+from percept.sensors.vehicle import EGO_LENGTH_M
+
+W = 4.0
+V = 25.0
+DT = 1 / 15
+
+
+def car(lane, x, rel=0.0, sigma_x=0.2, sigma_v=0.3, track_id=1):
+    """A neighbour in ``lane`` with its centre ``x`` ahead of the ego's, ``rel`` faster."""
+    zone, gap = zone_and_gap(x, EGO_LENGTH_M)
+    return Neighbour(track_id, lane, zone, x, gap, rel, 0.0, 0.0, EGO_LENGTH_M, sigma_x, sigma_v, 0.1)
+
+
+def around(*cars):
+    return Neighbours(tuple(sorted(cars, key=lambda n: (n.lane, abs(n.x_m)))))
+
+
+def path(offset=0.0, index=0, beside=(True, True), speed=V):
+    return EgoPath(LaneEstimate(offset, 0.0, 0.0, W, 1.0, index=index, beside=beside), speed)
+
+
+def test_a_rest_to_rest_path_asks_the_textbook_peaks():
+    p = MinJerkPath.between(0.0, 0.0, 0.0, W, 5.0)
+    t = np.linspace(0, 5, 5001)
+    refs = [p.at(x) for x in t]
+    y = np.array([r.offset_m for r in refs])
+    a = np.array([r.accel_mps2 for r in refs])
+    assert y[0] == 0 and y[-1] == pytest.approx(W) and refs[-1].rate_mps == pytest.approx(0, abs=1e-9)
+    # peak acceleration 10 D / (sqrt(3) T^2), peak jerk 60 D / T^3 (at the ends)
+    assert np.abs(a).max() == pytest.approx(10 * W / (math.sqrt(3) * 25), rel=1e-3)
+    assert np.abs(np.diff(a) / np.diff(t)).max() == pytest.approx(60 * W / 125, rel=1e-2)
+    # held at the end
+    assert p.at(9.0) == p.at(5.0)
+
+
+def test_a_path_from_motion_starts_where_the_car_is_and_ends_at_rest():
+    p = MinJerkPath.between(1.5, 1.2, -0.3, 0.0, 4.0)
+    start, end = p.at(0.0), p.at(4.0)
+    assert (start.offset_m, start.rate_mps, start.accel_mps2) == pytest.approx((1.5, 1.2, -0.3))
+    assert (end.offset_m, end.rate_mps, end.accel_mps2) == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+    with pytest.raises(ValueError, match="duration_s must be positive"):
+        MinJerkPath.between(0.0, 0.0, 0.0, W, 0.0)
+
+
+def test_idm_accelerates_on_a_free_road_and_brakes_behind_a_slow_car():
+    assert idm_accel(20.0, 30.0) == pytest.approx(3.0 * (1 - (20 / 30) ** 4))
+    assert idm_accel(30.0, 30.0) == pytest.approx(0.0)
+    assert idm_accel(25.0, 30.0, gap_m=20.0, closing_mps=5.0) < -3.0
+
+
+def test_mobil_leaves_a_slow_lead_for_a_free_lane_and_names_why_not_otherwise():
+    slow = car(0, 35.0, rel=-6.0)
+    verdict = judge(1, True, around(slow), V, 30.0)
+    assert verdict.go and verdict.gain_mps2 > 0.2
+    assert judge(1, False, around(slow), V, 30.0).reason == "no lane"
+    assert judge(1, None, around(slow), V, 30.0).reason == "no lane"
+    assert judge(1, True, around(slow, car(1, 0.0, track_id=2)), V, 30.0).reason == "beside"
+    assert judge(1, True, around(slow, car(1, 20.0, track_id=2)), V, 30.0).reason == "gap ahead"
+    assert judge(1, True, around(slow, car(1, -20.0, rel=2.0, track_id=2)), V, 30.0).reason == "gap behind"
+    # far enough behind for the time gap, but closing fast: it would have to brake hard
+    assert judge(1, True, around(slow, car(1, -50.0, rel=8.0, track_id=2)), V, 30.0).reason == "follower brakes"
+    # nothing to gain behind a lead far ahead and pulling away
+    assert judge(1, True, around(car(0, 80.0, rel=10.0)), V, 30.0).reason == "no gain"
+
+
+def test_perception_margins_make_mobil_more_careful():
+    # a follower 55 m back at the ego's speed: safe as measured (IDM brakes it by 1.8 m/s²), not with its gap 3 m
+    # uncertain
+    sure, unsure = car(1, -60.0, sigma_x=0.2), car(1, -60.0, sigma_x=3.0)
+    slow = car(0, 35.0, rel=-6.0, track_id=2)
+    assert judge(1, True, around(slow, sure), V, 30.0).go
+    assert not judge(1, True, around(slow, unsure), V, 30.0).go
+    assert judge(1, True, around(slow, unsure), V, 30.0, MobilConfig(sigmas=0.0)).go
+
+
+def run_law(law, frames, neighbours, start_index=0, width=W):
+    """Drive the law for ``frames`` on a car that follows the reference exactly; the lane estimate moves to the
+    lane beside as the car's centre crosses its boundary. Returns (debug records, offsets from the start lane)."""
+    index, offset, out, ys = start_index, 0.0, [], []
+    for _ in range(frames):
+        ref, dbg = law.update(path(offset, index), neighbours, V, DT)
+        out.append(dbg)
+        if ref is not None:
+            offset = ref.offset_m
+        if abs(offset) > width / 2:
+            side = 1 if offset > 0 else -1
+            index, offset = index + side, offset - side * width
+        ys.append(offset + (index - start_index) * width)
+    return out, np.array(ys)
+
+
+def test_a_change_starts_once_favoured_long_enough_and_ends_in_the_lane_beside():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=5.0, settle_s=1.0))
+    dbgs, ys = run_law(law, int(7.0 / DT), around(car(0, 35.0, rel=-6.0)))
+    events = [(i, d.event) for i, d in enumerate(dbgs) if d.event]
+    assert [e for _, e in events] == ["started", "completed"]
+    # settle_s of frames favouring the left before the start, duration_s on the path
+    assert events[0][0] == pytest.approx(1.0 / DT, abs=1.5)
+    assert (events[1][0] - events[0][0]) * DT == pytest.approx(5.0, abs=0.1)
+    assert ys[-1] == pytest.approx(W, abs=1e-3) and dbgs[-1].phase is Phase.KEEP
+
+
+def test_a_change_to_the_right_counts_the_lane_index_down():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=5.0, settle_s=0.2))
+    # a slow lead, and no lane to the left
+    for _ in range(int(7.0 / DT)):
+        ref, dbg = law.update(path(0.0, 0, beside=(False, True)), around(car(0, 35.0, rel=-6.0)), V, DT)
+        if dbg.event == "started":
+            assert dbg.side == -1 and dbg.into_lane == -1
+            break
+    offset, index, events = 0.0, 0, []
+    for _ in range(int(6.0 / DT)):
+        ref, dbg = law.update(path(offset, index, beside=(True, True)), around(car(0, 35.0, rel=-6.0)), V, DT)
+        events.append(dbg.event)
+        offset = ref.offset_m if ref is not None else offset
+        if offset < -W / 2 - 0.1:
+            index, offset = index - 1, offset + W
+            assert dbg.into_lane == -1  # this frame's debug was made before the move
+    assert "completed" in events and index == -1 and offset == pytest.approx(0.0, abs=1e-3)
+
+
+def test_a_path_that_ends_short_of_the_target_lane_is_aborted():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=2.0, settle_s=0.2))
+    events = [law.update(path(0.0, 0), around(car(0, 35.0, rel=-6.0)), V, DT)[1].event for _ in range(60)]
+    # the lane estimate never moved to the target lane
+    assert events.count("started") == 1 and "completed" not in events and events.count("aborted") == 1
+
+
+def test_no_change_without_a_view_behind():
+    law = LaneChange(30.0, LaneChangeConfig(settle_s=0.2))
+    blind = Neighbours((car(0, 35.0, rel=-6.0),), rear=False)
+    assert all(law.update(path(), blind, V, DT)[1].event is None for _ in range(60))
+
+
+def test_no_second_change_before_the_interval():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=2.0, settle_s=0.2, min_interval_s=8.0))
+    dbgs, _ = run_law(law, int(6.0 / DT), around(car(0, 35.0, rel=-6.0)))
+    assert [d.event for d in dbgs if d.event] == ["started", "completed"]
+    assert dbgs[-1].reason == "too soon"
+
+
+def test_a_change_returns_when_a_car_comes_up_beside_before_it_is_across():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=5.0, settle_s=0.2))
+    slow = car(0, 35.0, rel=-6.0)
+    dbgs, _ = run_law(law, int(1.0 / DT), around(slow))
+    assert dbgs[-1].phase is Phase.CHANGE
+    more, ys = run_law(law, int(7.0 / DT), around(slow, car(1, 1.0, rel=1.0, track_id=2)))
+    assert more[0].event == "aborted" and more[0].reason == "beside"
+    assert more[-1].phase is Phase.KEEP and abs(ys[-1]) < 1e-3
+
+
+def test_lane_keeping_follows_a_reference_with_its_feed_forward():
+    law = LaneKeeping(time_constant_s=0.8)
+    steer, dbg = law.update(path(0.5), LateralRef(0.5, 0.0, 0.0))
+    assert steer == pytest.approx(0.0, abs=1e-12)
+    steer, dbg = law.update(path(), LateralRef(0.0, 0.0, 0.4))
+    assert steer > 0 and dbg.reference_1pm == pytest.approx(0.4 / V ** 2)
+
+
+def test_a_change_follows_the_target_lanes_lead_as_well():
+    near = car(1, 20.0, rel=-3.0)
+    t = nearest_target(None, None, around(near, car(0, 50.0, track_id=2)), into_lane=1)
+    assert t.source == "target lane" and t.gap_m == pytest.approx(near.gap_m)
+    assert nearest_target(None, None, around(near), into_lane=0) is None

@@ -1,0 +1,95 @@
+"""Lane changes scored against truth, and driven in closed loop on truth and on vision."""
+
+import numpy as np
+import pytest
+
+from percept.control import Phase
+from percept.drive import DriveConfig, run_drive
+from percept.drive.lane_change_scoring import LaneChangeScorer, ProgressScorer
+from percept.drive.scoring import SafetyScorer, StepTruth
+from percept.sensors import ImuSample
+from percept.sims import WorldConfig
+
+
+class Changing:
+    """The parts of a LaneChangeDebug the scorers read."""
+
+    def __init__(self, phase=Phase.CHANGE, event=None):
+        self.phase, self.event = phase, event
+
+
+def test_a_boundary_crossed_in_a_commanded_change_is_no_departure(truth):
+    quiet, changing = SafetyScorer(), SafetyScorer()
+    for offset in (0.0, 0.6, 1.2):  # a 2 m car in a 4 m lane: a body edge over the line beyond 1 m
+        gt = truth(offset=offset)
+        quiet.update(StepTruth(gt, [], None, 0.0, 0.0))
+        changing.update(StepTruth(gt, [], None, 0.0, 0.0, changing_lanes=True))
+    assert quiet.result()["lane_departures"] == 1 and changing.result()["lane_departures"] == 0
+
+
+def test_the_laws_idm_is_highway_envs():
+    from highway_env.vehicle.behavior import IDMVehicle
+    from highway_env.vehicle.kinematics import Vehicle
+
+    from percept.control import mobil
+
+    assert (mobil.ACCEL_MPS2, mobil.DECEL_MPS2, mobil.TIME_GAP_S, mobil.DELTA) == (
+        IDMVehicle.COMFORT_ACC_MAX, -IDMVehicle.COMFORT_ACC_MIN, IDMVehicle.TIME_WANTED, IDMVehicle.DELTA)
+    # highway-env's desired distance is centre to centre, ours bumper to bumper
+    assert mobil.JAM_GAP_M == IDMVehicle.DISTANCE_WANTED - Vehicle.LENGTH
+
+
+@pytest.mark.parametrize("behind_m, unsafe", [(12.0, True), (65.0, False)])
+def test_a_change_onto_a_close_follower_is_unsafe_onto_a_far_one_not(truth, vehicle, behind_m, unsafe):
+    s = LaneChangeScorer(1 / 15)
+    s.update(truth(lane_index=("a", "b", 1)), Changing(event="started"))
+    # the ego's centre now in lane 0, a car at the ego's speed behind it there
+    s.update(truth([vehicle(5, -behind_m, 0.0, speed=25.0)], lane_index=("a", "b", 0)), Changing())
+    r = s.result()
+    assert r["started"] == 1 and r["unsafe"] == int(unsafe)
+    crossing = r["crossings"][0]
+    assert crossing["gap_behind_m"] == pytest.approx(behind_m - 5.0) and crossing["unsafe"] is unsafe
+
+
+def test_lateral_acceleration_and_jerk_are_taken_over_the_change_only(truth):
+    s, dt = LaneChangeScorer(0.1), 0.1
+    for a, phase in ((3.0, Phase.KEEP), (0.5, Phase.CHANGE), (0.8, Phase.CHANGE), (0.2, Phase.KEEP)):
+        gt = truth()
+        gt = gt.__class__(**{**gt.__dict__, "imu": ImuSample(np.array([0.0, a, 9.81]), np.zeros(3))})
+        s.update(gt, Changing(phase))
+    r = s.result()
+    assert r["peak_lateral_accel_mps2"] == pytest.approx(0.8) and r["peak_lateral_jerk_mps3"] == pytest.approx(3.0)
+
+
+def test_progress_is_the_mean_speed_over_the_set_one(truth):
+    p = ProgressScorer(30.0, 0.5)
+    assert p.result()["mean_speed_mps"] is None
+    for v in (20.0, 25.0):
+        p.update(truth(speed=v))
+    assert p.result() == {"mean_speed_mps": 22.5, "set_speed_ratio": 0.75, "distance_m": 22.5}
+
+
+@pytest.mark.slow
+def test_on_truth_the_car_overtakes_in_dense_traffic_and_keeps_its_lane_when_told():
+    on = run_drive(DriveConfig(WorldConfig("dense", 0), default="privileged"), render=False)
+    off = run_drive(DriveConfig(WorldConfig("dense", 0), default="privileged", lane_changes=False), render=False)
+    lc = on["lane_changes"]
+    assert lc["completed"] >= 1 and lc["unsafe"] == 0 and on["lane_changes_on"]
+    assert on["collisions"] == 0 and on["lane_departures"] == 0
+    assert lc["peak_lateral_accel_mps2"] <= 2.0 and lc["peak_lateral_jerk_mps3"] <= 3.0
+    assert off["lane_changes"]["started"] is None and not off["lane_changes_on"]
+    assert on["progress"]["mean_speed_mps"] > off["progress"]["mean_speed_mps"]
+
+
+@pytest.mark.slow
+def test_on_vision_the_lane_estimate_follows_the_car_into_the_next_lane():
+    indices = []
+
+    class Look:
+        def log_step(self, frame, truth, step):
+            indices.append(step.estimates["lanes"].lane.index)
+
+    r = run_drive(DriveConfig(WorldConfig("dense", 0), duration_s=36.0), recorder_factory=lambda w: Look())
+    assert r["lane_changes"]["completed"] >= 1 and r["lane_changes"]["unsafe"] == 0
+    assert r["collisions"] == 0 and r["lane_departures"] == 0
+    assert indices[0] == 0 and indices[-1] == 1  # one lane to the left
