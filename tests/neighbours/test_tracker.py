@@ -72,7 +72,8 @@ class _FakeFinder:
         self.dets = iter(dets)
 
     def find(self, left, right, lane):
-        return [next(self.dets)], np.zeros(0)
+        d = next(self.dets)
+        return ([] if d is None else [d]), np.zeros(0)
 
 
 def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
@@ -93,6 +94,31 @@ def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
     assert flagged_at is not None and crossed_at is not None
     assert (crossed_at - flagged_at) * DT >= 1.0
     assert NeighbourConfig().horizon_s >= 1.0
+
+
+def test_something_found_on_one_frame_in_three_is_not_flagged():
+    slot = NeighbourSlot(StereoRig(), None, DT)
+    # settled in the lane beside, then the same motion as a car moving over, but found on a third of the frames
+    lat = [W] * 30 + [W - 1.0 * k * DT for k in range(1, 60)]
+    slot.front = _FakeFinder([det(32.0, y) if k < 30 or k % 3 == 0 else None for k, y in enumerate(lat)])
+    frame = type("F", (), {"dropped": False, "has_rear": False, "left_gray": None, "right_gray": None})()
+    for k in range(len(lat)):
+        nb, _ = slot.step(frame, {EgoPath: EgoPath.straight(25.0)})
+        assert nb.cutting_in() is None
+        if k == 29:  # a settled neighbour before it moves
+            assert slot.tracker.tracks[0].settled >= TrackerConfig().min_settled
+    (track,) = slot.tracker.tracks
+    assert track.seen == 5 and slot.tracker.recent_frames == 15
+
+
+def test_tracks_move_with_the_ego_into_the_next_lane():
+    tr = NeighbourTracker(DT)
+    for _ in range(5):
+        tr.step({"front": [det(30.0, W + 0.2)]}, W)
+    (t,) = tr.tracks
+    assert t.lane == 1
+    tr.shift_lanes(W)  # the ego moved one lane to the left
+    assert t.lane == 0 and t.lat == pytest.approx(0.2, abs=0.05)
 
 
 def test_a_car_coming_over_from_the_lane_beyond_is_not_cutting_in():
