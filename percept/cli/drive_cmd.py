@@ -22,7 +22,7 @@ def drive(
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
     rear: opt.Rear = None,
-    lane_changes: opt.LaneChanges = "on",
+    lane_changes: opt.LaneChanges = "off",
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
                                          "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,
@@ -126,9 +126,9 @@ def summary_table(cfg, result: dict) -> Table:
     t.add_row("progress", "mean speed [m/s]", fmt(result["progress"]["mean_speed_mps"], "{:.2f}"))
     t.add_row("", "of the set speed", fmt(result["progress"]["set_speed_ratio"], "{:.3f}"))
     changes = result["lane_changes"]
-    t.add_row("lane changes" + ("" if result["lane_changes_on"] else " (off)"),
-              "started / completed / aborted / unsafe",
-              " / ".join(str(changes[k]) for k in ("started", "completed", "aborted", "unsafe")))
+    t.add_row("lane changes", "started / completed / aborted / unsafe",
+              " / ".join(fmt(changes[k], "{}") for k in ("started", "completed", "aborted", "unsafe"))
+              if result["lane_changes_on"] else "off")
     for task in cfg.tasks:
         group = result[task.name]
         name = f"{task.name} ({cfg.source(task.name).value})"

@@ -33,7 +33,7 @@ class Agent:
     ego path or the pose."""
 
     def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float,
-                 lane_changes: bool = True):
+                 lane_changes: bool = False):
         self.order = task_order(tasks)
         provided = {t.provides for t in self.order}
         for role in (EgoPath, PoseEstimate):

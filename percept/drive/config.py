@@ -27,7 +27,7 @@ class DriveConfig:
     # default (on where its traffic changes lanes, or as ``world.rear_rig`` says); resolved to True or False, and
     # ``world.rear_rig`` set to match
     rear: bool | None = None
-    lane_changes: bool = True  # the car changes lanes when MOBIL favours it (control.LaneChange); False: it keeps
+    lane_changes: bool = False  # the car changes lanes when MOBIL favours it (control.LaneChange); False: it keeps
     # its lane
 
     def __post_init__(self) -> None:

@@ -18,7 +18,7 @@ class LaneTruth:
     """The ego lane in the vehicle frame: offset_m of the vehicle centre from the lane centre (+ left),
     heading_rad of the vehicle relative to the lane (+ CCW), curvature_1pm of the lane (+ turning left), width_m;
     lane_index: highway-env's (from, to, id), ids counting lanes from the left; beside: (left, right) whether the road
-    has a lane beyond each boundary."""
+    has a lane beyond each boundary that its traffic may change into."""
 
     offset_m: float
     heading_rad: float
@@ -112,9 +112,11 @@ def lane_truth(ego) -> LaneTruth:
     k = -float(wrap_angle(lane.heading_at(s + ds) - lane.heading_at(s - ds))) / (2 * ds)
     rel = float(wrap_angle(hw_to_world_yaw(ego.heading) - hw_to_world_yaw(lane.heading_at(s))))
     _from, _to, lane_id = ego.lane_index
-    lanes = len(ego.road.network.graph[_from][_to])
-    return LaneTruth(-float(lat_hw), rel, k, float(lane.width_at(s)), tuple(ego.lane_index),
-                     (lane_id > 0, lane_id < lanes - 1))
+    lanes = ego.road.network.graph[_from][_to]
+    # a lane beside that the road's traffic may not enter (a ramp's acceleration lane) is none to change into
+    beside = tuple(0 <= i < len(lanes) and not getattr(lanes[i], "forbidden", False)
+                   for i in (lane_id - 1, lane_id + 1))
+    return LaneTruth(-float(lat_hw), rel, k, float(lane.width_at(s)), tuple(ego.lane_index), beside)
 
 
 _BOX_GRID = np.array([[a, b, h] for a in (-0.5, 0, 0.5) for b in (-0.5, 0, 0.5) for h in (0.0, 0.5, 1.0)])

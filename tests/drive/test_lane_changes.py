@@ -70,9 +70,9 @@ def test_progress_is_the_mean_speed_over_the_set_one(truth):
 
 
 @pytest.mark.slow
-def test_on_truth_the_car_overtakes_in_dense_traffic_and_keeps_its_lane_when_told():
-    on = run_drive(DriveConfig(WorldConfig("dense", 0), default="privileged"), render=False)
-    off = run_drive(DriveConfig(WorldConfig("dense", 0), default="privileged", lane_changes=False), render=False)
+def test_on_truth_the_car_overtakes_in_dense_traffic_and_keeps_its_lane_by_default():
+    on = run_drive(DriveConfig(WorldConfig("dense", 0), default="privileged", lane_changes=True), render=False)
+    off = run_drive(DriveConfig(WorldConfig("dense", 0), default="privileged"), render=False)
     lc = on["lane_changes"]
     assert lc["completed"] >= 1 and lc["unsafe"] == 0 and on["lane_changes_on"]
     assert on["collisions"] == 0 and on["lane_departures"] == 0
@@ -89,7 +89,8 @@ def test_on_vision_the_lane_estimate_follows_the_car_into_the_next_lane():
         def log_step(self, frame, truth, step):
             indices.append(step.estimates["lanes"].lane.index)
 
-    r = run_drive(DriveConfig(WorldConfig("dense", 0), duration_s=36.0), recorder_factory=lambda w: Look())
+    r = run_drive(DriveConfig(WorldConfig("dense", 0), duration_s=36.0, lane_changes=True),
+                  recorder_factory=lambda w: Look())
     assert r["lane_changes"]["completed"] >= 1 and r["lane_changes"]["unsafe"] == 0
     assert r["collisions"] == 0 and r["lane_departures"] == 0
     assert indices[0] == 0 and indices[-1] == 1  # one lane to the left
