@@ -143,8 +143,7 @@ class NeighbourTracker:
         for i, t in enumerate(self.tracks):
             for j, d in enumerate(dets):
                 # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
-                # and the track's (a car held unseen in the blind band may come out anywhere along it)
-                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m + 2 * self.sigma_x(t)
+                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
                 if dx <= gate_x and dl <= c.gate_l_m and self._may_take_over(t, d):
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))
