@@ -89,7 +89,8 @@ def test_on_vision_the_lane_estimate_follows_the_car_into_the_next_lane():
         def log_step(self, frame, truth, step):
             indices.append(step.estimates["lanes"].lane.index)
 
-    r = run_drive(DriveConfig(WorldConfig("dense", 0), duration_s=36.0, lane_changes=True),
+    # overtake: a slow car ahead, the lane to the left free after the faster traffic has passed
+    r = run_drive(DriveConfig(WorldConfig("overtake", 0), duration_s=20.0, lane_changes=True),
                   recorder_factory=lambda w: Look())
     assert r["lane_changes"]["completed"] >= 1 and r["lane_changes"]["unsafe"] == 0
     assert r["collisions"] == 0 and r["lane_departures"] == 0
