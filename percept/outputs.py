@@ -107,18 +107,31 @@ def write_json_atomic(path: Path | str, data: Any, indent: int | None = 2) -> No
 
 @contextlib.contextmanager
 def _stop_signals_held() -> Iterator[None]:
-    """Hold Ctrl-C and SIGTERM (main thread, POSIX) until the block is done: a stop that lands between creating a
+    """Hold Ctrl-C and SIGTERM (main thread) until the block is done: a stop that lands between creating a
     temporary and noting it down would leave the temporary behind. The stop is delivered right after (a write
-    takes milliseconds), so the command still stops at once and counts what was just written."""
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    takes milliseconds), so the command still stops at once and counts what was just written.
+
+    The handlers are swapped for ones that only note the signal, rather than the signals masked: a process-wide
+    signal masked in the main thread is delivered to another thread (OpenCV's, Rerun's), whose C handler still
+    makes the main thread run the Python handler in the middle of the block."""
+    stops = (signal.SIGINT, signal.SIGTERM)
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    stops = {signal.SIGINT, signal.SIGTERM}
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, stops)
+    old = {sig: signal.getsignal(sig) for sig in stops}
+    if any(h is None for h in old.values()):  # a handler installed outside Python cannot be put back
+        yield
+        return
+    held: list[int] = []
+    for sig in stops:
+        signal.signal(sig, lambda signum, _frame: held.append(signum))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+        for sig in dict.fromkeys(held):
+            signal.raise_signal(sig)
 
 
 def write_files_atomic(files: Mapping[Path | str, bytes]) -> None:

@@ -7,6 +7,9 @@ failing with ENOSPC part-way. Ctrl-C and library chatter: tests/cli/test_interru
 import errno
 import json
 import os
+import signal
+import threading
+import time
 from pathlib import Path
 
 import cv2
@@ -103,6 +106,33 @@ def test_a_set_of_files_is_complete_or_absent(tmp_path, disk_full, snapshot):
     with pytest.raises(OSError):
         outputs.write_files_atomic(files)
     assert snapshot(tmp_path) == {}
+
+
+def test_ctrl_c_while_a_set_is_written_lands_after_it_even_with_other_threads(tmp_path, monkeypatch, temporaries):
+    """With another thread alive the kernel may hand a process-wide SIGINT to it; the stop must still wait until
+    every file of the set is in place."""
+    stop, ready = threading.Event(), threading.Event()
+    other = threading.Thread(target=lambda: (ready.set(), stop.wait(10)))
+    other.start()
+    ready.wait(5)
+    staged = []
+    real_stage = outputs._stage
+
+    def stage_then_ctrl_c(path, data):
+        staged.append(real_stage(path, data))
+        if len(staged) == 1:
+            signal.pthread_kill(other.ident, signal.SIGINT)  # the signal reaches the other thread, as it can
+            time.sleep(0.05)
+        return staged[-1]
+
+    monkeypatch.setattr(outputs, "_stage", stage_then_ctrl_c)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            outputs.write_files_atomic({tmp_path / "a.bin": b"a", tmp_path / "b.bin": b"b"})
+    finally:
+        stop.set()
+        other.join()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.bin", "b.bin"] and temporaries(tmp_path) == []
 
 
 def test_calibration_save_on_a_full_disk_keeps_the_old_file(tmp_path, disk_full, snapshot):
