@@ -3,6 +3,7 @@
 
 from .base import Controller, sideslip_for_curvature, steering_for_curvature
 from .emergency_braking import EmergencyBraking, EmergencyBrakingDebug
+from .evasion import Evasion, EvasionConfig, EvasionDebug
 from .following import Following, FollowingDebug
 from .lane_change import LaneChange, LaneChangeConfig, LaneChangeDebug, Phase
 from .lane_keeping import LaneKeeping, LaneKeepingDebug
@@ -10,7 +11,8 @@ from .lateral_path import LateralRef, MinJerkPath
 from .mobil import Judgement, MobilConfig, idm_accel, judge
 from .target import Target, nearest_target
 
-__all__ = ["Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Following", "FollowingDebug", "Judgement",
+__all__ = ["Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Evasion", "EvasionConfig",
+           "EvasionDebug", "Following", "FollowingDebug", "Judgement",
            "LaneChange", "LaneChangeConfig", "LaneChangeDebug", "LaneKeeping", "LaneKeepingDebug", "LateralRef",
            "MinJerkPath", "MobilConfig", "Phase", "Target", "idm_accel", "judge", "nearest_target",
            "sideslip_for_curvature", "steering_for_curvature"]

@@ -1,5 +1,6 @@
 """Lane changes: when MOBIL favours a lane beside (``mobil.judge``), a minimum-jerk path into it that lane keeping
-follows, and a return to the lane it left when the target gap closes before the car is across.
+follows, and a return to the lane it left when the target gap closes before the car is across; and the swerve into a
+free lane that the evasion law (``evasion.py``) calls for when braking alone falls short.
 
 The law reads records only: the ego path (its lane, the lane's ``index`` and which boundaries have a lane beyond
 them) and the neighbours. A change starts once MOBIL has favoured the same side for ``settle_s`` (a verdict that
@@ -11,14 +12,16 @@ offset in the start lane - (index - index_start) w.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 
 from percept.sensors import EgoPath, Neighbours
 
 from .base import Controller
 from .lateral_path import LateralRef, MinJerkPath
+from .evasion import Evasion, EvasionConfig, EvasionDebug
 from .mobil import Judgement, MobilConfig, judge
+from .target import Target
 
 PLAN_POINTS = 12
 """Points of the rest of the path in the debug record (the review draws them)."""
@@ -32,6 +35,7 @@ class Phase(str, Enum):
     KEEP = "keep"  # keeping the lane
     CHANGE = "change"  # on the path into the lane beside
     RETURN = "return"  # on the path back into the lane it left (an aborted change)
+    EVADE = "evade"  # on a swerve into a free lane beside (evasion.py), which nothing aborts
 
 
 @dataclass(frozen=True)
@@ -42,6 +46,7 @@ class LaneChangeConfig:
     settle_s: float = 1.0  # how long MOBIL must favour the same side before a change starts [s]
     min_interval_s: float = 8.0  # least time from the end of one change to the start of the next [s]
     mobil: MobilConfig = field(default_factory=MobilConfig)  # the decision's parameters
+    evasion: EvasionConfig = field(default_factory=EvasionConfig)  # when to swerve, and how fast
 
 
 @dataclass(frozen=True)
@@ -53,12 +58,14 @@ class LaneChangeDebug:
     reason: str  # why, in words: MOBIL's gain for the side taken, its reasons for those not taken, or "too soon",
     # "no lane estimate", "on the path", "arrived", "not across" (a path that ended short of the target lane)
     judgements: tuple[Judgement, ...]  # MOBIL's verdicts this frame
-    event: str | None  # "started", "completed" or "aborted" on the frame it happened, else None
+    event: str | None  # "started", "completed", "aborted", or evasion's "swerve" / "full braking", on the frame it
+    # happened, else None
     ref: LateralRef | None  # the lateral reference handed to lane keeping (None: keep the lane's centre)
     plan_m: tuple = ()  # the rest of the path as (ahead [m], offset from the current lane's centre [m]) points at
     # the ego's speed (PLAN_POINTS of them; empty outside a change)
     into_lane: int = 0  # the target lane relative to the current one while the car is not yet across it (+1 left,
     # -1 right), else 0: the following law watches that lane's nearest car ahead as well
+    evasion: EvasionDebug | None = None  # the evasion law's judgement (None: not judged this frame)
 
 
 class LaneChange(Controller):
@@ -67,6 +74,7 @@ class LaneChange(Controller):
     def __init__(self, set_speed_mps: float, cfg: LaneChangeConfig = LaneChangeConfig()):
         """set_speed_mps: the speed the car wants [m/s] (MOBIL's desired speed for the ego)."""
         self.set_speed, self.cfg = set_speed_mps, cfg
+        self.evasion = Evasion(set_speed_mps, cfg.evasion, cfg.mobil)
         self.reset()
 
     def reset(self) -> None:
@@ -77,18 +85,25 @@ class LaneChange(Controller):
         self.path: MinJerkPath | None = None  # in the start lane's frame
         self.index0 = 0  # the lane index the change started from
         self.width0 = 0.0  # the lane width it was planned with [m]
+        self.evasion.reset()
 
-    def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
-               dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
+    def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float, dt: float,
+               target: Target | None = None) -> tuple[LateralRef | None, LaneChangeDebug]:
         """The reference (None: the lane's centre) and the debug record, from the ego path, the neighbours (None:
-        nothing is known around the car, so no change starts; one under way goes on), the speed [m/s] and the frame
-        period ``dt`` [s]. Without a view behind (``Neighbours.rear`` False) no change starts either."""
+        nothing is known around the car, so no change starts; one under way goes on), the speed [m/s], the frame
+        period ``dt`` [s] and the longitudinal laws' nearest target (``nearest_target`` with no change under way;
+        None: nothing ahead), which evasion judges while the car keeps its lane. Without a view behind
+        (``Neighbours.rear`` False) no change starts either."""
         if not path.follows_lane:  # nothing to steer along: a path under way runs on unseen
             self.favour, self.favour_s = 0, 0.0
             self.t_s += dt if self.phase is not Phase.KEEP else 0.0
             return None, LaneChangeDebug(self.phase, self.side, "no lane estimate", (), None, None)
         if self.phase is Phase.KEEP:
-            return self._keep(path, neighbours, speed_mps, dt)
+            side, evasion = self.evasion.update(target, path, neighbours, speed_mps)
+            if side:
+                return self._start(Phase.EVADE, side, path, self.cfg.evasion.duration_s, "swerve", evasion)
+            ref, debug = self._keep(path, neighbours, speed_mps, dt)
+            return ref, replace(debug, evasion=evasion, event=debug.event or evasion.event)
         return self._follow(path, neighbours, speed_mps, dt)
 
     def _keep(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
@@ -109,10 +124,17 @@ class LaneChange(Controller):
             return None, LaneChangeDebug(self.phase, 0, reason, verdicts, None, None)
         if self.since_end_s < self.cfg.min_interval_s:
             return None, LaneChangeDebug(self.phase, 0, "too soon", verdicts, None, None)
-        self.phase, self.side, self.t_s, self.index0, self.width0 = Phase.CHANGE, side, 0.0, lane.index, lane.width_m
-        self.path = MinJerkPath.between(lane.offset_m, 0.0, 0.0, side * lane.width_m, self.cfg.duration_s)
+        return self._start(Phase.CHANGE, side, path, self.cfg.duration_s, reason, None, verdicts)
+
+    def _start(self, phase: Phase, side: int, path: EgoPath, duration_s: float, reason: str,
+               evasion: EvasionDebug | None, verdicts: tuple[Judgement, ...] = ()) -> tuple[LateralRef, LaneChangeDebug]:
+        """Begin a path of ``duration_s`` from where the car is into the lane on ``side``: a change or a swerve."""
+        lane = path.lane
+        self.phase, self.side, self.t_s, self.index0, self.width0 = phase, side, 0.0, lane.index, lane.width_m
+        self.path = MinJerkPath.between(lane.offset_m, 0.0, 0.0, side * lane.width_m, duration_s)
         ref = self.path.at(0.0)
-        return ref, LaneChangeDebug(self.phase, side, reason, verdicts, "started", ref, into_lane=side)
+        event = "started" if phase is Phase.CHANGE else "swerve"
+        return ref, LaneChangeDebug(phase, side, reason, verdicts, event, ref, into_lane=side, evasion=evasion)
 
     def _follow(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
                 dt: float) -> tuple[LateralRef | None, LaneChangeDebug]:
@@ -136,13 +158,13 @@ class LaneChange(Controller):
         ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2)
         ahead = [self.t_s + k * (self.path.duration_s - self.t_s) / (PLAN_POINTS - 1) for k in range(PLAN_POINTS)]
         plan = tuple((speed_mps * (t - self.t_s), self.path.at(t).offset_m - shift) for t in ahead)
-        into = self.side if self.phase is Phase.CHANGE and not crossed else 0
+        into = self.side if self.phase is not Phase.RETURN and not crossed else 0
         return ref, LaneChangeDebug(self.phase, self.side, reason, verdicts, event, ref, plan, into)
 
     def _end(self, crossed: int) -> tuple[None, LaneChangeDebug]:
         """The path's end: a change is completed when the lane estimate has moved to the target lane, else (it never
         got across) it counts as aborted; a return just ends."""
-        side, changing = self.side, self.phase is Phase.CHANGE
+        side, changing = self.side, self.phase is Phase.CHANGE  # a swerve ends with no event: it counts as a swerve
         event = ("completed" if crossed == side else "aborted") if changing else None
         self.phase, self.side, self.since_end_s = Phase.KEEP, 0, 0.0
         reason = "arrived" if event != "aborted" else "not across"

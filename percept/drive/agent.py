@@ -29,7 +29,8 @@ class Agent:
     its role, whichever task provides it: lane keeping on the ego path (``EgoPath``); following and emergency
     braking on the lead (``Lead``), the braking request (``BrakingRequest``) and a neighbour cutting in
     (``Neighbours``), at the speed of the pose estimate (``PoseEstimate``); when ``lane_changes``, the lane-change
-    law on the ego path and the neighbours hands lane keeping its reference. ValueError when no task provides the
+    law on the ego path, the neighbours and the nearest target hands lane keeping its reference (a change, or a
+    swerve when braking alone falls short). ValueError when no task provides the
     ego path or the pose."""
 
     def __init__(self, tasks: tuple[Task, ...], sources: dict, ctx: SlotContext, set_speed_mps: float,
@@ -64,10 +65,12 @@ class Agent:
             timing[task.name] = (time.perf_counter() - t0) * 1e3
             by_record[task.provides] = estimates[task.name]
         path, speed, neighbours = by_record[EgoPath], by_record[PoseEstimate].speed_mps, by_record.get(Neighbours)
-        ref, change = self.changing.update(path, neighbours, speed, self.dt_s) if self.changing else (None, None)
+        request, lead = by_record.get(BrakingRequest), by_record.get(Lead)
+        ahead = nearest_target(lead, request, neighbours)
+        ref, change = (self.changing.update(path, neighbours, speed, self.dt_s, ahead) if self.changing
+                       else (None, None))
         steer, keeping = self.keeping.update(path, ref)
-        request = by_record.get(BrakingRequest)
-        target = nearest_target(by_record.get(Lead), request, neighbours, change.into_lane if change else 0)
+        target = nearest_target(lead, request, neighbours, change.into_lane) if change and change.into_lane else ahead
         follow, following = self.following.update(target, speed)
         accel, braking = self.braking.update(target, speed, follow, self.dt_s,
                                              withdrawn=request is not None and request.withdrawn)

@@ -8,7 +8,8 @@ by IDM with highway-env's own ``IDMVehicle`` parameters (``control.idm_accel``; 
 speed, so that only the ego's arrival brakes it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under
 ``UNSAFE_TIME_GAP_S`` at the ego's speed, or a car is beside the ego in it. Peak lateral acceleration and jerk are
 the true ones (the IMU's lateral axis without noise, less the lane's own centripetal v^2 kappa) over the frames of
-a commanded change.
+a commanded change, swerves left out. Evasive manoeuvres (``evasive``) are the evasion law's swerves and its full
+braking where no lane was free, each with its outcome: whether the ego hit anything within ``EVASIVE_WINDOW_S``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,10 @@ UNSAFE_BRAKING_MPS2 = 2.0
 """A change that makes its new follower brake harder than this is unsafe [m/s²]."""
 UNSAFE_TIME_GAP_S = 0.5
 """A change that leaves a gap ahead or behind shorter than this at the ego's speed is unsafe [s]."""
+EVASIVE_WINDOW_S = 5.0
+"""An evasive manoeuvre failed when the ego hits something within this long of its start [s]."""
+EVASIVE_EVENTS = ("swerve", "full braking")
+"""The lane-change law's events that begin an evasive manoeuvre."""
 
 
 class ProgressScorer:
@@ -54,13 +59,15 @@ class LaneChangeScorer:
         self.peak_jerk = None  # [m/s³]
         self._lane = None  # the ego's true lane id on the previous frame
         self._accel = None  # the lateral acceleration on the previous frame of a change [m/s²]
+        self.evasive: list[dict] = []  # per evasive manoeuvre: when, what, and whether the ego hit anything
 
     def update(self, gt, debug) -> None:
         """One frame: ``gt`` the ground truth, ``debug`` the lane-change law's record (None: lane changes off)."""
         lane = gt.lane.lane_index[2]
-        changing = debug is not None and debug.phase.value != "keep"
+        changing = debug is not None and debug.phase.value not in ("keep", "evade")
         if debug is not None and debug.event in self.counts:
             self.counts[debug.event] += 1
+        self._evasive(gt, debug)
         if self._lane is not None and lane != self._lane:
             self._judge_crossing(gt)
         self._lane = lane
@@ -72,6 +79,25 @@ class LaneChangeScorer:
                 jerk = abs(accel - self._accel) / self.dt
                 self.peak_jerk = max(self.peak_jerk or 0.0, jerk)
         self._accel = accel if changing else None
+
+    def _evasive(self, gt, debug) -> None:
+        """Note an evasive manoeuvre's start, and a collision within ``EVASIVE_WINDOW_S`` of it."""
+        if debug is not None and debug.event in EVASIVE_EVENTS:
+            self.evasive.append({"time_s": round(gt.time_s, 3), "kind": debug.event, "side": debug.side,
+                                 "collision": False})
+        for e in self.evasive:
+            if gt.crashed and gt.time_s - e["time_s"] <= EVASIVE_WINDOW_S:
+                e["collision"] = True
+
+    def evasive_result(self) -> dict:
+        """The run JSON's ``evasive`` group: count, swerves, full brakings and those that ended in a collision (null
+        where no law commands the car; collisions null where there was no evasive manoeuvre)."""
+        if not self.commanded:
+            return {"count": None, "swerves": None, "full_braking": None, "collisions": None, "manoeuvres": []}
+        kinds = [e["kind"] for e in self.evasive]
+        return {"count": len(kinds), "swerves": kinds.count("swerve"), "full_braking": kinds.count("full braking"),
+                "collisions": sum(e["collision"] for e in self.evasive) if kinds else None,
+                "manoeuvres": self.evasive}
 
     def _judge_crossing(self, gt) -> None:
         """The new lane's follower and gaps on the frame the ego's centre entered it."""

@@ -72,7 +72,7 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
               "duration_s": round(sim_s, 4), "frames": frames, "realtime_factor": sim_s / wall if wall > 0 else None,
               "slots": {name: src.value for name, src in cfg.sources.items()}, "rear": cfg.rear,
               "lane_changes_on": cfg.lane_changes, **safety.result(changes.counts["unsafe"]), "progress": pace.result(),
-              "lane_changes": changes.result()}
+              "lane_changes": changes.result(), "evasive": changes.evasive_result()}
     result.update({t.name: scorers[t.name].result() for t in cfg.tasks})
     result["timing_ms"] = timing_json(cfg, slot_ms, render_ms if render else None, frames)
     return result

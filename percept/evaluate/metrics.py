@@ -12,7 +12,9 @@ RUN_HEADLINES = (("progress.mean_speed_mps", "mean speed [m/s]", "{:.2f}"),
                  ("lane_changes.completed", "changes completed", "{:.2f}"),
                  ("lane_changes.aborted", "changes aborted", "{:.2f}"),
                  ("lane_changes.peak_lateral_accel_mps2", "peak lateral accel [m/s²]", "{:.2f}"),
-                 ("lane_changes.peak_lateral_jerk_mps3", "peak lateral jerk [m/s³]", "{:.2f}"))
+                 ("lane_changes.peak_lateral_jerk_mps3", "peak lateral jerk [m/s³]", "{:.2f}"),
+                 ("evasive.count", "evasive manoeuvres", "{:.2f}"),
+                 ("evasive.collisions", "evasive, ending in a collision", "{:.2f}"))
 """The run-level figures the summaries show beside the tasks' headlines: (metric, label, format)."""
 
 

@@ -70,7 +70,7 @@ def with_rear(cfg: WorldConfig, rear: bool | None) -> WorldConfig:
     than a bool or None."""
     if rear not in (None, True, False):
         raise ValueError(f"rear must be True, False or None (the scenario's default), got {rear!r}")
-    on = (cfg.rear_rig is not None or SCENARIOS[cfg.scenario].lane_changes) if rear is None else bool(rear)
+    on = (cfg.rear_rig is not None or SCENARIOS[cfg.scenario].rear_by_default) if rear is None else bool(rear)
     if on and cfg.rear_rig is None:
         return replace(cfg, rear_rig=rear_rig(cfg.rig))
     if not on and cfg.rear_rig is not None:

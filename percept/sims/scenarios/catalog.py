@@ -33,6 +33,13 @@ class Scenario:
     build: Callable  # build(env, rng) -> highway-env Road, with the ego made by ``env.make_ego``
     ego_speed_mps: float = 25.0  # the ego's nominal speed [m/s] (``build`` sets its start and cruise speeds)
     lane_changes: bool = False  # True: the traffic changes lanes on its own (MOBIL); False: it keeps its lanes
+    watch_beside: bool = False  # the rear rig is on by default even though the traffic keeps its lanes: the ego
+    # needs to know whether the lanes beside it are free (an evasive manoeuvre)
+
+    @property
+    def rear_by_default(self) -> bool:
+        """Whether the rear rig is on unless asked otherwise."""
+        return self.lane_changes or self.watch_beside
 
 
 def build_highway(env, rng) -> Road:
@@ -77,6 +84,43 @@ def build_cut_in(env, rng) -> Road:
          cut_in_lane=("0", "1", 1), cut_in_gap_m=float(rng.uniform(12.0, 20.0)))
     place_idm(road, ("0", "1", 1), 60.0 + 150.0, 24.0)
     place_traffic(road, rng, [2 - side], 0.0, 500.0, 5, (24.0, 28.0), [])
+    return road
+
+
+CLOSE_CUT_IN_SPEED_MPS = 11.0
+"""The speed of ``cut-in-close``'s slow car [m/s]: 14 m/s slower than the ego, a car pulling out at a truck's pace."""
+CLOSE_CUT_IN_AT_S = 11.0
+"""When, into the run, the slow car pulls out [s]: after the car beside of the variant has come up from behind."""
+CLOSE_CUT_IN_LATERAL_MPS = 2.0
+"""The cap on its lateral speed as it pulls out [m/s]: twice a lane-changing driver's (``placing.PeoplePaced``)."""
+
+
+def build_cut_in_close(env, rng) -> Road:
+    """A slow car in the next lane pulls out in front of the ego when its bumper gap is 10-12 m, 14 m/s slower:
+    braking alone at 8 m/s² cannot cancel the closing (12 m) before it is in the ego's way, and the lane on the
+    other side is free. On odd seeds, the variant: a car rides beside the ego in that other lane, and the slow car
+    is 8-9 m/s slower and pulls out 12-15 m ahead, so that full braking avoids it (the car beside comes up from behind
+    in the first seconds, where the rear rig sees it)."""
+    road = new_road(env, straight_road(3, 2000.0))
+    env.road = road
+    ego_s = 60.0
+    env.make_ego(("0", "1", 1), ego_s, 25.0)
+    side = int(rng.choice([0, 2]))
+    boxed = env.config["scenario_seed"] % 2 == 1
+    speed = 25.0 - float(rng.uniform(8.0, 9.0)) if boxed else CLOSE_CUT_IN_SPEED_MPS
+    gap = float(rng.uniform(12.0, 15.0) if boxed else rng.uniform(12.0, 14.0))
+    # it pulls out about CLOSE_CUT_IN_AT_S into the run: x = x_ego + L + gap + (v_ego - v) t (its centre, IDM's
+    # own length)
+    start = ego_s + 5.0 + gap + (25.0 - speed) * CLOSE_CUT_IN_AT_S
+    cutter = place_idm(road, ("0", "1", side), start, speed, cls=ScriptedVehicle, paced=True,
+                       cut_in_lane=("0", "1", 1), cut_in_gap_m=gap)
+    cutter.lateral_speed_mps = CLOSE_CUT_IN_LATERAL_MPS
+    if boxed:
+        # in the other lane: comes up from behind (seen by the rear rig) and stays beside the ego for the rest of the
+        # run, its centre 0-2 m behind the ego's
+        place_idm(road, ("0", "1", 2 - side), ego_s - 40.0, 30.0, cls=ScriptedVehicle,
+                  pace_offset_m=-float(rng.uniform(0.0, 2.0)), pace_s=60.0)
+    place_traffic(road, rng, [0, 1, 2], ego_s - 400.0, ego_s - 150.0, 4, (24.0, 27.0), [])
     return road
 
 
@@ -152,6 +196,9 @@ SCENARIOS: dict[str, Scenario] = {s.name: s for s in [
              25.0),
     Scenario("cut-in", "a vehicle from the next lane cuts in 12-20 m ahead; the ego falls back to its time gap", 40.0,
              build_cut_in, 25.0),
+    Scenario("cut-in-close", "a car 14 m/s slower pulls out 10-12 m ahead: only swerving into the free lane avoids "
+             "it; odd seeds: that lane is taken and only full braking does", 25.0, build_cut_in_close, 25.0,
+             watch_beside=True),
     Scenario("crossing", "pedestrians cross the ego lane at 5 km/h from both sides, others stay on the verge; "
              "ego at 20-60 km/h", 70.0, build_crossing, 12.0),
     Scenario("loop", "a 3.7 km closed circuit with ArUco landmark signs at surveyed positions", 160.0, build_loop,

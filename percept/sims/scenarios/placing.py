@@ -63,13 +63,15 @@ class PeoplePaced:
     """Mixin over a highway-env ControlledVehicle class: it steers with ControlledVehicle's law, its lateral speed
     command, -K_p l, capped at ``LANE_CHANGE_LATERAL_SPEED_MPS``. highway-env's LinearVehicle classes (Aggressive,
     Defensive) steer with that law's linearisation at its default gains, which ignores a vehicle's own gains; they
-    steer with the law itself here."""
+    steer with the law itself here. A vehicle may set its own cap as ``lateral_speed_mps``."""
+
+    lateral_speed_mps = LANE_CHANGE_LATERAL_SPEED_MPS  # the cap on its lateral speed command [m/s]
 
     def steering_control(self, target_lane_index) -> float:
         lateral = self.road.network.get_lane(target_lane_index).local_coordinates(self.position)[1]
         gain = self.KP_LATERAL
         # |K_p l| <= v_max  <=>  K_p <= v_max / |l|: the law runs with that gain this step
-        self.KP_LATERAL = min(gain, LANE_CHANGE_LATERAL_SPEED_MPS / max(abs(float(lateral)), 1e-6))
+        self.KP_LATERAL = min(gain, self.lateral_speed_mps / max(abs(float(lateral)), 1e-6))
         try:
             return ControlledVehicle.steering_control(self, target_lane_index)
         finally:
