@@ -21,14 +21,14 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import signal
 import socket
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping
+
+from .held_signals import stop_signals_held
 
 _CHUNK = 1 << 20
 _os_write = os.write
@@ -105,35 +105,6 @@ def write_json_atomic(path: Path | str, data: Any, indent: int | None = 2) -> No
     write_text_atomic(path, json.dumps(data, indent=indent))
 
 
-@contextlib.contextmanager
-def _stop_signals_held() -> Iterator[None]:
-    """Hold Ctrl-C and SIGTERM (main thread) until the block is done: a stop that lands between creating a
-    temporary and noting it down would leave the temporary behind. The stop is delivered right after (a write
-    takes milliseconds), so the command still stops at once and counts what was just written.
-
-    The handlers are swapped for ones that only note the signal, rather than the signals masked: a process-wide
-    signal masked in the main thread is delivered to another thread (OpenCV's, Rerun's), whose C handler still
-    makes the main thread run the Python handler in the middle of the block."""
-    stops = (signal.SIGINT, signal.SIGTERM)
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    old = {sig: signal.getsignal(sig) for sig in stops}
-    if any(h is None for h in old.values()):  # a handler installed outside Python cannot be put back
-        yield
-        return
-    held: list[int] = []
-    for sig in stops:
-        signal.signal(sig, lambda signum, _frame: held.append(signum))
-    try:
-        yield
-    finally:
-        for sig, handler in old.items():
-            signal.signal(sig, handler)
-        for sig in dict.fromkeys(held):
-            signal.raise_signal(sig)
-
-
 def write_files_atomic(files: Mapping[Path | str, bytes]) -> None:
     """Write several files as one unit: every file goes to a fsynced temporary first, then all are renamed.
 
@@ -141,7 +112,7 @@ def write_files_atomic(files: Mapping[Path | str, bytes]) -> None:
     targets already renamed, so that a set of new files is complete or absent. Ctrl-C and SIGTERM are held while
     the files are written and take effect when they are in place.
     """
-    with _stop_signals_held():
+    with stop_signals_held():
         _write_files(files)
 
 
@@ -232,12 +203,12 @@ def folder_lock(folder: Path | str, command: str, warn: Callable[[str], None] = 
     lock = folder / LOCK_NAME
     me = json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "command": command, "argv": sys.argv,
                      "started": time.strftime("%Y-%m-%d %H:%M:%S")}).encode()
-    with _stop_signals_held():
+    with stop_signals_held():
         fd = _take_lock(lock, me, warn)
     try:
         yield lock
     finally:
-        with _stop_signals_held():
+        with stop_signals_held():
             if _same_file(fd, lock):
                 lock.unlink(missing_ok=True)
             os.close(fd)

@@ -17,13 +17,14 @@ def test_scenarios_lists_every_scenario_and_condition(tmp_path):
     out = tmp_path / "s.json"
     r = runner.invoke(app, ["scenarios", "--json", str(out)])
     assert r.exit_code == 0, r.output
-    for name in ("highway", "curves", "lead-brake", "cut-in", "crossing", "loop", "dense", "overtake", "merge", "night",
-                 "dropout"):
+    for name in ("highway", "curves", "lead-brake", "cut-in", "cut-in-close", "crossing", "loop", "dense", "overtake",
+                 "merge", "night", "dropout"):
         assert name in r.output
     d = json.loads(out.read_text())
-    assert set(d["scenarios"]) == {"highway", "curves", "lead-brake", "cut-in", "crossing", "loop", "dense", "overtake",
-                                   "merge"}
+    assert set(d["scenarios"]) == {"highway", "curves", "lead-brake", "cut-in", "cut-in-close", "crossing", "loop",
+                                   "dense", "overtake", "merge"}
     assert {k for k, v in d["scenarios"].items() if v["lane_changes"]} == {"dense", "overtake", "merge"}
+    assert {k for k, v in d["scenarios"].items() if v["rear"]} == {"dense", "overtake", "merge", "cut-in-close"}
     assert set(d["conditions"]) == {"clear", "night", "rain", "glare", "noise", "dropout"}
 
 

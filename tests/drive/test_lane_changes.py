@@ -8,6 +8,7 @@ from percept.drive import DriveConfig, run_drive
 from percept.drive.lane_change_scoring import LaneChangeScorer, ProgressScorer
 from percept.drive.scoring import SafetyScorer, StepTruth
 from percept.sensors import ImuSample
+from percept.sensors.vehicle import MAX_BRAKE_MPS2
 from percept.sims import WorldConfig
 
 
@@ -95,3 +96,29 @@ def test_on_vision_the_lane_estimate_follows_the_car_into_the_next_lane():
     assert r["lane_changes"]["completed"] >= 1 and r["lane_changes"]["unsafe"] == 0
     assert r["collisions"] == 0 and r["lane_departures"] == 0
     assert indices[0] == 0 and indices[-1] == 1  # one lane to the left
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_on_truth_only_a_swerve_avoids_the_close_cut_in(seed):
+    cfg = WorldConfig("cut-in-close", seed)
+    braking = run_drive(DriveConfig(cfg, default="privileged", duration_s=15.0), render=False)
+    evading = run_drive(DriveConfig(cfg, default="privileged", duration_s=15.0, lane_changes=True), render=False)
+    assert braking["collisions"] == 1 and braking["evasive"]["count"] is None
+    ev = evading["evasive"]
+    assert evading["collisions"] == 0 and evading["lane_departures"] == 0 and evading["unsafe_lane_changes"] == 0
+    assert (ev["count"], ev["swerves"], ev["full_braking"], ev["collisions"]) == (1, 1, 0, 0)
+    # swerves are left out of the change's comfort peaks
+    assert evading["lane_changes"]["peak_lateral_accel_mps2"] is None
+
+
+def test_on_truth_with_the_other_lane_taken_braking_avoids_the_milder_cut_in_and_nothing_swerves():
+    accels = []
+
+    class Look:
+        def log_step(self, frame, truth, step):
+            accels.append(step.accel_mps2)
+
+    r = run_drive(DriveConfig(WorldConfig("cut-in-close", 1), default="privileged", duration_s=15.0,
+                              lane_changes=True), recorder_factory=lambda w: Look(), render=False)
+    assert r["collisions"] == 0 and r["evasive"]["swerves"] == 0 and r["unsafe_lane_changes"] == 0
+    assert min(accels) == pytest.approx(-MAX_BRAKE_MPS2)  # full braking

@@ -51,9 +51,11 @@ def _draw_change(rec: rr.RecordingStream, ctx: PartContext, change, path: EgoPat
     """A lane change's events in the log and its planned path around the car and on the left image."""
     if change.event is not None:
         where = {1: "to the left", -1: "to the right"}.get(change.side, "")
-        level = rr.TextLogLevel.WARN if change.event == "aborted" else rr.TextLogLevel.INFO
-        rec.log(CHANGES, rr.TextLog(f"lane change {where} {change.event}: {change.reason}".replace("  ", " "),
-                                    level=level))
+        level = rr.TextLogLevel.INFO if change.event in ("started", "completed") else rr.TextLogLevel.WARN
+        ev = change.evasion
+        text = (f"evasive {change.event} {where}: braking needs {ev.needed_mps2:.1f} m/s²" if ev is not None
+                and change.event in ("swerve", "full braking") else f"lane change {where} {change.event}: {change.reason}")
+        rec.log(CHANGES, rr.TextLog(text.replace("  ", " "), level=level))
     lane = path.lane if path is not None and path.follows_lane else None
     if not change.plan_m or lane is None:
         ctx.buffer.clear(ctx.around_ego("lane_change"))
