@@ -129,6 +129,10 @@ def summary_table(cfg, result: dict) -> Table:
     t.add_row("lane changes", "started / completed / aborted / unsafe",
               " / ".join(fmt(changes[k], "{}") for k in ("started", "completed", "aborted", "unsafe"))
               if result["lane_changes_on"] else "off")
+    evasive = result["evasive"]
+    t.add_row("evasive", "swerves / full brakings / collisions",
+              " / ".join(fmt(evasive[k], "{}") for k in ("swerves", "full_braking", "collisions"))
+              if result["lane_changes_on"] else "off")
     for task in cfg.tasks:
         group = result[task.name]
         name = f"{task.name} ({cfg.source(task.name).value})"

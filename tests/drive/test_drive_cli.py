@@ -13,7 +13,7 @@ from percept.cli.view_cmd import rerun_executable
 runner = CliRunner()
 KEYS = ["scenario", "condition", "seed", "duration_s", "frames", "realtime_factor", "collisions",
         "pedestrian_collisions", "lane_departures", "unsafe_lane_changes", "lanes", "longitudinal", "pedestrians",
-        "odometry", "timing_ms", "progress", "lane_changes"]
+        "odometry", "timing_ms", "progress", "lane_changes", "evasive"]
 
 
 def rerun_bin() -> str:
@@ -134,3 +134,13 @@ def test_drive_table_prints_no_python_values():
 def test_drive_seed_bound_is_written_in_full(one_line_error):
     r = runner.invoke(app, ["drive", "--seed", "99999999999", "--no-record"])
     one_line_error(r, "between 0 and 2147483647, got 99999999999")
+
+
+def test_drive_shows_the_swerve_that_avoided_a_close_cut_in(tmp_path):
+    js = tmp_path / "run.json"
+    r = runner.invoke(app, ["drive", "--scenario", "cut-in-close", "--privileged", "--lane-changes", "on",
+                            "--duration", "14", "--no-record", "--json", str(js)])
+    assert r.exit_code == 0, r.output
+    row = next(line for line in r.output.splitlines() if "evasive" in line)
+    assert "1 / 0 / 0" in row
+    assert json.loads(js.read_text())["evasive"]["manoeuvres"][0]["kind"] == "swerve"
