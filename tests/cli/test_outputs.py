@@ -126,10 +126,13 @@ def test_ctrl_c_while_a_set_is_written_lands_after_it_even_with_other_threads(tm
         return staged[-1]
 
     monkeypatch.setattr(outputs, "_stage", stage_then_ctrl_c)
+    # Ctrl-C as Python's default handler takes it (an earlier command in this process may have left it ignored)
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         with pytest.raises(KeyboardInterrupt):
             outputs.write_files_atomic({tmp_path / "a.bin": b"a", tmp_path / "b.bin": b"b"})
     finally:
+        signal.signal(signal.SIGINT, old)
         stop.set()
         other.join()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.bin", "b.bin"] and temporaries(tmp_path) == []
