@@ -3,16 +3,16 @@
 
 from .base import Controller, sideslip_for_curvature, steering_for_curvature
 from .emergency_braking import EmergencyBraking, EmergencyBrakingDebug
-from .evasion import Evasion, EvasionConfig, EvasionDebug
+from .evasion import EVASIVE_EVENTS, Evasion, EvasionConfig, EvasionDebug
 from .following import Following, FollowingDebug
 from .lane_change import LaneChange, LaneChangeConfig, LaneChangeDebug, Phase
 from .lane_keeping import LaneKeeping, LaneKeepingDebug
 from .lateral_path import LateralRef, MinJerkPath
 from .mobil import Judgement, MobilConfig, idm_accel, judge
-from .target import Target, nearest_target
+from .target import Target, in_target_lane, nearer, nearest_target
 
-__all__ = ["Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Evasion", "EvasionConfig",
-           "EvasionDebug", "Following", "FollowingDebug", "Judgement",
-           "LaneChange", "LaneChangeConfig", "LaneChangeDebug", "LaneKeeping", "LaneKeepingDebug", "LateralRef",
-           "MinJerkPath", "MobilConfig", "Phase", "Target", "idm_accel", "judge", "nearest_target",
-           "sideslip_for_curvature", "steering_for_curvature"]
+__all__ = ["EVASIVE_EVENTS", "Controller", "EmergencyBraking", "EmergencyBrakingDebug", "Evasion", "EvasionConfig",
+           "EvasionDebug", "Following", "FollowingDebug", "Judgement", "LaneChange", "LaneChangeConfig",
+           "LaneChangeDebug", "LaneKeeping", "LaneKeepingDebug", "LateralRef", "MinJerkPath", "MobilConfig", "Phase",
+           "Target", "idm_accel", "in_target_lane", "judge", "nearer", "nearest_target", "sideslip_for_curvature",
+           "steering_for_curvature"]

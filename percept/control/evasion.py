@@ -21,8 +21,8 @@ from .mobil import MobilConfig, judge
 from .target import Target
 from .tuning import STOP_GAIN
 
-FREE = ("ok", "no gain")
-"""MOBIL's verdicts that leave a lane free to swerve into (it need not pay; it must be safe)."""
+EVASIVE_EVENTS = ("swerve", "full braking")
+"""The events that begin an evasive manoeuvre (``EvasionDebug.event``)."""
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,8 @@ class Evasion(Controller):
         self.acting = False  # an evasive manoeuvre is under way (one event per episode)
 
     def needed(self, target: Target | None) -> float | None:
-        """The deceleration [m/s²] the emergency-braking law would command for ``target`` (None: no vehicle closing)."""
+        """The deceleration [m/s²] the emergency-braking law would command for ``target`` (None: no vehicle
+        closing)."""
         if target is None or target.kind is not ObjectKind.VEHICLE or target.closing_mps <= 0:
             return None
         if target.source not in ("cut-in", "lead"):
@@ -81,7 +82,7 @@ class Evasion(Controller):
             self.acting = False
             return 0, EvasionDebug(need, self.short, 0, "braking suffices", None)
         side = self._free_side(target, path, neighbours, speed_mps)
-        event = None if self.acting else ("swerve" if side else "full braking")
+        event = None if self.acting else EVASIVE_EVENTS[0 if side else 1]
         self.acting = True
         reason = f"swerve {'left' if side > 0 else 'right'}" if side else "no free lane: full braking"
         return side, EvasionDebug(need, self.short, side, reason, event)
@@ -93,7 +94,6 @@ class Evasion(Controller):
         cutter = neighbours.cutting_in() if target.source == "cut-in" else None
         order = (-cutter.lane, cutter.lane) if cutter is not None else (1, -1)
         for side in order:
-            if judge(side, path.lane.lane_beside(side), neighbours, speed_mps, self.set_speed,
-                     self.mobil).reason in FREE:
+            if judge(side, path.lane.lane_beside(side), neighbours, speed_mps, self.set_speed, self.mobil).safe:
                 return side
         return 0

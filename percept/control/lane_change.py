@@ -18,15 +18,13 @@ from enum import Enum
 from percept.sensors import EgoPath, Neighbours
 
 from .base import Controller
-from .lateral_path import LateralRef, MinJerkPath
 from .evasion import Evasion, EvasionConfig, EvasionDebug
+from .lateral_path import LateralRef, MinJerkPath
 from .mobil import Judgement, MobilConfig, judge
 from .target import Target
 
 PLAN_POINTS = 12
 """Points of the rest of the path in the debug record (the review draws them)."""
-UNSAFE = ("beside", "gap ahead", "gap behind", "follower brakes")
-"""MOBIL's reasons that end a change not yet across the boundary (the gain may fade without ending it)."""
 
 
 class Phase(str, Enum):
@@ -101,7 +99,7 @@ class LaneChange(Controller):
         if self.phase is Phase.KEEP:
             side, evasion = self.evasion.update(target, path, neighbours, speed_mps)
             if side:
-                return self._start(Phase.EVADE, side, path, self.cfg.evasion.duration_s, "swerve", evasion)
+                return self._start(Phase.EVADE, side, path, self.cfg.evasion.duration_s, evasion.reason, evasion)
             ref, debug = self._keep(path, neighbours, speed_mps, dt)
             return ref, replace(debug, evasion=evasion, event=debug.event or evasion.event)
         return self._follow(path, neighbours, speed_mps, dt)
@@ -127,13 +125,14 @@ class LaneChange(Controller):
         return self._start(Phase.CHANGE, side, path, self.cfg.duration_s, reason, None, verdicts)
 
     def _start(self, phase: Phase, side: int, path: EgoPath, duration_s: float, reason: str,
-               evasion: EvasionDebug | None, verdicts: tuple[Judgement, ...] = ()) -> tuple[LateralRef, LaneChangeDebug]:
+               evasion: EvasionDebug | None,
+               verdicts: tuple[Judgement, ...] = ()) -> tuple[LateralRef, LaneChangeDebug]:
         """Begin a path of ``duration_s`` from where the car is into the lane on ``side``: a change or a swerve."""
         lane = path.lane
         self.phase, self.side, self.t_s, self.index0, self.width0 = phase, side, 0.0, lane.index, lane.width_m
         self.path = MinJerkPath.between(lane.offset_m, 0.0, 0.0, side * lane.width_m, duration_s)
         ref = self.path.at(0.0)
-        event = "started" if phase is Phase.CHANGE else "swerve"
+        event = "started" if evasion is None else evasion.event
         return ref, LaneChangeDebug(phase, side, reason, verdicts, event, ref, into_lane=side, evasion=evasion)
 
     def _follow(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
@@ -149,7 +148,7 @@ class LaneChange(Controller):
         if self.phase is Phase.CHANGE and not crossed and neighbours is not None:
             verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
             verdicts, reason = (verdict,), verdict.reason
-            if verdict.reason in UNSAFE:
+            if not verdict.safe:  # the gain may fade without ending it
                 self.phase, event, self.t_s = Phase.RETURN, "aborted", 0.0
                 self.path = MinJerkPath.between(planned.offset_m, planned.rate_mps, planned.accel_mps2, 0.0,
                                                 self.cfg.duration_s)

@@ -66,7 +66,14 @@ class Judgement:
 
     @property
     def go(self) -> bool:
+        """The change pays and is safe."""
         return self.reason == "ok"
+
+    @property
+    def safe(self) -> bool:
+        """The lane exists and the change is safe, whether or not it pays (a swerve needs no gain; a change under
+        way that stops paying goes on)."""
+        return self.reason in ("ok", "no gain")
 
 
 def _gap(n: Neighbour, k: float) -> float:

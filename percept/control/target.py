@@ -23,20 +23,28 @@ class Target:
         return self.kind is ObjectKind.PEDESTRIAN
 
 
+def nearer(*targets: Target | None) -> Target | None:
+    """The nearest of ``targets`` (None where none is given)."""
+    return min((t for t in targets if t is not None), key=lambda t: t.gap_m, default=None)
+
+
+def in_target_lane(neighbours: Neighbours | None, into_lane: int) -> Target | None:
+    """While the car changes into the lane ``into_lane`` (+1 left, -1 right; 0 none), the nearest neighbour ahead in
+    that lane; None otherwise."""
+    ahead = neighbours.nearest(into_lane, Zone.AHEAD) if into_lane and neighbours is not None else None
+    return None if ahead is None else Target(ahead.gap_m, -ahead.rel_speed_mps, ObjectKind.VEHICLE, "target lane")
+
+
 def nearest_target(lead: Lead | None, request: BrakingRequest | None,
                    neighbours: Neighbours | None = None, into_lane: int = 0) -> Target | None:
     """The nearest of the lead (longitudinal slot), the braking request (pedestrian slot), the neighbour flagged
-    as cutting in (neighbours slot) and, while the car changes into the lane ``into_lane`` (+1 left, -1 right; 0
-    none), the nearest neighbour ahead in that lane; None when there is none."""
-    cands = []
+    as cutting in (neighbours slot) and ``in_target_lane``; None when there is none."""
+    cands = [in_target_lane(neighbours, into_lane)]
     cut_in = neighbours.cutting_in() if neighbours is not None else None
     if cut_in is not None:
         cands.append(Target(cut_in.gap_m, -cut_in.rel_speed_mps, ObjectKind.VEHICLE, "cut-in"))
-    ahead = neighbours.nearest(into_lane, Zone.AHEAD) if into_lane and neighbours is not None else None
-    if ahead is not None:
-        cands.append(Target(ahead.gap_m, -ahead.rel_speed_mps, ObjectKind.VEHICLE, "target lane"))
     if lead is not None:
         cands.append(Target(bumper_gap_m(lead.range_m), -lead.range_rate_mps, lead.kind, "lead"))
     if BrakingRequest.asking(request) is not None:
         cands.append(Target(bumper_gap_m(request.stop_before_m), -request.range_rate_mps, request.kind, "request"))
-    return min(cands, key=lambda t: t.gap_m) if cands else None
+    return nearer(*cands)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from percept.control import EmergencyBraking, Following, LaneChange, LaneKeeping, nearest_target
+from percept.control import EmergencyBraking, Following, LaneChange, LaneKeeping, in_target_lane, nearer, nearest_target
 from percept.sensors import BrakingRequest, EgoPath, Frame, Lead, Neighbours, PoseEstimate, Source
 
 from .tasks import SlotContext, Task, task_order, upstream_of
@@ -70,7 +70,8 @@ class Agent:
         ref, change = (self.changing.update(path, neighbours, speed, self.dt_s, ahead) if self.changing
                        else (None, None))
         steer, keeping = self.keeping.update(path, ref)
-        target = nearest_target(lead, request, neighbours, change.into_lane) if change and change.into_lane else ahead
+        # during a change, the target lane's nearest car ahead as well
+        target = nearer(ahead, in_target_lane(neighbours, change.into_lane)) if change else ahead
         follow, following = self.following.update(target, speed)
         accel, braking = self.braking.update(target, speed, follow, self.dt_s,
                                              withdrawn=request is not None and request.withdrawn)

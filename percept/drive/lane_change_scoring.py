@@ -1,12 +1,13 @@
-"""Progress and lane changes against ground truth: the run JSON's ``progress`` and ``lane_changes`` groups.
+"""Progress and lane changes against ground truth: the run JSON's ``progress``, ``lane_changes`` and ``evasive``
+groups.
 
 Progress is the mean true speed, its ratio to the set speed, and the distance driven. A lane change is started,
 completed or aborted as the lane-change law's debug record says (null where no law commands the car: lane changes
 off, or highway-env's MOBIL driving it). A change is **unsafe** when, on the frame the ego's true lane changes, the
-new follower would have to brake harder than ``UNSAFE_BRAKING_MPS2``
-by IDM with highway-env's own ``IDMVehicle`` parameters (``control.idm_accel``; the follower taken to want its own
-speed, so that only the ego's arrival brakes it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under
-``UNSAFE_TIME_GAP_S`` at the ego's speed, or a car is beside the ego in it. Peak lateral acceleration and jerk are
+new follower would have to brake harder than ``UNSAFE_BRAKING_MPS2`` by IDM with highway-env's own ``IDMVehicle``
+parameters (``control.idm_accel``; the follower taken to want its own speed, so that only the ego's arrival brakes
+it) to keep its safe gap, or the bumper gap ahead or behind in the new lane is under ``UNSAFE_TIME_GAP_S`` at the
+ego's speed, or a car is beside the ego in it. Peak lateral acceleration and jerk are
 the true ones (the IMU's lateral axis without noise, less the lane's own centripetal v^2 kappa) over the frames of
 a commanded change, swerves left out. Evasive manoeuvres (``evasive``) are the evasion law's swerves and its full
 braking where no lane was free, each with its outcome: whether the ego hit anything within ``EVASIVE_WINDOW_S``.
@@ -14,7 +15,7 @@ braking where no lane was free, each with its outcome: whether the ego hit anyth
 
 from __future__ import annotations
 
-from percept.control import idm_accel
+from percept.control import EVASIVE_EVENTS, Phase, idm_accel
 from percept.sensors import Zone
 
 from .neighbours_truth import truth_neighbours
@@ -25,8 +26,6 @@ UNSAFE_TIME_GAP_S = 0.5
 """A change that leaves a gap ahead or behind shorter than this at the ego's speed is unsafe [s]."""
 EVASIVE_WINDOW_S = 5.0
 """An evasive manoeuvre failed when the ego hits something within this long of its start [s]."""
-EVASIVE_EVENTS = ("swerve", "full braking")
-"""The lane-change law's events that begin an evasive manoeuvre."""
 
 
 class ProgressScorer:
@@ -64,7 +63,7 @@ class LaneChangeScorer:
     def update(self, gt, debug) -> None:
         """One frame: ``gt`` the ground truth, ``debug`` the lane-change law's record (None: lane changes off)."""
         lane = gt.lane.lane_index[2]
-        changing = debug is not None and debug.phase.value not in ("keep", "evade")
+        changing = debug is not None and debug.phase not in (Phase.KEEP, Phase.EVADE)
         if debug is not None and debug.event in self.counts:
             self.counts[debug.event] += 1
         self._evasive(gt, debug)

@@ -36,7 +36,8 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
                                              world.crossing_pedestrians, agent.following.time_gap,
                                              rig.camera.fx * rig.baseline_m, cfg.detector))
                for t in cfg.tasks}
-    safety, pace, changes = SafetyScorer(), ProgressScorer(world.cruise_speed_mps, world.dt), LaneChangeScorer(world.dt, cfg.lane_changes)
+    safety, pace = SafetyScorer(), ProgressScorer(world.cruise_speed_mps, world.dt)
+    changes = LaneChangeScorer(world.dt, cfg.lane_changes)
     recorder = recorder_factory(world) if recorder_factory else None
     duration = cfg.duration_s if cfg.duration_s is not None else world.scenario.duration_s
     n = max(int(round(duration / world.dt)), 1)

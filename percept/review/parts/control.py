@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import rerun as rr
 
+from percept.control import EVASIVE_EVENTS
 from percept.sensors import EgoPath
 
 from ..context import ESTIMATE_RGB, TRUTH_RGB, Part, PartContext, Plot, log_on_change
@@ -53,8 +54,9 @@ def _draw_change(rec: rr.RecordingStream, ctx: PartContext, change, path: EgoPat
         where = {1: "to the left", -1: "to the right"}.get(change.side, "")
         level = rr.TextLogLevel.INFO if change.event in ("started", "completed") else rr.TextLogLevel.WARN
         ev = change.evasion
-        text = (f"evasive {change.event} {where}: braking needs {ev.needed_mps2:.1f} m/s²" if ev is not None
-                and change.event in ("swerve", "full braking") else f"lane change {where} {change.event}: {change.reason}")
+        text = (f"evasive {change.event} {where}: braking needs {ev.needed_mps2:.1f} m/s²"
+                if ev is not None and change.event in EVASIVE_EVENTS
+                else f"lane change {where} {change.event}: {change.reason}")
         rec.log(CHANGES, rr.TextLog(text.replace("  ", " "), level=level))
     lane = path.lane if path is not None and path.follows_lane else None
     if not change.plan_m or lane is None:
