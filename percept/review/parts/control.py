@@ -10,6 +10,7 @@ import rerun as rr
 
 from percept.control import EVASIVE_EVENTS
 from percept.sensors import EgoPath
+from percept.sensors.vehicle import ACCEL_RANGE_MPS2
 
 from ..context import ESTIMATE_RGB, TRUTH_RGB, Part, PartContext, Plot, log_on_change
 
@@ -39,7 +40,10 @@ def draw(rec: rr.RecordingStream, ctx: PartContext, step, control: dict, truth) 
     terms.pop("follow", None)  # the following law's output: shown as its own two terms
     terms["cruise"] = getattr(following, "cruise_mps2", None)
     terms["follow"] = getattr(following, "follow_mps2", None)
-    ctx.scalars("accel_mps2", command=step.accel_mps2, **{k: terms.get(k) for k in TERM_RGB})
+    # a term beyond what a law may command is drawn at the limit (the log says the limit clipped it): an emergency
+    # term of -1000 m/s² just before contact would flatten the plot
+    ctx.scalars("accel_mps2", command=step.accel_mps2,
+                **{k: None if terms.get(k) is None else float(np.clip(terms[k], *ACCEL_RANGE_MPS2)) for k in TERM_RGB})
     ctx.scalars("steering_rad", command=step.steering_rad)
     accel, steering = limits(control)
     log_on_change(rec, ctx, LOG, (accel, steering), f"acceleration limited by {accel}; steering: {steering}")
