@@ -8,7 +8,8 @@ speed (beyond ``speed_sigmas`` of its estimate) takes its centre to the ego lane
 which was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row since it was
 laterally still there: a car changing into it from the lane beyond, or a ramp's car arriving in the acceleration lane,
 is not cutting in to the ego's), is flagged as cutting in, with the predicted time to that crossing, so the following
-law can treat it as a lead before it arrives.
+law can treat it as a lead before it arrives; the flag stays on while it is tracked in the ego lane after, so that the
+car is not lost before the lead's own slot takes it up close by.
 """
 
 from __future__ import annotations
@@ -99,13 +100,15 @@ class NeighbourSlot:
         the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back (a
         merging car may pause on the line)."""
         c = self.cfg
+        if lane == 0:  # flagged on its way in: it stays a target while it is tracked in the ego lane
+            return True, 0.0
         # towards the ego lane: -sign(l) l' > 0; shift from its lane's centre towards it: -sign(l) (l - lane w)
         toward = -math.copysign(1.0, lat) * vl
         shift = -math.copysign(1.0, lat) * (lat - lane * width)
         if t.warning:
             holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
         else:
-            holds = (t.settled >= self.tracker.cfg.min_settled and t.camera is not None and not t.cut_off
+            holds = (t.settled >= self.tracker.cfg.min_settled and t.camera is not None
                      and t.seen >= c.min_seen_share * self.tracker.recent_frames
                      and shift >= c.min_shift_m
                      and toward > max(c.min_lateral_speed_mps, c.speed_sigmas * sig_vl))
@@ -122,7 +125,7 @@ class NeighbourSlot:
         if abs(lane) > 1 or gap > (self.cfg.ahead_m if zone is Zone.AHEAD else self.cfg.behind_m):
             return None
         P = t.kf.P
-        warn = lane != 0 and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
+        warn = (lane != 0 or t.warning) and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
         cut_in, ttc = self._intent(t, lat, vl, lane, width, math.sqrt(max(P[3, 3], 0.0))) if warn else (False, None)
         t.warning = cut_in
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,

@@ -24,6 +24,10 @@ class TrackerConfig:
 
     accel_noise_mps2: float = 2.0  # along-lane white acceleration (1-sigma) [m/s^2]
     lateral_accel_noise_mps2: float = 0.8  # lateral white acceleration (1-sigma) [m/s^2]
+    manoeuvre_accel_noise_mps2: float = 4.0  # ... while the track manoeuvres sideways (a car pulling out) [m/s^2]
+    manoeuvre_sigmas: float = 1.0  # a lateral innovation beyond this many sigmas ...
+    manoeuvre_frames: int = 2  # ... of one sign this many detections in a row starts a manoeuvre, which lasts
+    # until an innovation of that sign falls under it [-]
     lateral_sigma_m: float = 0.12  # a detection's lateral position noise near by (1-sigma), added in quadrature to
     # the detection's own range-dependent sigma_lat_m [m]
     outlier_sigmas: float = 3.0  # a lateral innovation beyond this many sigmas is down-weighted to this size [-]
@@ -63,6 +67,10 @@ class Track:
     settled: int = 0  # detections in a row in that lane since it was laterally still there
     still: bool = False  # it has been laterally still in that lane
     warning: bool = False  # flagged as cutting in at the last report
+    veer: int = 0  # signed count of the lateral innovations in a row beyond TrackerConfig.manoeuvre_sigmas, of one
+    # sign (+ left) [-]
+    veer: int = 0  # signed count of the lateral innovations in a row beyond TrackerConfig.manoeuvre_sigmas, all of
+    # one sign (+ left) [-]
     seen_bits: int = 1  # one bit a frame, the newest lowest: whether a rig found it (the last TrackerConfig.recent_s)
 
     @property
@@ -87,6 +95,8 @@ class NeighbourTracker:
         self.tracks: list[Track] = []
         self._next_id = 1
         self.width = DEFAULT_LANE_WIDTH_M  # the lane width of the last frame [m]
+        # white acceleration: Q = q^2 [[dt^4/4, dt^3/2], [dt^3/2, dt^2]] per axis
+        self._block = np.array([[dt_s ** 4 / 4, dt_s ** 3 / 2], [dt_s ** 3 / 2, dt_s ** 2]])
 
     def reset(self) -> None:
         self.tracks.clear()
@@ -98,11 +108,9 @@ class NeighbourTracker:
         # state (x, x', l, l'): x_k+1 = x_k + dt x'_k, l_k+1 = l_k + dt l'_k
         kf.F = np.array([[1, dt, 0, 0], [0, 1, 0, 0], [0, 0, 1, dt], [0, 0, 0, 1]], float)
         kf.H = np.array([[1, 0, 0, 0], [0, 0, 1, 0]], float)
-        # white acceleration: Q = q^2 [[dt^4/4, dt^3/2], [dt^3/2, dt^2]] per axis
-        block = np.array([[dt ** 4 / 4, dt ** 3 / 2], [dt ** 3 / 2, dt ** 2]])
         kf.Q = np.zeros((4, 4))
-        kf.Q[:2, :2] = block * c.accel_noise_mps2 ** 2
-        kf.Q[2:, 2:] = block * c.lateral_accel_noise_mps2 ** 2
+        kf.Q[:2, :2] = self._block * c.accel_noise_mps2 ** 2
+        kf.Q[2:, 2:] = self._block * c.lateral_accel_noise_mps2 ** 2
         kf.x = np.array([[det.x_m], [0.0], [det.lat_m], [0.0]])
         sigma_l2 = c.lateral_sigma_m ** 2 + det.sigma_lat_m ** 2
         kf.P = np.diag([max(det.sigma_x_m, 0.3) ** 2, 6.0 ** 2, sigma_l2, 1.0 ** 2])
@@ -129,6 +137,8 @@ class NeighbourTracker:
         detections), make new tracks, keep the blind band's tracks and drop the lost ones."""
         window = (1 << self.recent_frames) - 1
         for t in self.tracks:
+            q = self.cfg.manoeuvre_accel_noise_mps2 if self.manoeuvring(t) else self.cfg.lateral_accel_noise_mps2
+            t.kf.Q[2:, 2:] = self._block * q ** 2
             t.kf.predict()
             t.camera, t.box_px = None, None
             t.seen_bits = (t.seen_bits << 1) & window
@@ -154,7 +164,9 @@ class NeighbourTracker:
             used_t.add(i)
             used_d.add(j)
             t, d = self.tracks[i], dets[j]
-            t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=self._noise(t, d))
+            R = self._noise(t, d)
+            self._count_veer(t, d.lat_m - t.lat, float(t.kf.P[2, 2]) + R[1, 1])
+            t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
             t.hits, t.misses = t.hits + 1, 0
             t.seen_bits |= 1
             # a held track leaves the band once a rig has seen it confirm_hits times in a row: a lone detection of
@@ -173,6 +185,20 @@ class NeighbourTracker:
             if j not in used_d:
                 self.tracks.append(Track(self._next_id, self._new_filter(d), camera=rig, box_px=d.box_px))
                 self._next_id += 1
+
+    def manoeuvring(self, t: Track) -> bool:
+        """Whether a track's lateral innovations say it moves sideways faster than its filter follows: then its
+        lateral process noise is ``manoeuvre_accel_noise_mps2`` (Bar-Shalom, Li & Kirubarajan 2001, sec. 11.2: a
+        manoeuvre detected from the innovations switches the noise level)."""
+        return abs(t.veer) >= self.cfg.manoeuvre_frames
+
+    def _count_veer(self, t: Track, nu_m: float, s_m2: float) -> None:
+        """Count a lateral innovation ``nu_m`` [m] of variance ``s_m2`` [m^2] into ``Track.veer``: one beyond
+        ``manoeuvre_sigmas`` of the sign of the run so far extends it, of the other sign starts a new run, and a
+        small one ends it (a single jump of the face, which the outlier weighting damps, is a run of one)."""
+        big = abs(nu_m) > self.cfg.manoeuvre_sigmas * np.sqrt(s_m2)
+        sign = 1 if nu_m > 0 else -1
+        t.veer = (t.veer + sign if t.veer * sign > 0 else sign) if big else 0
 
     def _may_take_over(self, t: Track, d: Detection) -> bool:
         """Whether detection ``d`` may update track ``t``: any may, but a track held in the blind band is taken over

@@ -216,8 +216,10 @@ class Neighbour:
     sigma_lateral_m: float = 0.0  # 1-sigma of lateral_m [m]
     camera: str | None = None  # "front" or "rear": the rig that measured it this frame (None: predicted only)
     box_px: tuple | None = None  # (u0, v0, u1, v1) in that rig's left image [px], or None
-    cut_in: bool = False  # its lateral motion will take it across the boundary into the ego lane
-    time_to_cross_s: float | None = None  # predicted time until its centre reaches that boundary [s] (cut-ins only)
+    cut_in: bool = False  # its lateral motion will take it across the boundary into the ego lane (or, in the ego
+    # lane, it came in so, and stays flagged while it is tracked there)
+    time_to_cross_s: float | None = None  # predicted time until its centre reaches that boundary [s] (cut-ins only; 0
+    # once across)
 
     @property
     def predicted(self) -> bool:
@@ -251,7 +253,7 @@ class Neighbours:
         return next((n for n in self.tracks if n.lane == lane and n.zone is zone), None)
 
     def cutting_in(self) -> Neighbour | None:
-        """The nearest neighbour ahead in a lane beside flagged as cutting in (the following law treats it as a lead
-        before it arrives); None when none is."""
-        ahead = [n for n in self.tracks if n.cut_in and n.zone is Zone.AHEAD and n.lane != 0]
+        """The nearest neighbour ahead flagged as cutting in (the following law treats it as a lead before it arrives,
+        and until the lead's own slot takes it up); None when none is."""
+        ahead = [n for n in self.tracks if n.cut_in and n.zone is Zone.AHEAD]
         return min(ahead, key=lambda t: t.gap_m) if ahead else None

@@ -94,6 +94,9 @@ def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
     assert flagged_at is not None and crossed_at is not None
     assert (crossed_at - flagged_at) * DT >= 1.0
     assert NeighbourConfig().horizon_s >= 1.0
+    # in the ego lane now, it stays flagged: a target until the lead's own slot takes it up
+    cut = nb.cutting_in()
+    assert cut is not None and cut.lane == 0 and cut.time_to_cross_s == 0.0
 
 
 def test_something_found_on_one_frame_in_three_is_not_flagged():
@@ -166,6 +169,43 @@ def test_a_lone_sideways_jump_of_a_face_barely_moves_the_track():
     for k in range(20):
         tr.step({"front": [det(30.0, W - 1.3)]}, W)
     assert abs(t.lat - (W - 1.3)) < 0.2
+
+
+def _pull_out(cfg: TrackerConfig) -> tuple[list[float], list[float], list[bool]]:
+    """A car settled 12 m ahead in the left lane pulls out towards the ego lane, its lateral speed rising at
+    3 m/s^2 to 1.8 m/s: (true lateral speeds, estimated ones, whether the track manoeuvres), a frame each from the
+    pull-out's first."""
+    tr = NeighbourTracker(DT, cfg)
+    for _ in range(30):
+        tr.step({"front": [det(12.0, W)]}, W)
+    lat, speed, truth, est, veers = W, 0.0, [], [], []
+    for _ in range(15):
+        speed = min(speed + 3.0 * DT, 1.8)
+        lat -= speed * DT
+        tr.step({"front": [det(12.0, lat)]}, W)
+        truth.append(-speed)
+        est.append(float(tr.tracks[0].kf.x[3, 0]))
+        veers.append(tr.manoeuvring(tr.tracks[0]))
+    return truth, est, veers
+
+
+def test_a_car_pulling_out_is_followed_sideways_once_its_innovations_say_it_manoeuvres():
+    truth, est, veers = _pull_out(TrackerConfig())
+    assert not veers[0] and any(veers[:8])
+    # 0.73 s after it began, its lateral speed is read within a fifth of the truth
+    assert est[10] == pytest.approx(truth[10], rel=0.2)
+    # the filter without the manoeuvre's noise reads less than half of it
+    truth, est_fixed, _ = _pull_out(replace(TrackerConfig(), manoeuvre_accel_noise_mps2=0.8))
+    assert abs(est_fixed[10]) < 0.5 * abs(truth[10])
+
+
+def test_a_lone_sideways_jump_is_no_manoeuvre():
+    tr = NeighbourTracker(DT)
+    for _ in range(30):
+        tr.step({"front": [det(30.0, W)]}, W)
+    tr.step({"front": [det(30.0, W - 1.3)]}, W)
+    tr.step({"front": [det(30.0, W)]}, W)
+    assert not tr.manoeuvring(tr.tracks[0]) and tr.tracks[0].veer == 0
 
 
 def _held_track() -> NeighbourTracker:

@@ -27,9 +27,11 @@ def test_a_lane_is_not_free_while_a_track_may_be_in_the_span():
     assert nb.lane_free(-1, 0.0, 20.0) is False and nb.lane_free(0, 50.0, 50.0)
 
 
-def test_the_nearest_car_cutting_in_ahead_in_a_lane_beside_is_the_lead():
-    nb = Neighbours((track(1, 1, 40.0, cut_in=True), track(2, -1, 25.0, cut_in=True), track(3, 0, 15.0, cut_in=True),
+def test_the_nearest_car_cutting_in_ahead_is_the_lead():
+    nb = Neighbours((track(1, 1, 40.0, cut_in=True), track(2, -1, 25.0, cut_in=True), track(3, 0, 15.0),
                      track(4, 1, 2.0, cut_in=True)))
-    # the ego lane's car and the car beside are not cut-ins ahead
+    # the ego lane's car not flagged, and the car beside, are not cut-ins ahead
     assert nb.cutting_in().track_id == 2
+    # one flagged on its way in stays the cut-in once in the ego lane
+    assert Neighbours(nb.tracks + (track(5, 0, 12.0, cut_in=True),)).cutting_in().track_id == 5
     assert Neighbours((track(1, 1, 40.0),)).cutting_in() is None
