@@ -36,10 +36,11 @@ def in_target_lane(neighbours: Neighbours | None, into_lane: int) -> Target | No
 
 
 def nearest_target(lead: Lead | None, request: BrakingRequest | None,
-                   neighbours: Neighbours | None = None, into_lane: int = 0) -> Target | None:
-    """The nearest of the lead (longitudinal slot), the braking request (pedestrian slot), the neighbour flagged
-    as cutting in (neighbours slot) and ``in_target_lane``; None when there is none."""
-    cands = [in_target_lane(neighbours, into_lane)]
+                   neighbours: Neighbours | None = None) -> Target | None:
+    """The nearest of the lead (longitudinal slot), the braking request (pedestrian slot) and the neighbour flagged
+    as cutting in (neighbours slot); None when there is none. During a lane change the agent adds
+    ``in_target_lane`` with ``nearer``."""
+    cands = []
     cut_in = neighbours.cutting_in() if neighbours is not None else None
     if cut_in is not None:
         cands.append(Target(cut_in.gap_m, -cut_in.rel_speed_mps, ObjectKind.VEHICLE, "cut-in"))

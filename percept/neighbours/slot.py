@@ -93,12 +93,13 @@ class NeighbourSlot:
 
     def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float
                 ) -> tuple[bool, float | None]:
-        """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside: it starts when the
-        track, settled in its lane, measured this frame (not cut off by the image's edge) and on ``min_seen_share``
-        of the recent ones, moves towards the ego lane faster than both ``min_lateral_speed_mps`` and
-        ``speed_sigmas`` as a rig measures it, has left its lane's centre by ``min_shift_m`` towards it and will reach
-        the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move back (a
-        merging car may pause on the line)."""
+        """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside, or in the ego lane
+        after a warning: it starts when the track, settled in its lane, measured this frame (a face cut off by the
+        image's edge counts: a car pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves
+        towards the ego lane faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it,
+        has left its lane's centre by ``min_shift_m`` towards it and will reach the boundary within ``horizon_s``; it
+        holds while the car stays shifted that way and does not move back (a merging car may pause on the line), and
+        once it is in the ego lane (time to crossing 0)."""
         c = self.cfg
         if lane == 0:  # flagged on its way in: it stays a target while it is tracked in the ego lane
             return True, 0.0

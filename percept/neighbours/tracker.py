@@ -67,8 +67,6 @@ class Track:
     settled: int = 0  # detections in a row in that lane since it was laterally still there
     still: bool = False  # it has been laterally still in that lane
     warning: bool = False  # flagged as cutting in at the last report
-    veer: int = 0  # signed count of the lateral innovations in a row beyond TrackerConfig.manoeuvre_sigmas, of one
-    # sign (+ left) [-]
     veer: int = 0  # signed count of the lateral innovations in a row beyond TrackerConfig.manoeuvre_sigmas, all of
     # one sign (+ left) [-]
     seen_bits: int = 1  # one bit a frame, the newest lowest: whether a rig found it (the last TrackerConfig.recent_s)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from percept.control import (LaneChange, LaneChangeConfig, LaneKeeping, LateralRef, MinJerkPath, MobilConfig, Phase,
-                             idm_accel, judge, nearest_target)
+                             idm_accel, in_target_lane, judge, nearer, nearest_target)
 from percept.sensors import EgoPath, LaneEstimate, Neighbour, Neighbours, Zone, zone_and_gap
 from percept.sensors.vehicle import EGO_LENGTH_M
 
@@ -170,6 +170,7 @@ def test_lane_keeping_follows_a_reference_with_its_feed_forward():
 
 def test_a_change_follows_the_target_lanes_lead_as_well():
     near = car(1, 20.0, rel=-3.0)
-    t = nearest_target(None, None, around(near, car(0, 50.0, track_id=2)), into_lane=1)
+    record = around(near, car(0, 50.0, track_id=2))
+    t = nearer(nearest_target(None, None, record), in_target_lane(record, 1))
     assert t.source == "target lane" and t.gap_m == pytest.approx(near.gap_m)
-    assert nearest_target(None, None, around(near), into_lane=0) is None
+    assert nearer(nearest_target(None, None, around(near)), in_target_lane(around(near), 0)) is None
