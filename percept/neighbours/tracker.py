@@ -237,26 +237,32 @@ class NeighbourTracker:
 
     def _heading_for_band(self, t: Track) -> bool:
         """Whether a track lies within ``fringe_m`` of the blind band's ends, outside it, and moves towards it."""
-        c = self.cfg
-        x, vx = t.x, float(t.kf.x[1, 0])
-        return (c.blind_ahead_m < x <= c.blind_ahead_m + c.fringe_m and vx < 0) or (
-            c.blind_behind_m - c.fringe_m <= x < c.blind_behind_m and vx > 0)
+        # towards the band: x' < 0 ahead of it, x' > 0 behind it
+        return self._in_fringe(t) and float(t.kf.x[1, 0]) * t.x < 0
 
     def sigma_x(self, t: Track) -> float:
         """A track's along-lane 1-sigma [m]: its filter's, widened at ``blind_spread_mps`` for as long as it has been
         held in the blind band (a car there may change its speed unseen)."""
         return float(np.sqrt(max(t.kf.P[0, 0], 0.0))) + self.cfg.blind_spread_mps * t.blind_s
 
+    def _in_fringe(self, t: Track) -> bool:
+        """Whether a track lies within ``fringe_m`` of the blind band's ends, outside it."""
+        c = self.cfg
+        return (c.blind_ahead_m < t.x <= c.blind_ahead_m + c.fringe_m
+                or c.blind_behind_m - c.fringe_m <= t.x < c.blind_behind_m)
+
     def _keep_or_drop(self, width_m: float) -> None:
-        """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until
-        a rig takes it over; an established one heading for the band from its fringe coasts; any other counts a miss,
-        and too many drop it."""
+        """Unseen tracks: a confirmed one in (or come out of) the blind band, or last seen cut off by the image's edge
+        in its fringe (a car at the edge that vanishes has gone on into the band), is held in the band by prediction
+        until a rig takes it over; an established one heading for the band from its fringe coasts; any other counts a
+        miss, and too many drop it."""
         c = self.cfg
         kept = []
         for t in self.tracks:
             if t.camera is None:
                 beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
-                if beside and (self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0) and t.blind_s < c.max_blind_s:
+                into = self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0 or (t.cut_off and self._in_fringe(t))
+                if beside and into and t.blind_s < c.max_blind_s:
                     self._hold_in_band(t)
                 elif not (beside and t.hits >= c.min_settled and self._heading_for_band(t)):
                     t.misses += 1

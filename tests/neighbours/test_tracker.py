@@ -256,6 +256,26 @@ def test_a_track_heading_for_the_band_coasts_unseen_from_its_fringe():
     assert tr.tracks == []
 
 
+def test_a_car_last_seen_cut_off_in_the_fringe_is_held_in_the_band_when_it_vanishes():
+    cfg = TrackerConfig()
+    tr = NeighbourTracker(DT)
+    x = cfg.blind_ahead_m + 1.0
+    for _ in range(30):  # seen cut off at the front image's edge, read as drifting away from the band
+        tr.step({"front": [replace(det(x, -W, sigma=2.0), cut_off=True)]}, W)
+        x += 0.5 * DT
+    for _ in range(cfg.max_misses + 1):  # then unseen: it has gone on into the band
+        tr.step({}, W)
+    (t,) = tr.tracks
+    assert t.blind_s > 0 and cfg.blind_behind_m <= t.x <= cfg.blind_ahead_m
+    # a whole face in the same place that vanishes is lost, not held
+    tr = NeighbourTracker(DT)
+    for k in range(30):
+        tr.step({"front": [det(cfg.blind_ahead_m + 1.0 + 0.5 * k * DT, -W)]}, W)
+    for _ in range(cfg.max_misses + 1):
+        tr.step({}, W)
+    assert tr.tracks == []
+
+
 def test_bad_points_config_is_refused():
     from percept.neighbours import BandStereo
 
