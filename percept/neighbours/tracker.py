@@ -151,9 +151,7 @@ class NeighbourTracker:
         for i, t in enumerate(self.tracks):
             for j, d in enumerate(dets):
                 # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
-                # and with a held track's (a car held unseen in the blind band may come out at either end of it)
-                held = 2 * self.sigma_x(t) if t.blind_s > 0 else 0.0
-                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m + held
+                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
                 if dx <= gate_x and dl <= c.gate_l_m and self._may_take_over(t, d):
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))

@@ -276,21 +276,6 @@ def test_a_car_last_seen_cut_off_in_the_fringe_is_held_in_the_band_when_it_vanis
     assert tr.tracks == []
 
 
-def test_a_held_car_coming_out_at_the_far_end_of_the_band_keeps_its_track():
-    cfg = TrackerConfig()
-    tr = _held_track()  # stopped at the band's front end
-    (held,) = tr.tracks
-    for _ in range(int(4 / DT)):  # unseen 4 s more: it may be anywhere in the band
-        tr.step({}, W)
-    # it comes out behind, 3 m/s slower than the ego: the rear rig sees it 2 m past the band's rear end
-    x = cfg.blind_behind_m - 2.0
-    for _ in range(cfg.confirm_hits + 5):
-        tr.step({"rear": [det(x, W)]}, W)
-        x -= 3.0 * DT
-    assert [t.track_id for t in tr.tracks] == [held.track_id]
-    assert held.blind_s == 0.0 and held.x == pytest.approx(x + 3.0 * DT, abs=1.0)
-
-
 def test_bad_points_config_is_refused():
     from percept.neighbours import BandStereo
 
