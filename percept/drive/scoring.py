@@ -63,6 +63,8 @@ class StepTruth:
     accel_mps2: float  # the commanded acceleration [m/s²]
     steering_rad: float  # the commanded front-wheel angle [rad]
     changing_lanes: bool = False  # a lane change (or its return) is commanded this frame
+    change_side: int = 0  # the side of that change, +1 left, -1 right (0: either, highway-env's MOBIL in the ego's
+    # place, whose side is not read)
 
 
 def hard_braking(step: StepTruth) -> bool:
@@ -72,22 +74,37 @@ def hard_braking(step: StepTruth) -> bool:
 
 @dataclass
 class SafetyScorer:
-    """Run-level counts: collisions, pedestrians hit, lane departures (a body edge crossing a lane boundary while no
-    lane change is commanded)."""
+    """Run-level counts: collisions, pedestrians hit, lane departures (a body edge crossing a lane boundary, unless a
+    lane change is commanded and the boundary is the one it crosses: the far side of the lane left, or the near side
+    of the lane it has come into)."""
 
     departures: int = 0  # times a body edge crossed a lane boundary outside a commanded lane change
     crashed: bool = False  # the ego hit something other than a pedestrian (those count in ped_hits)
     ped_hits: set = field(default_factory=set)  # ids of the pedestrians hit
-    _outside: bool = False  # a body edge is over a lane boundary this frame
+    _over: int = 0  # the boundary a body edge is over this frame: +1 left, -1 right, 0 none
+    _start_lane: int | None = None  # the true lane's id where the change under way began (None: no change)
 
     def update(self, step: StepTruth) -> None:
         gt = step.truth
-        outside = abs(gt.lane.offset_m) + EGO_WIDTH_M / 2 > gt.lane.width_m / 2
-        if outside and not self._outside and not step.changing_lanes:
+        half = gt.lane.width_m / 2 - EGO_WIDTH_M / 2
+        # a body edge over the left boundary: offset > w/2 - W/2; over the right one: offset < -(w/2 - W/2)
+        over = 1 if gt.lane.offset_m > half else -1 if gt.lane.offset_m < -half else 0
+        lane = gt.lane.lane_index[2]
+        self._start_lane = (lane if self._start_lane is None else self._start_lane) if step.changing_lanes else None
+        if over and not self._over and not self._crossed_by_change(step, over, lane):
             self.departures += 1
-        self._outside = outside
+        self._over = over
         self.crashed |= gt.crashed and not gt.pedestrians_hit
         self.ped_hits.update(gt.pedestrians_hit)
+
+    def _crossed_by_change(self, step: StepTruth, over: int, lane: int) -> bool:
+        """Whether the boundary on side ``over`` of true lane ``lane`` is the one the commanded change crosses: on its
+        side in the lane it began in, on the other side once the car is in the next one."""
+        if not step.changing_lanes:
+            return False
+        if step.change_side == 0:
+            return True
+        return over == (step.change_side if lane == self._start_lane else -step.change_side)
 
     def result(self, unsafe_lane_changes: int = 0) -> dict:
         """The run's safety counts, under the names in ``SAFETY_COUNTS``; ``unsafe_lane_changes`` as the lane-change

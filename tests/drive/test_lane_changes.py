@@ -19,13 +19,25 @@ class Changing:
         self.phase, self.event = phase, event
 
 
+def _departures(truth, frames, side: int = 0, changing: bool = True) -> int:
+    """Lane departures over ``frames``, each (offset [m], true lane id), for a change to ``side`` (``changing``)."""
+    s = SafetyScorer()
+    for offset, lane in frames:
+        s.update(StepTruth(truth(offset=offset, lane_index=("a", "b", lane)), [], None, 0.0, 0.0, changing, side))
+    return s.result()["lane_departures"]
+
+
 def test_a_boundary_crossed_in_a_commanded_change_is_no_departure(truth):
-    quiet, changing = SafetyScorer(), SafetyScorer()
-    for offset in (0.0, 0.6, 1.2):  # a 2 m car in a 4 m lane: a body edge over the line beyond 1 m
-        gt = truth(offset=offset)
-        quiet.update(StepTruth(gt, [], None, 0.0, 0.0))
-        changing.update(StepTruth(gt, [], None, 0.0, 0.0, changing_lanes=True))
-    assert quiet.result()["lane_departures"] == 1 and changing.result()["lane_departures"] == 0
+    # a 2 m car in a 4 m lane: a body edge is over a line beyond 1 m; lane 1 to lane 0 on the left, the centre
+    # crossing between the third and fourth frames
+    left = [(0.0, 1), (0.6, 1), (1.2, 1), (-1.6, 0), (-0.4, 0)]
+    assert _departures(truth, left, changing=False) == 1
+    assert _departures(truth, left, side=+1) == 0
+    assert _departures(truth, left, side=0) == 0  # highway-env's MOBIL in the ego's place: any boundary
+    # the car drifts over the right boundary while a change to the left is commanded: a departure
+    assert _departures(truth, [(0.0, 1), (-0.6, 1), (-1.2, 1)], side=+1) == 1
+    # in the new lane, over its far (left) boundary: a departure too
+    assert _departures(truth, left + [(0.6, 0), (1.2, 0)], side=+1) == 1
 
 
 def test_the_laws_idm_is_highway_envs():
