@@ -252,19 +252,22 @@ class NeighbourTracker:
                 or c.blind_behind_m - c.fringe_m <= t.x < c.blind_behind_m)
 
     def _keep_or_drop(self, width_m: float) -> None:
-        """Unseen tracks: a confirmed one in (or come out of) the blind band, or last seen cut off by the image's edge
-        in its fringe (a car at the edge that vanishes has gone on into the band), is held in the band by prediction
-        until a rig takes it over; an established one heading for the band from its fringe coasts; any other counts a
-        miss, and too many drop it."""
+        """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until a
+        rig takes it over; an established one heading for the band from its fringe coasts; one last seen cut off by
+        the image's edge in the fringe and not heading for the band (its speed read from faces that are only in part
+        in view) is held too (a car at the edge that vanishes has gone on into the band); any other counts a miss,
+        and too many drop it."""
         c = self.cfg
         kept = []
         for t in self.tracks:
             if t.camera is None:
                 beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
-                into = self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0 or (t.cut_off and self._in_fringe(t))
+                coasts = beside and t.hits >= c.min_settled and self._heading_for_band(t)
+                into = self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0 or (
+                    t.cut_off and self._in_fringe(t) and not coasts)
                 if beside and into and t.blind_s < c.max_blind_s:
                     self._hold_in_band(t)
-                elif not (beside and t.hits >= c.min_settled and self._heading_for_band(t)):
+                elif not coasts:
                     t.misses += 1
             if t.misses <= (c.max_misses if t.confirmed else 1):
                 kept.append(t)

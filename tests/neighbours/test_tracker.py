@@ -267,6 +267,16 @@ def test_a_car_last_seen_cut_off_in_the_fringe_is_held_in_the_band_when_it_vanis
         tr.step({}, W)
     (t,) = tr.tracks
     assert t.blind_s > 0 and cfg.blind_behind_m <= t.x <= cfg.blind_ahead_m
+    # one read as heading into the band coasts on at its speed instead of stopping at the band's end
+    tr = NeighbourTracker(DT)
+    x = cfg.blind_ahead_m + 9.0
+    for _ in range(30):
+        tr.step({"front": [replace(det(x, -W, sigma=0.3), cut_off=True)]}, W)
+        x -= 4.0 * DT
+    for _ in range(int(1.0 / DT)):
+        tr.step({}, W)
+    (t,) = tr.tracks
+    assert t.x == pytest.approx(x - 4.0 * (1.0 - DT), abs=0.5) and t.kf.x[1, 0] == pytest.approx(-4.0, abs=0.3)
     # a whole face in the same place that vanishes is lost, not held
     tr = NeighbourTracker(DT)
     for k in range(30):
