@@ -78,7 +78,7 @@ class SafetyScorer:
     lane change is commanded and the boundary is the one it crosses: the far side of the lane left, or the near side
     of the lane it has come into)."""
 
-    departures: int = 0  # times a body edge crossed a lane boundary outside a commanded lane change
+    departures: int = 0  # times a body edge crossed a lane boundary that no commanded lane change crosses
     crashed: bool = False  # the ego hit something other than a pedestrian (those count in ped_hits)
     ped_hits: set = field(default_factory=set)  # ids of the pedestrians hit
     _over: int = 0  # the boundary a body edge is over this frame: +1 left, -1 right, 0 none

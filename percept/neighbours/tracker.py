@@ -236,7 +236,7 @@ class NeighbourTracker:
         t.blind_s += self.dt
 
     def _heading_for_band(self, t: Track) -> bool:
-        """Whether a track lies within ``fringe_m`` of the blind band's ends, outside it, and moves towards it."""
+        """Whether a track lies in the band's fringe (``_in_fringe``) and moves towards the band."""
         # towards the band: x' < 0 ahead of it, x' > 0 behind it
         return self._in_fringe(t) and float(t.kf.x[1, 0]) * t.x < 0
 
@@ -253,18 +253,19 @@ class NeighbourTracker:
 
     def _keep_or_drop(self, width_m: float) -> None:
         """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until a
-        rig takes it over; an established one heading for the band from its fringe coasts; one last seen cut off by
-        the image's edge in the fringe and not heading for the band (its speed read from faces that are only in part
-        in view) is held too (a car at the edge that vanishes has gone on into the band); any other counts a miss,
-        and too many drop it."""
+        rig takes it over; one heading for the band from its fringe, established or last seen cut off by the image's
+        edge, coasts; one last seen cut off in the fringe and not heading for the band (its speed read from faces that
+        are only in part in view) is held too (a car at the edge that vanishes has gone on into the band); any other
+        counts a miss, and too many drop it."""
         c = self.cfg
         kept = []
         for t in self.tracks:
             if t.camera is None:
                 beside = t.confirmed and abs(t.lat) >= 0.5 * width_m
-                coasts = beside and t.hits >= c.min_settled and self._heading_for_band(t)
+                heading = self._heading_for_band(t)
+                coasts = beside and (t.hits >= c.min_settled or t.cut_off) and heading
                 into = self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0 or (
-                    t.cut_off and self._in_fringe(t) and not coasts)
+                    t.cut_off and self._in_fringe(t) and not heading)
                 if beside and into and t.blind_s < c.max_blind_s:
                     self._hold_in_band(t)
                 elif not coasts:

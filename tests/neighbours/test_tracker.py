@@ -267,10 +267,10 @@ def test_a_car_last_seen_cut_off_in_the_fringe_is_held_in_the_band_when_it_vanis
         tr.step({}, W)
     (t,) = tr.tracks
     assert t.blind_s > 0 and cfg.blind_behind_m <= t.x <= cfg.blind_ahead_m
-    # one read as heading into the band coasts on at its speed instead of stopping at the band's end
+    # one read as heading into the band, however young, coasts on at its speed instead of stopping at its end
     tr = NeighbourTracker(DT)
     x = cfg.blind_ahead_m + 9.0
-    for _ in range(30):
+    for _ in range(cfg.min_settled - 2):
         tr.step({"front": [replace(det(x, -W, sigma=0.3), cut_off=True)]}, W)
         x -= 4.0 * DT
     for _ in range(int(1.0 / DT)):
