@@ -51,12 +51,11 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         step = agent.step(frame)
         ahead = feed.ahead()
         change = step.control["lane_change"]
-        # the boundary a commanded change crosses, or any that highway-env's MOBIL driving in the ego's place
-        # crosses, is no departure
-        commanded = change is not None and change.phase is not Phase.KEEP
-        changing = commanded or cfg.world.autopilot_lane_changes
-        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad, changing,
-                          change.side if commanded else 0)
+        # the boundary a commanded change crosses, or any that highway-env's MOBIL in the ego's place crosses, is no
+        # departure (side 0: either)
+        side = change.side if change is not None and change.phase is not Phase.KEEP else 0
+        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad,
+                          bool(side) or cfg.world.autopilot_lane_changes, side)
         safety.update(truth)
         pace.update(gt)
         changes.update(gt, change)

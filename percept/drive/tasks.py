@@ -165,7 +165,7 @@ TASKS: tuple[Task, ...] = (
          higher_is_better=("time_gap_mean_s", "time_gap_min_s", "time_gap_steady_s"),
          eval_plots=lazy("percept.evaluate.plots:range_error_by_range")),
     Task("pedestrians", BrakingRequest, lazy("percept.drive.privileged:PrivilegedPedestrians"),
-         lazy("percept.drive.scoring:PedestrianScorer"), vision=_pedestrian_slot,
+         lazy("percept.drive.pedestrian_scoring:PedestrianScorer"), vision=_pedestrian_slot,
          recorder="percept.review.parts.pedestrians:PART", reads=(EgoPath,),
          headline=(Headline("recall", "recall", "{:.3f}"), Headline("false stops", "false_stops", "{}"),
                    Headline("verge brakes", "verge_brakes", "{}"),

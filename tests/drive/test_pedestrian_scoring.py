@@ -5,7 +5,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from percept.drive.privileged import Obstacle
-from percept.drive.scoring import PedestrianScorer, ScoreContext, StepTruth, person_matches
+from percept.drive.pedestrian_scoring import PedestrianScorer, person_matches
+from percept.drive.scoring import ScoreContext, StepTruth
 from percept.sensors import BrakingRequest, ObjectKind, StereoRig
 
 
