@@ -52,10 +52,10 @@ def run_drive(cfg: DriveConfig, recorder_factory=None, progress: Callable[[int, 
         ahead = feed.ahead()
         change = step.control["lane_change"]
         # the boundary a commanded change crosses, or any that highway-env's MOBIL in the ego's place crosses, is no
-        # departure (side 0: either)
-        side = change.side if change is not None and change.phase is not Phase.KEEP else 0
-        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad,
-                          bool(side) or cfg.world.autopilot_lane_changes, side)
+        # departure
+        side = change.side if change is not None and change.phase is not Phase.KEEP else (
+            0 if cfg.world.autopilot_lane_changes else None)
+        truth = StepTruth(gt, ahead, in_path_obstacle(ahead), step.accel_mps2, step.steering_rad, side)
         safety.update(truth)
         pace.update(gt)
         changes.update(gt, change)

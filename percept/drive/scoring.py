@@ -61,9 +61,13 @@ class StepTruth:
     in_path: Obstacle | None  # the true obstacle the ego must respect (None: nothing)
     accel_mps2: float  # the commanded acceleration [m/s²]
     steering_rad: float  # the commanded front-wheel angle [rad]
-    changing_lanes: bool = False  # a lane change (or its return) is commanded this frame
-    change_side: int = 0  # the side of that change, +1 left, -1 right (0: either, highway-env's MOBIL in the ego's
-    # place, whose side is not read)
+    change_side: int | None = None  # the side of the lane change (or its return, or a swerve) under way this frame,
+    # +1 left, -1 right; 0: either (highway-env's MOBIL in the ego's place, whose side is not read); None: none
+
+    @property
+    def changing_lanes(self) -> bool:
+        """A lane change is under way this frame."""
+        return self.change_side is not None
 
 
 def hard_braking(step: StepTruth) -> bool:
@@ -99,11 +103,10 @@ class SafetyScorer:
     def _crossed_by_change(self, step: StepTruth, over: int, lane: int) -> bool:
         """Whether the boundary on side ``over`` of true lane ``lane`` is the one the commanded change crosses: on its
         side in the lane it began in, on the other side once the car is in the next one."""
-        if not step.changing_lanes:
-            return False
-        if step.change_side == 0:
-            return True
-        return over == (step.change_side if lane == self._start_lane else -step.change_side)
+        side = step.change_side
+        if side is None or side == 0:  # no change, or highway-env's MOBIL: any boundary is its
+            return side == 0
+        return over == (side if lane == self._start_lane else -side)
 
     def result(self, unsafe_lane_changes: int = 0) -> dict:
         """The run's safety counts, under the names in ``SAFETY_COUNTS``; ``unsafe_lane_changes`` as the lane-change

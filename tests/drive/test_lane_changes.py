@@ -19,11 +19,11 @@ class Changing:
         self.phase, self.event = phase, event
 
 
-def _departures(truth, frames, side: int = 0, changing: bool = True) -> int:
-    """Lane departures over ``frames``, each (offset [m], true lane id), for a change to ``side`` (``changing``)."""
+def _departures(truth, frames, side: int | None) -> int:
+    """Lane departures over ``frames``, each (offset [m], true lane id), during a change to ``side`` (None: none)."""
     s = SafetyScorer()
     for offset, lane in frames:
-        s.update(StepTruth(truth(offset=offset, lane_index=("a", "b", lane)), [], None, 0.0, 0.0, changing, side))
+        s.update(StepTruth(truth(offset=offset, lane_index=("a", "b", lane)), [], None, 0.0, 0.0, side))
     return s.result()["lane_departures"]
 
 
@@ -31,7 +31,7 @@ def test_a_boundary_crossed_in_a_commanded_change_is_no_departure(truth):
     # a 2 m car in a 4 m lane: a body edge is over a line beyond 1 m; lane 1 to lane 0 on the left, the centre
     # crossing between the third and fourth frames
     left = [(0.0, 1), (0.6, 1), (1.2, 1), (-1.6, 0), (-0.4, 0)]
-    assert _departures(truth, left, changing=False) == 1
+    assert _departures(truth, left, side=None) == 1
     assert _departures(truth, left, side=+1) == 0
     assert _departures(truth, left, side=0) == 0  # highway-env's MOBIL in the ego's place: any boundary
     # the car drifts over the right boundary while a change to the left is commanded: a departure
@@ -65,13 +65,15 @@ def test_a_change_onto_a_close_follower_is_unsafe_onto_a_far_one_not(truth, vehi
 
 
 def test_lateral_acceleration_and_jerk_are_taken_over_the_change_only(truth):
-    s, dt = LaneChangeScorer(0.1), 0.1
+    dt = 0.1
+    s = LaneChangeScorer(dt)
     for a, phase in ((3.0, Phase.KEEP), (0.5, Phase.CHANGE), (0.8, Phase.CHANGE), (0.2, Phase.KEEP)):
         gt = truth()
         gt = gt.__class__(**{**gt.__dict__, "imu": ImuSample(np.array([0.0, a, 9.81]), np.zeros(3))})
         s.update(gt, Changing(phase))
     r = s.result()
-    assert r["peak_lateral_accel_mps2"] == pytest.approx(0.8) and r["peak_lateral_jerk_mps3"] == pytest.approx(3.0)
+    # jerk: |0.8 - 0.5| / dt
+    assert r["peak_lateral_accel_mps2"] == pytest.approx(0.8) and r["peak_lateral_jerk_mps3"] == pytest.approx(0.3 / dt)
 
 
 def test_progress_is_the_mean_speed_over_the_set_one(truth):
