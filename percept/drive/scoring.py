@@ -1,7 +1,7 @@
 """Run metrics against ground truth (docs/design.md, "Scoring definitions"), one scorer per task returning its JSON
 group (pedestrians in ``pedestrian_scoring``, neighbours in ``neighbours_scoring``, lane changes in
-``lane_change_scoring``), plus the run-level safety counts. A metric that does not apply is None. The formulas live in each task's
-``metrics`` module (pure numpy), shared with the footage commands.
+``lane_change_scoring``), plus the run-level safety counts. A metric that does not apply is None. The formulas live
+in each task's ``metrics`` module (pure numpy), shared with the footage commands.
 
 A scorer has ``update(estimate, debug, step)`` once per frame and ``result() -> dict``.
 """
