@@ -40,7 +40,12 @@ class Phase(str, Enum):
 class LaneChangeConfig:
     """When to change lanes and how."""
 
-    duration_s: float = 5.0  # T: how long a change (or a return) takes [s]
+    duration_s: float = 5.0  # T: how long a change takes, and a return at least [s]
+    return_jerk_mps3: float = 2.0  # a return's path is stretched beyond duration_s until its peak jerk is at most
+    # this (a 4 m change from rest in 5 s asks 1.92); lane keeping adds its own on top [m/s³]
+    return_max_s: float = 8.0  # ... up to this long [s]
+    return_margin_m: float = 0.3  # ... so long as it keeps the car's centre this far inside the boundary of the lane
+    # it left (a longer return turns back later): else it takes duration_s [m]
     settle_s: float = 1.0  # how long MOBIL must favour the same side before a change starts [s]
     min_interval_s: float = 8.0  # least time from the end of one change to the start of the next [s]
     mobil: MobilConfig = field(default_factory=MobilConfig)  # the decision's parameters
@@ -149,9 +154,7 @@ class LaneChange(Controller):
             verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
             verdicts, reason = (verdict,), verdict.reason
             if not verdict.safe:  # the gain may fade without ending it
-                self.phase, event, self.t_s = Phase.RETURN, "aborted", 0.0
-                self.path = MinJerkPath.between(planned.offset_m, planned.rate_mps, planned.accel_mps2, 0.0,
-                                                self.cfg.duration_s)
+                self.phase, event, self.t_s, self.path = Phase.RETURN, "aborted", 0.0, self._return(planned)
         # offset in the current lane = offset in the start lane - (index - index_start) w (the width planned with)
         shift = crossed * self.width0
         ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2)
@@ -159,6 +162,18 @@ class LaneChange(Controller):
         plan = tuple((speed_mps * (t - self.t_s), self.path.at(t).offset_m - shift) for t in ahead)
         into = self.side if self.phase is not Phase.RETURN and not crossed else 0
         return ref, LaneChangeDebug(self.phase, self.side, reason, verdicts, event, ref, plan, into)
+
+    def _return(self, at: LateralRef) -> MinJerkPath:
+        """The path back to the centre of the lane the change left, from ``at`` (in its frame): the shortest from
+        ``duration_s`` whose jerk is within ``return_jerk_mps3``, if it keeps the car's centre ``return_margin_m``
+        inside the boundary all along; else (a longer path turns back later) the ``duration_s`` one."""
+        c = self.cfg
+        y0, v0, a0 = at.offset_m, at.rate_mps, at.accel_mps2
+        gentle = MinJerkPath.within_jerk(y0, v0, a0, 0.0, c.duration_s, c.return_jerk_mps3, c.return_max_s)
+        # |y| <= w/2 - margin all along the path
+        if max(abs(y) for y in gentle.extent_m) <= self.width0 / 2 - c.return_margin_m:
+            return gentle
+        return MinJerkPath.between(y0, v0, a0, 0.0, c.duration_s)
 
     def _end(self, crossed: int) -> tuple[None, LaneChangeDebug]:
         """The path's end: a change is completed when the lane estimate has moved to the target lane, else (it never

@@ -43,6 +43,37 @@ class MinJerkPath:
         c3, c4, c5 = np.linalg.solve(A, b)
         return cls((c0, c1, c2, float(c3), float(c4), float(c5)), T)
 
+    @classmethod
+    def within_jerk(cls, y0: float, v0: float, a0: float, y1: float, min_duration_s: float, max_jerk_mps3: float,
+                    max_duration_s: float, step_s: float = 0.25) -> "MinJerkPath":
+        """The shortest of the quintics from ``min_duration_s`` up to ``max_duration_s`` [s], in steps of ``step_s``,
+        whose peak jerk is at most ``max_jerk_mps3`` [m/s³] (the longest when none is): a path that starts in motion,
+        as a return from a change under way does, asks more jerk than one from rest over the same time."""
+        T = min_duration_s
+        path = cls.between(y0, v0, a0, y1, T)
+        while path.peak_jerk_mps3 > max_jerk_mps3 and T + step_s <= max_duration_s + 1e-9:
+            T += step_s
+            path = cls.between(y0, v0, a0, y1, T)
+        return path
+
+    @property
+    def extent_m(self) -> tuple[float, float]:
+        """The least and the largest offset the path reaches [m]."""
+        c, T = self.coeffs, self.duration_s
+        # y' = c1 + 2 c2 t + 3 c3 t^2 + 4 c4 t^3 + 5 c5 t^4 = 0 inside (0, T), and the ends
+        roots = np.roots([5 * c[5], 4 * c[4], 3 * c[3], 2 * c[2], c[1]]) if any(c[1:]) else []
+        times = [0.0, T] + [float(r.real) for r in roots if abs(r.imag) < 1e-9 and 0 < r.real < T]
+        ys = [self.at(t).offset_m for t in times]
+        return min(ys), max(ys)
+
+    @property
+    def peak_jerk_mps3(self) -> float:
+        """The largest size of the path's jerk [m/s³]."""
+        c, T = self.coeffs, self.duration_s
+        # y(3) = 6 c3 + 24 c4 t + 60 c5 t^2: a parabola, largest in size at an end or at its vertex t = -c4 / (5 c5)
+        vertex = [-c[4] / (5 * c[5])] if c[5] != 0 and 0 < -c[4] / (5 * c[5]) < T else []
+        return max(abs(6 * c[3] + 24 * c[4] * t + 60 * c[5] * t * t) for t in [0.0, T, *vertex])
+
     def at(self, t_s: float) -> LateralRef:
         """The path at ``t_s`` [s] (held at its end after T)."""
         t = min(max(t_s, 0.0), self.duration_s)

@@ -24,6 +24,9 @@ UNSAFE_BRAKING_MPS2 = 2.0
 """A change that makes its new follower brake harder than this is unsafe [m/s²]."""
 UNSAFE_TIME_GAP_S = 0.5
 """A change that leaves a gap ahead or behind shorter than this at the ego's speed is unsafe [s]."""
+JUDGED_WITHIN_M = 300.0
+"""The new follower and leader judged at a crossing are the nearest true cars within this bumper gap, well beyond what
+the rigs see, so that a fast car coming from out of their view counts [m]."""
 EVASIVE_WINDOW_S = 5.0
 """An evasive manoeuvre failed when the ego hits something within this long of its start [s]."""
 
@@ -101,7 +104,7 @@ class LaneChangeScorer:
     def _judge_crossing(self, gt) -> None:
         """The new lane's follower and gaps on the frame the ego's centre entered it."""
         v = gt.speed_mps
-        around = truth_neighbours(gt)
+        around = truth_neighbours(gt, JUDGED_WITHIN_M, JUDGED_WITHIN_M)
         ahead, behind = around.nearest(0, Zone.AHEAD), around.nearest(0, Zone.BEHIND)
         # the follower wants its own speed: only the ego's arrival brakes it
         vf = v + behind.rel_speed_mps if behind is not None else 0.0

@@ -143,7 +143,26 @@ class NeighbourTracker:
         self.width = width_m
         for rig, dets in detections.items():
             self._associate(rig, dets)
+        self._merge()
         self._keep_or_drop(width_m)
+
+    def _merge(self) -> None:
+        """Two tracks in one lane, each within the other's association gate, are one car tracked twice (far away its
+        face breaks into groups that may each start a track): the one a rig measured this frame stays, else the one
+        with more detections. Tracks held in the blind band are left to the hand-over."""
+        c, w = self.cfg, self.width
+        gone = set()
+        free = [t for t in self.tracks if t.blind_s <= 0]
+        for a in free:
+            for b in free:
+                if a is b or id(a) in gone or id(b) in gone or round(a.lat / w) != round(b.lat / w):
+                    continue
+                gate = c.gate_x_m + c.gate_x_rel * min(abs(a.x), abs(b.x))
+                if abs(a.x - b.x) <= gate and abs(a.lat - b.lat) <= c.gate_l_m:
+                    # keep the measured one, then the one with more detections
+                    keep = max((a, b), key=lambda t: (t.camera is not None, t.hits))
+                    gone.add(id(b) if keep is a else id(a))
+        self.tracks = [t for t in self.tracks if id(t) not in gone]
 
     def _associate(self, rig: str, dets: list[Detection]) -> None:
         c = self.cfg
@@ -179,8 +198,11 @@ class NeighbourTracker:
             t.settled = t.settled + 1 if lane == t.lane and t.still else int(t.still)
             t.lane = lane
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
+        # a detection left over inside the gate of a track this rig measured this frame is another part of that car
+        # (far away a car's face breaks into several groups): it makes no track of its own
+        parts = {j for _, i, j in pairs if i in used_t}
         for j, d in enumerate(dets):
-            if j not in used_d:
+            if j not in used_d and j not in parts:
                 self.tracks.append(Track(self._next_id, self._new_filter(d), camera=rig, box_px=d.box_px))
                 self._next_id += 1
 

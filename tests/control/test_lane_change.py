@@ -53,6 +53,21 @@ def test_a_path_from_motion_starts_where_the_car_is_and_ends_at_rest():
         MinJerkPath.between(0.0, 0.0, 0.0, W, 0.0)
 
 
+def test_the_peak_jerk_is_the_largest_over_the_path_and_a_path_from_motion_is_stretched_to_bound_it():
+    for p in (MinJerkPath.between(0.0, 0.0, 0.0, W, 5.0), MinJerkPath.between(1.85, 1.48, 0.3, 0.0, 5.0)):
+        t = np.linspace(0, p.duration_s, 20001)
+        a = np.array([p.at(x).accel_mps2 for x in t])
+        assert p.peak_jerk_mps3 == pytest.approx(np.abs(np.diff(a) / np.diff(t)).max(), rel=2e-3)
+    assert MinJerkPath.between(0.0, 0.0, 0.0, W, 5.0).peak_jerk_mps3 == pytest.approx(60 * W / 125)
+    # a return from mid-change (1.85 m across at 1.48 m/s) asks 3.0 m/s^3 in 5 s: stretched in 0.25 s steps
+    bounded = MinJerkPath.within_jerk(1.85, 1.48, 0.0, 0.0, 5.0, 2.0, 8.0)
+    shorter = MinJerkPath.between(1.85, 1.48, 0.0, 0.0, bounded.duration_s - 0.25)
+    assert bounded.peak_jerk_mps3 <= 2.0 < shorter.peak_jerk_mps3 and 5.0 < bounded.duration_s <= 8.0
+    assert MinJerkPath.within_jerk(0.0, 0.0, 0.0, W, 5.0, 2.0, 8.0).duration_s == 5.0
+    # none within the bound by the longest: the longest
+    assert MinJerkPath.within_jerk(1.85, 1.48, 0.0, 0.0, 5.0, 0.1, 6.0).duration_s == pytest.approx(6.0)
+
+
 def test_idm_accelerates_on_a_free_road_and_brakes_behind_a_slow_car():
     assert idm_accel(20.0, 30.0) == pytest.approx(3.0 * (1 - (20 / 30) ** 4))
     assert idm_accel(30.0, 30.0) == pytest.approx(0.0)
@@ -158,6 +173,30 @@ def test_a_change_returns_when_a_car_comes_up_beside_before_it_is_across():
     more, ys = run_law(law, int(7.0 / DT), around(slow, car(1, 1.0, rel=1.0, track_id=2)))
     assert more[0].event == "aborted" and more[0].reason == "beside"
     assert more[-1].phase is Phase.KEEP and abs(ys[-1]) < 1e-3
+
+
+def _change_under_way(seconds: float) -> LaneChange:
+    """A law ``seconds`` into a 5 s change to the left, away from a slow lead."""
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=5.0, settle_s=0.2, return_jerk_mps3=2.0, return_margin_m=0.3))
+    run_law(law, int(0.2 / DT) + 1 + round(seconds / DT), around(car(0, 35.0, rel=-6.0)))
+    assert law.phase is Phase.CHANGE
+    return law
+
+
+def test_a_change_that_turns_unsafe_early_returns_within_the_jerk_bound_and_its_lane():
+    law = _change_under_way(0.8)
+    # a car closing from behind in the target lane
+    dbgs, _ = run_law(law, 1, around(car(0, 35.0, rel=-6.0), car(1, -15.0, rel=2.0, track_id=2)))
+    assert dbgs[0].event == "aborted" and law.phase is Phase.RETURN
+    assert law.path.duration_s > 5.0 and law.path.peak_jerk_mps3 <= 2.0
+    assert max(abs(y) for y in law.path.extent_m) <= W / 2 - 0.3
+
+
+def test_a_change_that_turns_unsafe_late_returns_in_the_change_time_not_later():
+    law = _change_under_way(2.5)
+    dbgs, _ = run_law(law, 1, around(car(0, 35.0, rel=-6.0), car(1, -15.0, rel=2.0, track_id=2)))
+    # a longer return would turn back beyond the margin: back in duration_s, whatever its jerk
+    assert dbgs[0].event == "aborted" and law.path.duration_s == 5.0 and law.path.peak_jerk_mps3 > 2.0
 
 
 def test_lane_keeping_follows_a_reference_with_its_feed_forward():

@@ -52,12 +52,13 @@ def test_the_laws_idm_is_highway_envs():
     assert mobil.JAM_GAP_M == IDMVehicle.DISTANCE_WANTED - Vehicle.LENGTH
 
 
-@pytest.mark.parametrize("behind_m, unsafe", [(12.0, True), (65.0, False)])
-def test_a_change_onto_a_close_follower_is_unsafe_onto_a_far_one_not(truth, vehicle, behind_m, unsafe):
+@pytest.mark.parametrize("behind_m, speed, unsafe", [(12.0, 25.0, True), (65.0, 25.0, False), (95.0, 37.0, True)])
+def test_a_change_onto_a_close_or_fast_follower_is_unsafe_onto_a_far_one_not(truth, vehicle, behind_m, speed, unsafe):
     s = LaneChangeScorer(1 / 15)
     s.update(truth(lane_index=("a", "b", 1)), Changing(event="started"))
-    # the ego's centre now in lane 0, a car at the ego's speed behind it there
-    s.update(truth([vehicle(5, -behind_m, 0.0, speed=25.0)], lane_index=("a", "b", 0)), Changing())
+    # the ego's centre now in lane 0 at 25 m/s, a car behind it there: at its speed, or beyond the rigs' view and
+    # closing at 12 m/s
+    s.update(truth([vehicle(5, -behind_m, 0.0, speed=speed)], lane_index=("a", "b", 0)), Changing())
     r = s.result()
     assert r["started"] == 1 and r["unsafe"] == int(unsafe)
     crossing = r["crossings"][0]
@@ -98,18 +99,20 @@ def test_on_truth_the_car_overtakes_in_dense_traffic_and_keeps_its_lane_by_defau
 
 @pytest.mark.slow
 def test_on_vision_the_lane_estimate_follows_the_car_into_the_next_lane():
-    indices = []
+    indices, sides = [], []
 
     class Look:
         def log_step(self, frame, truth, step):
             indices.append(step.estimates["lanes"].lane.index)
+            change = step.control["lane_change"]
+            sides.extend([change.side] if change.event == "started" else [])
 
-    # overtake: a slow car ahead, the lane to the left free after the faster traffic has passed
-    r = run_drive(DriveConfig(WorldConfig("overtake", 0), duration_s=20.0, lane_changes=True),
+    # dense: held up in the first seconds, with a gap beside
+    r = run_drive(DriveConfig(WorldConfig("dense", 8), duration_s=12.0, lane_changes=True),
                   recorder_factory=lambda w: Look())
-    assert r["lane_changes"]["completed"] >= 1 and r["lane_changes"]["unsafe"] == 0
+    assert r["lane_changes"]["completed"] == 1 and r["lane_changes"]["unsafe"] == 0
     assert r["collisions"] == 0 and r["lane_departures"] == 0
-    assert indices[0] == 0 and indices[-1] == 1  # one lane to the left
+    assert len(sides) == 1 and indices[-1] - indices[0] == sides[0]  # one lane over, to the side it changed to
 
 
 @pytest.mark.parametrize("seed", [0, 2])
