@@ -96,7 +96,7 @@ def truth_neighbour(gt, obj, horizon_s: float = CUT_IN_HORIZON_S) -> Neighbour |
                      camera=camera, box_px=box, cut_in=flagged, time_to_cross_s=t_cross)
 
 
-def truth_neighbours(gt, ahead_m: float = 80.0, behind_m: float = 100.0,
+def truth_neighbours(gt, ahead_m: float = 80.0, behind_m: float = 85.0,
                      horizon_s: float = CUT_IN_HORIZON_S) -> Neighbours:
     """Every vehicle of the ground truth ``gt`` in the ego lane and the lanes either side whose bumper gap is within
     ``ahead_m`` ahead or ``behind_m`` behind (and every one beside), nearest first within each lane (lanes -1, 0,
@@ -116,7 +116,7 @@ def truth_neighbours(gt, ahead_m: float = 80.0, behind_m: float = 100.0,
 
 
 class PrivilegedNeighbours(TruthSlot):
-    """The true vehicles in the ego lane and the lanes either side (``truth_neighbours``, 80 m ahead, 100 m behind)."""
+    """The true vehicles in the ego lane and the lanes either side (``truth_neighbours``, 80 m ahead, 85 m behind)."""
 
     def step(self, frame: Frame, upstream: dict) -> tuple[Neighbours, None]:
         return truth_neighbours(self.truth.get()), None

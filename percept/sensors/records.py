@@ -234,7 +234,7 @@ class Neighbours:
 
     tracks: tuple[Neighbour, ...]  # nearest first within each lane
     ahead_m: float = 80.0  # how far ahead the lanes are covered [m]
-    behind_m: float = 100.0  # how far behind [m]
+    behind_m: float = 85.0  # how far behind [m]
     rear: bool = True  # whether the rear rig saw this frame (False: behind is covered by prediction only)
 
     def in_lane(self, lane: int) -> tuple[Neighbour, ...]:

@@ -36,13 +36,13 @@ def test_lanes_follow_the_ego_offset_and_the_curve(vehicle, truth):
 
 def test_zones_and_bumper_gaps_and_the_ranges_covered(vehicle, truth):
     cars = [vehicle(1, 20, 0), vehicle(2, -20, 4.0, rear_visible=1.0, visible=0), vehicle(3, 4.0, -4.0),
-            vehicle(4, 90, 0), vehicle(5, -70, 0), vehicle(6, 50, 0, length=12.0)]
+            vehicle(4, 90, 0), vehicle(5, -95, 0), vehicle(6, 50, 0, length=12.0)]
     n = by_id(truth_neighbours(truth(cars)))
     assert (n[1].zone, n[1].gap_m) == (Zone.AHEAD, pytest.approx(15.0))
     assert (n[2].zone, n[2].gap_m) == (Zone.BEHIND, pytest.approx(15.0))
     assert (n[3].zone, n[3].gap_m) == (Zone.BESIDE, 0.0)
     assert n[6].gap_m == pytest.approx(50 - 6 - 2.5) and n[6].length_m == 12.0
-    assert 4 not in n and 5 not in n   # beyond 80 m ahead and 60 m behind
+    assert 4 not in n and 5 not in n   # beyond 80 m ahead and 85 m behind
     wide = by_id(truth_neighbours(truth(cars), ahead_m=100, behind_m=100))
     assert 4 in wide and 5 in wide
 
@@ -105,4 +105,4 @@ def test_the_privileged_slot_reports_the_truth_of_its_feed(vehicle, truth):
     feed.truth = truth([vehicle(7, 30, 4.0)])
     est, debug = slot.step(None, {})
     assert debug is None and [n.track_id for n in est.tracks] == [7]
-    assert (est.ahead_m, est.behind_m, est.rear) == (80.0, 60.0, True)
+    assert (est.ahead_m, est.behind_m, est.rear) == (80.0, 85.0, True)

@@ -31,7 +31,7 @@ LOG = "neighbours/warnings"
 """The text log of cut-in warnings: one line when a track's warning starts, one when it ends."""
 BLIND = TrackerConfig()
 """Where the tracker holds tracks by prediction: its default blind band."""
-RANGE = {"ahead_m": 80.0, "behind_m": 100.0}
+RANGE = {"ahead_m": 80.0, "behind_m": 85.0}
 """How far the truth's nearest vehicles are looked for without an estimate [m] (``Neighbours``' defaults)."""
 
 
