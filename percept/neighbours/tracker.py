@@ -148,8 +148,9 @@ class NeighbourTracker:
 
     def _merge(self) -> None:
         """Two tracks in one lane, each within the other's association gate, are one car tracked twice (far away its
-        face breaks into groups that may each start a track): the one a rig measured this frame stays, else the one
-        with more detections. Tracks held in the blind band are left to the hand-over."""
+        face breaks into groups that may each start a track): the one with more detections stays (a young one
+        measured this frame beside an established one unseen for a frame is the duplicate). Tracks held in the blind
+        band are left to the hand-over."""
         c, w = self.cfg, self.width
         gone = set()
         free = [t for t in self.tracks if t.blind_s <= 0]
@@ -159,8 +160,7 @@ class NeighbourTracker:
                     continue
                 gate = c.gate_x_m + c.gate_x_rel * min(abs(a.x), abs(b.x))
                 if abs(a.x - b.x) <= gate and abs(a.lat - b.lat) <= c.gate_l_m:
-                    # keep the measured one, then the one with more detections
-                    keep = max((a, b), key=lambda t: (t.camera is not None, t.hits))
+                    keep = max((a, b), key=lambda t: t.hits)
                     gone.add(id(b) if keep is a else id(a))
         self.tracks = [t for t in self.tracks if id(t) not in gone]
 
