@@ -43,6 +43,17 @@ def test_a_far_car_whose_face_breaks_into_groups_is_one_track():
     assert len(tr.tracks) == 2
 
 
+def test_of_two_tracks_of_one_car_the_established_one_stays():
+    tr = NeighbourTracker(DT)
+    for _ in range(20):
+        tr.step({"rear": [det(-16.0, W)]}, W)
+    (old,) = tr.tracks
+    # a young track of the same car, 1 m off across its lane, takes this frame's detection from the established one
+    tr.tracks.append(replace(old, track_id=99, kf=tr._new_filter(det(-15.5, W - 1.0)), hits=2))
+    tr.step({"rear": [det(-15.5, W - 1.0)]}, W)
+    assert [t.track_id for t in tr.tracks] == [old.track_id]
+
+
 def test_blind_band_keeps_the_track_and_the_front_rig_takes_it_over():
     tr = NeighbourTracker(DT)
     cfg = TrackerConfig()
