@@ -96,7 +96,7 @@ def truth_neighbour(gt, obj, horizon_s: float = CUT_IN_HORIZON_S) -> Neighbour |
                      camera=camera, box_px=box, cut_in=flagged, time_to_cross_s=t_cross)
 
 
-def truth_neighbours(gt, ahead_m: float = 80.0, behind_m: float = 85.0,
+def truth_neighbours(gt, ahead_m: float = Neighbours.ahead_m, behind_m: float = Neighbours.behind_m,
                      horizon_s: float = CUT_IN_HORIZON_S) -> Neighbours:
     """Every vehicle of the ground truth ``gt`` in the ego lane and the lanes either side whose bumper gap is within
     ``ahead_m`` ahead or ``behind_m`` behind (and every one beside), nearest first within each lane (lanes -1, 0,

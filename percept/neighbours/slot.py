@@ -28,9 +28,8 @@ from .tracker import NeighbourTracker, Track, TrackerConfig
 class NeighbourConfig:
     """What the slot covers and when it warns."""
 
-    ahead_m: float = 80.0  # covered ahead of the ego: the largest bumper gap reported [m]
-    behind_m: float = 85.0  # covered behind it: a lane change must see a follower closing fast long before it
-    # arrives, and the rear rig's points reach 90 m (PointsConfig.far_m) [m]
+    ahead_m: float = Neighbours.ahead_m  # covered ahead of the ego: the largest bumper gap reported [m]
+    behind_m: float = Neighbours.behind_m  # covered behind it [m]
     front_near_m: float = 3.0  # the nearest face the front rig measures, along the lane [m]
     rear_near_m: float = -3.0  # the nearest face the rear rig measures [m]
     horizon_s: float = 3.0  # a cut-in is flagged when the boundary is this close in time [s]

@@ -234,7 +234,8 @@ class Neighbours:
 
     tracks: tuple[Neighbour, ...]  # nearest first within each lane
     ahead_m: float = 80.0  # how far ahead the lanes are covered [m]
-    behind_m: float = 85.0  # how far behind [m]
+    behind_m: float = 85.0  # how far behind: a lane change must see a follower closing fast long before it arrives,
+    # and the rear rig's points reach 90 m of camera depth [m]
     rear: bool = True  # whether the rear rig saw this frame (False: behind is covered by prediction only)
 
     def in_lane(self, lane: int) -> tuple[Neighbour, ...]:

@@ -12,7 +12,7 @@ import numpy as np
 import rerun as rr
 
 from percept.neighbours import TrackerConfig
-from percept.sensors import Zone
+from percept.sensors import Neighbours, Zone
 
 from ..context import Part, PartContext, Plot
 from .lane_view import (LANE_NAMES, LANES, band_outline, lane_to_vehicle, nearest_estimates, nearest_truths,
@@ -31,7 +31,7 @@ LOG = "neighbours/warnings"
 """The text log of cut-in warnings: one line when a track's warning starts, one when it ends."""
 BLIND = TrackerConfig()
 """Where the tracker holds tracks by prediction: its default blind band."""
-RANGE = {"ahead_m": 80.0, "behind_m": 85.0}
+RANGE = {"ahead_m": Neighbours.ahead_m, "behind_m": Neighbours.behind_m}
 """How far the truth's nearest vehicles are looked for without an estimate [m] (``Neighbours``' defaults)."""
 
 
