@@ -11,6 +11,7 @@ be beside the ego.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 
 import numpy as np
 from filterpy.kalman import KalmanFilter
@@ -151,18 +152,17 @@ class NeighbourTracker:
         face breaks into groups that may each start a track): the one with more detections stays (a young one
         measured this frame beside an established one unseen for a frame is the duplicate). Tracks held in the blind
         band are left to the hand-over."""
-        c, w = self.cfg, self.width
-        gone = set()
-        free = [t for t in self.tracks if t.blind_s <= 0]
-        for a in free:
-            for b in free:
-                if a is b or id(a) in gone or id(b) in gone or round(a.lat / w) != round(b.lat / w):
-                    continue
-                gate = c.gate_x_m + c.gate_x_rel * min(abs(a.x), abs(b.x))
-                if abs(a.x - b.x) <= gate and abs(a.lat - b.lat) <= c.gate_l_m:
-                    keep = max((a, b), key=lambda t: t.hits)
-                    gone.add(id(b) if keep is a else id(a))
+        w, gone = self.width, set()
+        for a, b in combinations([t for t in self.tracks if t.blind_s <= 0], 2):
+            if id(a) in gone or id(b) in gone or round(a.lat / w) != round(b.lat / w):
+                continue
+            if abs(a.x - b.x) <= self._gate_x(min(abs(a.x), abs(b.x))) and abs(a.lat - b.lat) <= self.cfg.gate_l_m:
+                gone.add(id(b) if a.hits >= b.hits else id(a))  # the older-found stays on a tie
         self.tracks = [t for t in self.tracks if id(t) not in gone]
+
+    def _gate_x(self, x_m: float) -> float:
+        """The association gate along the lane for a track at ``x_m`` [m]: gate_x_m + gate_x_rel |x| [m]."""
+        return self.cfg.gate_x_m + self.cfg.gate_x_rel * abs(x_m)
 
     def _associate(self, rig: str, dets: list[Detection]) -> None:
         c = self.cfg
@@ -170,7 +170,7 @@ class NeighbourTracker:
         for i, t in enumerate(self.tracks):
             for j, d in enumerate(dets):
                 # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
-                gate_x = c.gate_x_m + c.gate_x_rel * abs(t.x) + 2 * d.sigma_x_m
+                gate_x = self._gate_x(t.x) + 2 * d.sigma_x_m
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
                 if dx <= gate_x and dl <= c.gate_l_m and self._may_take_over(t, d):
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))
