@@ -4,7 +4,9 @@ free lane that the evasion law (``evasion.py``) calls for when braking alone fal
 
 The law reads records only: the ego path (its lane, the lane's ``index`` and which boundaries have a lane beyond
 them) and the neighbours. A change starts once MOBIL has favoured the same side for ``settle_s`` (a verdict that
-flickers with perception's noise starts nothing) and ``min_interval_s`` after the last one ended. The path is planned
+flickers with perception's noise starts nothing) and ``min_interval_s`` after the last one ended, and never into a
+lane that opened beside the car less than ``new_lane_m`` back (an acceleration lane's end is not marked before it
+comes). The path is planned
 in the frame of the lane the change started from; the lane estimate moves to the target lane as the car's centre
 crosses the boundary (its ``index`` changes), and the reference moves with it: offset in the current lane =
 offset in the start lane - (index - index_start) w.
@@ -48,6 +50,8 @@ class LaneChangeConfig:
     # it left (a longer return turns back later): else it takes duration_s [m]
     settle_s: float = 1.0  # how long MOBIL must favour the same side before a change starts [s]
     min_interval_s: float = 8.0  # least time from the end of one change to the start of the next [s]
+    new_lane_m: float = 500.0  # a lane that opened beside the car (its boundary was the road's edge, a solid line)
+    # less than this far back may be an acceleration lane, whose end is not marked: no change goes into it [m]
     mobil: MobilConfig = field(default_factory=MobilConfig)  # the decision's parameters
     evasion: EvasionConfig = field(default_factory=EvasionConfig)  # when to swerve, and how fast
 
@@ -85,6 +89,9 @@ class LaneChange(Controller):
         self.t_s = 0.0  # time on the current path [s]
         self.since_end_s = self.cfg.min_interval_s  # time since the last change ended [s]
         self.favour, self.favour_s = 0, 0.0  # the side MOBIL favours, and for how long [s]
+        self.edge_index: int | None = None  # the lane index edge_ago_m was counted in
+        self.edge_ago_m: dict[int, float | None] = {1: None, -1: None}  # side -> how far back its boundary was the
+        # road's edge (None: not seen so since the car came into this lane) [m]
         self.path: MinJerkPath | None = None  # in the start lane's frame
         self.index0 = 0  # the lane index the change started from
         self.width0 = 0.0  # the lane width it was planned with [m]
@@ -101,6 +108,7 @@ class LaneChange(Controller):
             self.favour, self.favour_s = 0, 0.0
             self.t_s += dt if self.phase is not Phase.KEEP else 0.0
             return None, LaneChangeDebug(self.phase, self.side, "no lane estimate", (), None, None)
+        self._watch_edges(path.lane.index, path.lane.beside, speed_mps * dt)
         if self.phase is Phase.KEEP:
             side, evasion = self.evasion.update(target, path, neighbours, speed_mps)
             if side:
@@ -115,8 +123,7 @@ class LaneChange(Controller):
         self.since_end_s += dt
         lane = path.lane
         seen = neighbours is not None and neighbours.rear
-        verdicts = tuple(judge(s, lane.lane_beside(s), neighbours, speed_mps, self.set_speed, self.cfg.mobil)
-                         for s in (1, -1)) if seen else ()
+        verdicts = tuple(self._judge(s, lane.lane_beside(s), neighbours, speed_mps) for s in (1, -1)) if seen else ()
         best = max((j for j in verdicts if j.go), key=lambda j: j.gain_mps2, default=None)
         side = best.side if best is not None else 0
         self.favour_s = self.favour_s + dt if side == self.favour and side else 0.0
@@ -128,6 +135,22 @@ class LaneChange(Controller):
         if self.since_end_s < self.cfg.min_interval_s:
             return None, LaneChangeDebug(self.phase, 0, "too soon", verdicts, None, None)
         return self._start(Phase.CHANGE, side, path, self.cfg.duration_s, reason, None, verdicts)
+
+    def _watch_edges(self, index: int, beside: tuple, moved_m: float) -> None:
+        """Count how far the car has gone (``moved_m`` this frame [m]) since each boundary of lane ``index`` was
+        last the road's edge (``beside``: the lane estimate's (left, right) verdicts); a new lane forgets them."""
+        if index != self.edge_index:
+            self.edge_index, self.edge_ago_m = index, {1: None, -1: None}
+        for side, there in zip((1, -1), beside):
+            ago = self.edge_ago_m[side]
+            self.edge_ago_m[side] = 0.0 if there is False else None if ago is None else ago + moved_m
+
+    def _judge(self, side: int, lane_there: bool | None, neighbours: Neighbours, speed_mps: float) -> Judgement:
+        """MOBIL's verdict on ``side``, or "new lane" for a lane that opened less than ``new_lane_m`` back."""
+        ago = self.edge_ago_m[side]
+        if lane_there and ago is not None and ago < self.cfg.new_lane_m:
+            return Judgement(side, 0.0, 0.0, "new lane")
+        return judge(side, lane_there, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
 
     def _start(self, phase: Phase, side: int, path: EgoPath, duration_s: float, reason: str,
                evasion: EvasionDebug | None,

@@ -62,7 +62,8 @@ class Judgement:
     side: int  # +1 left, -1 right
     gain_mps2: float  # the incentive's left-hand side less the bias (+ favours the change) [m/s²]
     imposed_mps2: float  # the new follower's acceleration after the change (pessimistic) [m/s²]
-    reason: str  # "ok", or why not: "no lane", "beside", "gap ahead", "gap behind", "follower brakes", "no gain"
+    reason: str  # "ok", or why not: "no lane", "new lane" (LaneChange's), "beside", "gap ahead", "gap behind",
+    # "follower brakes", "no gain"
 
     @property
     def go(self) -> bool:

@@ -158,6 +158,23 @@ def test_no_change_without_a_view_behind():
     assert all(law.update(path(), blind, V, DT)[1].event is None for _ in range(60))
 
 
+def test_no_change_into_a_lane_that_opened_beside_the_car_until_it_has_run_new_lane_m():
+    law = LaneChange(30.0, LaneChangeConfig(settle_s=0.2, new_lane_m=100.0))
+    slow = around(car(0, 35.0, rel=-6.0))
+    # the road's edge on the right, then a lane opens there (an acceleration lane); none on the left
+    law.update(path(beside=(False, False)), slow, V, DT)
+    dbgs = [law.update(path(beside=(False, True)), slow, V, DT)[1] for _ in range(int(6.0 / DT))]
+    start = next(k for k, d in enumerate(dbgs) if d.event == "started")
+    assert "right: new lane" in dbgs[0].reason and dbgs[start].side == -1
+    # 100 m at 25 m/s, then settle_s
+    assert start * DT == pytest.approx(100.0 / V + 0.2, abs=0.15)
+    # a lane the car came into forgets the edges of the one it left: its lane beside is no new lane
+    law.reset()
+    law.update(path(beside=(False, False)), slow, V, DT)
+    events = [law.update(path(index=1, beside=(False, True)), slow, V, DT)[1].event for _ in range(10)]
+    assert "started" in events
+
+
 def test_no_second_change_before_the_interval():
     law = LaneChange(30.0, LaneChangeConfig(duration_s=2.0, settle_s=0.2, min_interval_s=8.0))
     dbgs, _ = run_law(law, int(6.0 / DT), around(car(0, 35.0, rel=-6.0)))
