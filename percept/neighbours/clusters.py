@@ -19,6 +19,7 @@ import numpy as np
 from percept.sensors import LaneEstimate
 
 from .points import StandingPoints
+from .quantiles import quantiles
 
 VEHICLE_WIDTH_M = 2.0
 """The width assumed for every vehicle (highway-env's Vehicle.WIDTH): where only its side, or one edge of its face,
@@ -135,7 +136,7 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     within ``side_m`` of the edge nearest the ego lane's centre line, which a car in a lane beside shows along its
     length); the face's range is ``face_range`` of those points, its lateral extent runs from that inner edge to the
     face's outer edge."""
-    low, top = np.quantile(pts.z[idx], [0.1, 0.9])
+    low, top = quantiles(pts.z[idx], [0.1, 0.9])
     # near by the band holds only a car's lower part; farther, up to a little above the camera's height
     if low > cfg.max_low_m or (top < min(cfg.min_top_m, camera_height_m - 0.1)
                                and np.min(np.abs(x)) > cfg.side_reach_m):
@@ -143,7 +144,7 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     side = _side_view(pts, idx, x, lat, width, face_range, cfg)
     if side is not None:
         return side
-    l0, l1 = np.quantile(lat, [0.05, 0.95])
+    l0, l1 = quantiles(lat, [0.05, 0.95])
     if not cfg.min_width_m <= l1 - l0 <= cfg.max_width_m:
         return None
     beside = abs(0.5 * (l0 + l1)) > 0.5 * width
@@ -159,7 +160,7 @@ def _measure(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndarra
     if measured.lat_m is not None:
         inner, outer = measured.lat_m if sign > 0 else measured.lat_m[::-1]
     else:
-        outer = np.quantile(lat[face], 0.95 if sign > 0 else 0.05)
+        outer = quantiles(lat[face], 0.95 if sign > 0 else 0.05)
     centre_lat = float(0.5 * (inner + outer))
     if abs(centre_lat) > 1.5 * width or abs(outer - inner) > cfg.max_width_m:
         return None

@@ -11,6 +11,7 @@ from percept.sensors import LaneEstimate, Side, StereoRig
 
 from .clusters import VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ClusterConfig, Detection, Face, find_vehicles, lane_coordinates
 from .points import BandStereo, PointsConfig, StandingPoints
+from .quantiles import quantiles
 from .refine import refine_face
 
 
@@ -164,5 +165,5 @@ class RigFinder:
         p = self.cam[:2] + (np.stack([pts.x[at], pts.y[at]], axis=1) - self.cam[:2]) * s
         moved = StandingPoints(pts.u[at], pts.v[at], pts.d[at], p[:, 0], p[:, 1], pts.z[at])
         _, lat, _ = lane_coordinates(moved, self._lane)
-        lo, hi = np.quantile(lat, [0.05, 0.95])
+        lo, hi = quantiles(lat, [0.05, 0.95])
         return float(lo), float(hi)

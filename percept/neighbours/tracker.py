@@ -45,7 +45,8 @@ class TrackerConfig:
     max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
     min_settled: int = 10  # detections in a row in one lane, since the track was laterally still in it, that make it
     # a settled neighbour there (a car still moving over from the lane beyond is not) [-]
-    still_mps: float = 0.3  # a track is laterally still when its lateral speed is below this [m/s]
+    still_mps: float = 0.3  # a track is laterally still once its lateral speed is below this [m/s] ...
+    still_frames: int = 3  # ... on this many detections in a row since it was confirmed (its filter starts at rest) [-]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
     recent_s: float = 1.0  # the window over which a track's detections are counted (Track.seen) [s]
 
@@ -67,6 +68,7 @@ class Track:
     lane: int | None = None  # the lane its centre was in at its last detection (-1, 0, +1 ...)
     settled: int = 0  # detections in a row in that lane since it was laterally still there
     still: bool = False  # it has been laterally still in that lane
+    calm: int = 0  # detections in a row with its lateral speed under TrackerConfig.still_mps
     warning: bool = False  # flagged as cutting in at the last report
     veer: int = 0  # signed count of the lateral innovations in a row beyond TrackerConfig.manoeuvre_sigmas, all of
     # one sign (+ left) [-]
@@ -194,7 +196,8 @@ class NeighbourTracker:
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
             # its lane: round(l / w)
             lane = int(round(t.lat / self.width))
-            t.still = lane == t.lane and t.still or abs(float(t.kf.x[3, 0])) < c.still_mps
+            t.calm = t.calm + 1 if t.hits >= c.confirm_hits and abs(float(t.kf.x[3, 0])) < c.still_mps else 0
+            t.still = lane == t.lane and t.still or t.calm >= c.still_frames
             t.settled = t.settled + 1 if lane == t.lane and t.still else int(t.still)
             t.lane = lane
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
