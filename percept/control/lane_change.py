@@ -6,10 +6,9 @@ The law reads records only: the ego path (its lane, the lane's ``index`` and whi
 them) and the neighbours. A change starts once MOBIL has favoured the same side for ``settle_s`` (a verdict that
 flickers with perception's noise starts nothing) and ``min_interval_s`` after the last one ended, and never into a
 lane that opened beside the car less than ``new_lane_m`` back (an acceleration lane's end is not marked before it
-comes). The path is planned
-in the frame of the lane the change started from; the lane estimate moves to the target lane as the car's centre
-crosses the boundary (its ``index`` changes), and the reference moves with it: offset in the current lane =
-offset in the start lane - (index - index_start) w.
+comes). The path is planned in the frame of the lane the change started from; the lane estimate moves to the target
+lane as the car's centre crosses the boundary (its ``index`` changes), and the reference moves with it: offset in
+the current lane = offset in the start lane - (index - index_start) w.
 """
 
 from __future__ import annotations

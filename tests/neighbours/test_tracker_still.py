@@ -26,4 +26,3 @@ def test_a_still_car_is_still_once_confirmed_and_calm_and_settled_after_that():
     # detections confirm_hits .. confirm_hits + still_frames - 1 are the calm ones
     assert still_at == cfg.confirm_hits + cfg.still_frames - 1
     assert t.settled == 30 - still_at + 1
-
