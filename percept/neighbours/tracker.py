@@ -167,12 +167,12 @@ class NeighbourTracker:
         return self.cfg.gate_x_m + self.cfg.gate_x_rel * abs(x_m)
 
     def _associate(self, rig: str, dets: list[Detection]) -> None:
-        c = self.cfg
-        pairs = []
+        c, pairs = self.cfg, []
         for i, t in enumerate(self.tracks):
+            gate_t = self._gate_x(t.x)
             for j, d in enumerate(dets):
                 # the gate widens with the detection's own along-lane uncertainty (a face cut off by the image's edge)
-                gate_x = self._gate_x(t.x) + 2 * d.sigma_x_m
+                gate_x = gate_t + 2 * d.sigma_x_m
                 dx, dl = abs(d.x_m - t.x), abs(d.lat_m - t.lat)
                 if dx <= gate_x and dl <= c.gate_l_m and self._may_take_over(t, d):
                     pairs.append((dx / gate_x + dl / c.gate_l_m, i, j))
