@@ -50,6 +50,8 @@ class ClusterConfig:
     min_width_m: float = 0.4  # narrower groups are poles and the like [m]
     max_width_m: float = 3.0  # a group or face wider than this is no one vehicle: rain streaks or noise matched by
     # chance across the image, or cars run together [m]
+    speckle_share: float = 0.6  # a group too wide for one vehicle is grouped again without its speckles when they
+    # are under this share of its points [-]
     max_low_m: float = 0.9  # a vehicle's points reach down to this height (mismatched far background does not) [m]
     min_top_m: float = 1.0  # and, beyond side_reach_m, up to this height (a guard rail, 0.45-0.77 m, does not) [m]
 
@@ -98,21 +100,47 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
                   cfg: ClusterConfig = ClusterConfig(), camera_height_m: float = np.inf) -> list[Detection]:
     """The vehicles among ``pts`` with centres in the ego lane or a lane beside it and faces between ``x_lo`` and
     ``x_hi`` along the lane [m], each face's range from ``face``; camera_height_m: the rig's height, which bounds what
-    the band shows of a car [m]."""
+    the band shows of a car [m]. A group too wide for a vehicle, a minority of whose points are speckles
+    (``StandingPoints.speckle``), is grouped again without them: near the car, noise at night and rain streaks matched
+    by chance stand up from the road, and joined to a car they make one group too wide for a vehicle (speckles are not
+    dropped everywhere: a car's side, or its lamps at night, may be matched only in small patches)."""
     x, lat, width = lane_coordinates(pts, lane)
     half = 1.5 * width + 1.0
     keep = (x >= x_lo) & (x <= x_hi) & (np.abs(lat) <= half)
-    if not np.any(keep):
+    out = []
+    for group in _groups(x, lat, np.flatnonzero(keep), x_lo, x_hi, half, cfg):
+        det = _measure(pts, group, x[group], lat[group], x_lo >= 0, width, face, cfg, camera_height_m)
+        if det is None and pts.speckle is not None and _joined_to_speckles(pts.speckle[group], lat[group], cfg):
+            out += [d for g in _groups(x, lat, group[~pts.speckle[group]], x_lo, x_hi, half, cfg)
+                    if (d := _measure(pts, g, x[g], lat[g], x_lo >= 0, width, face, cfg, camera_height_m))]
+        elif det is not None:
+            out.append(det)
+    return out
+
+
+def _joined_to_speckles(speckle: np.ndarray, lat: np.ndarray, cfg: ClusterConfig) -> bool:
+    """Whether a group's points (``speckle`` flags and lateral places ``lat`` [m], each (N,)) spread wider than one
+    vehicle (their 5-95 % range) and some, fewer than ``speckle_share``, are speckles: a car joined to them (a group
+    mostly of speckles is noise, and what is left of it would be noise too)."""
+    if not 0 < speckle.mean() < cfg.speckle_share:
+        return False
+    l0, l1 = quantiles(lat, [0.05, 0.95])
+    return l1 - l0 > cfg.max_width_m
+
+
+def _groups(x: np.ndarray, lat: np.ndarray, idx: np.ndarray, x_lo: float, x_hi: float, half: float,
+            cfg: ClusterConfig) -> list[np.ndarray]:
+    """The groups of points ``idx`` (along ``x``, across ``lat``, each (N,) [m]) that may be a vehicle: each connected
+    group of occupied ground-grid cells over [x_lo, x_hi] x [-half, half] with enough points for its range."""
+    if len(idx) == 0:
         return []
-    x, lat, idx = x[keep], lat[keep], np.flatnonzero(keep)
     nx, nl = int(np.ceil((x_hi - x_lo) / cfg.cell_x_m)), int(np.ceil(2 * half / cfg.cell_l_m))
-    ix = np.minimum(((x - x_lo) / cfg.cell_x_m).astype(np.int32), nx - 1)
-    il = np.minimum(((lat + half) / cfg.cell_l_m).astype(np.int32), nl - 1)
+    ix = np.minimum(((x[idx] - x_lo) / cfg.cell_x_m).astype(np.int32), nx - 1)
+    il = np.minimum(((lat[idx] + half) / cfg.cell_l_m).astype(np.int32), nl - 1)
     counts = np.bincount(ix * nl + il, minlength=nx * nl).reshape(nx, nl)
     occupied = (counts >= cfg.min_points).astype(np.uint8)
     n, labels = cv2.connectedComponents(occupied, connectivity=8)
     point_label = labels[ix, il]
-    ahead = x_lo >= 0
     out = []
     for k in range(1, n):
         sel = point_label == k
@@ -120,12 +148,9 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
         if n_points < cfg.min_group_points or (labels == k).sum() < cfg.min_cells:
             continue
         # N >= max(min_group_points, c / Z^2), Z the group's nearest range along the lane
-        near = float(np.min(np.abs(x[sel])))
-        if n_points < cfg.group_points_m2 / max(near, 1.0) ** 2:
-            continue
-        det = _measure(pts, idx[sel], x[sel], lat[sel], ahead, width, face, cfg, camera_height_m)
-        if det is not None:
-            out.append(det)
+        near = float(np.min(np.abs(x[idx[sel]])))
+        if n_points >= cfg.group_points_m2 / max(near, 1.0) ** 2:
+            out.append(idx[sel])
     return out
 
 

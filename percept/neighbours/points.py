@@ -30,6 +30,12 @@ class PointsConfig:
     texture: int = 4  # StereoBM's texture threshold (rejects flat blocks)
     uniqueness: int = 10  # StereoBM's uniqueness ratio [%]
     shrink: int = 2  # match at 1 / shrink of the resolution (image pyramid levels: 1 or 2) [-]
+    speckle_px: int = 30  # a matched patch of fewer pixels than this (at the matching resolution) ...
+    speckle_range_px: float = 1.0  # ... whose disparity steps by no more than this inside is a speckle [px]
+    drop_far_speckles: bool = True  # leave the far strip's speckles out of the points and its map (far away they
+    # are phantoms), not just flag them ...
+    drop_near_speckles: bool = False  # ... and the near map's (ahead, a car pulling out close by at night or in rain
+    # is found only without them; behind, a car's lamps at night may be matched only in small patches)
     split_m: float = 32.0  # beyond this camera depth, points come from a strip matched at full resolution [m]
 
 
@@ -38,7 +44,7 @@ class StandingPoints:
     """The points of one rig that stand up from the road; all arrays (N,).
 
     u, v: left-image pixel at full resolution [px]; d: disparity at full resolution [px]; x, y, z: vehicle frame
-    [m]."""
+    [m]; speckle: whether the point lies in a speckle (``PointsConfig.speckle_px``), None when not told."""
 
     u: np.ndarray
     v: np.ndarray
@@ -46,6 +52,7 @@ class StandingPoints:
     x: np.ndarray
     y: np.ndarray
     z: np.ndarray
+    speckle: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.u)
@@ -56,15 +63,23 @@ class _Matcher:
     first num_disp columns no value, and the padding lets it match every column whose partner is in view (a car close
     by in the lane to the left fills those columns)."""
 
-    def __init__(self, v0: int, v1: int, shrink: int, num_disp: int, cfg: PointsConfig):
+    def __init__(self, v0: int, v1: int, shrink: int, num_disp: int, cfg: PointsConfig, drop_speckles: bool):
         self.v0, self.v1, self.shrink, self.num_disp = v0, v1, shrink, num_disp
         self.bm = cv2.StereoBM_create(numDisparities=num_disp, blockSize=cfg.block)
         self.bm.setTextureThreshold(cfg.texture)
         self.bm.setUniquenessRatio(cfg.uniqueness)
+        # a speckle's disparity range in the map's units, 1/16 px
+        self.speckle = (cfg.speckle_px, int(round(16 * cfg.speckle_range_px)))
+        self.drop = drop_speckles
+        if self.drop:  # StereoBM leaves them out of its map
+            self.bm.setSpeckleWindowSize(self.speckle[0])
+            self.bm.setSpeckleRange(self.speckle[1])
         self.disparity: np.ndarray | None = None  # the last map, int16 in 1/16 px of its resolution
 
     def match(self, left_gray: np.ndarray, right_gray: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Full-resolution (u, v, d) of every matched pixel [px]."""
+        """Full-resolution (u, v, d) of every matched pixel [px], and whether it lies in a speckle: a small patch that
+        sensor noise at night or a rain streak matched by chance (OpenCV's filterSpeckles; none when the matcher drops
+        them)."""
         band = np.s_[self.v0:self.v1]
         L, R = np.ascontiguousarray(left_gray[band]), np.ascontiguousarray(right_gray[band])
         k, pad = self.shrink, self.num_disp
@@ -72,11 +87,16 @@ class _Matcher:
             L, R = cv2.pyrDown(L), cv2.pyrDown(R)
         L = cv2.copyMakeBorder(L, 0, 0, pad, 0, cv2.BORDER_REPLICATE)
         R = cv2.copyMakeBorder(R, 0, 0, pad, 0, cv2.BORDER_REPLICATE)
-        self.disparity = self.bm.compute(L, R)[:, pad:]
+        self.disparity = np.ascontiguousarray(self.bm.compute(L, R)[:, pad:])
         rows, cols = np.nonzero(self.disparity > 0)
         # full-resolution disparity: d = shrink d_k / 16
         d = self.disparity[rows, cols].astype(np.float32) * np.float32(k / 16.0)
-        return (cols * k).astype(np.float32), (rows * k + self.v0).astype(np.float32), d
+        if self.drop:
+            return (cols * k).astype(np.float32), (rows * k + self.v0).astype(np.float32), d, np.zeros(len(d), bool)
+        kept = self.disparity.copy()
+        cv2.filterSpeckles(kept, 0, *self.speckle)
+        speckle = kept[rows, cols] <= 0
+        return (cols * k).astype(np.float32), (rows * k + self.v0).astype(np.float32), d, speckle
 
     def pixels_near(self, box: tuple[int, int, int, int], d0: float, tol_px: float) -> tuple[np.ndarray, np.ndarray]:
         """Full-resolution pixels (u, v) of ``box`` (u0, v0, u1, v1) whose disparity is within tol_px of d0; each
@@ -109,8 +129,10 @@ class BandStereo:
         v_low = int(min(cam.height, np.ceil((hz + cam.fy * (h - cfg.low_m) / 6.0) / k) * k))
         v_split = int(min(cam.height, np.ceil(hz + cam.fy * (h - cfg.low_m) / cfg.split_m) + 2))
         # numDisparities: a multiple of 16 covering f b / near at the matching resolution
-        self.near = _Matcher(v_top, v_low, k, int(np.ceil(fb / cfg.near_m / k / 16.0)) * 16, cfg)
-        self.far = _Matcher(v_top, v_split, 1, int(np.ceil(fb / (0.8 * cfg.split_m) / 16.0)) * 16, cfg)
+        self.near = _Matcher(v_top, v_low, k, int(np.ceil(fb / cfg.near_m / k / 16.0)) * 16, cfg,
+                             cfg.drop_near_speckles)
+        self.far = _Matcher(v_top, v_split, 1, int(np.ceil(fb / (0.8 * cfg.split_m) / 16.0)) * 16, cfg,
+                            cfg.drop_far_speckles)
         R = rig.vehicle_from_cam(Side.LEFT)
         self._R, self._t = np.asarray(R.R), np.asarray(R.t)
 
@@ -122,15 +144,15 @@ class BandStereo:
         """The standing points of one grey pair ((H, W) uint8 each)."""
         cfg, cam = self.cfg, self.rig.camera
         fb = np.float32(cam.fx * self.rig.baseline_m)
-        un, vn, dn = self.near.match(left_gray, right_gray)
-        uf, vf, df = self.far.match(left_gray, right_gray)
+        un, vn, dn, sn = self.near.match(left_gray, right_gray)
+        uf, vf, df, sf = self.far.match(left_gray, right_gray)
         # Z = f b / d: the near map below the split depth, the strip beyond it
         keep_n, keep_f = fb / dn < cfg.split_m, (fb / df >= cfg.split_m) & (fb / df <= cfg.far_m)
-        u, v, d = (np.concatenate([a[keep_n], b[keep_f]]) for a, b in ((un, uf), (vn, vf), (dn, df)))
+        u, v, d, s = (np.concatenate([a[keep_n], b[keep_f]]) for a, b in ((un, uf), (vn, vf), (dn, df), (sn, sf)))
         Z = fb / d
         # camera ray times depth: X = (u - cx) Z / f, Y = (v - cy) Z / f
         pc = np.stack([(u - cam.cx) * Z / cam.fx, (v - cam.cy) * Z / cam.fy, Z], axis=1)
         # p_v = R^T p_c + c
         pv = pc @ self._R.T.astype(np.float32) + self._t.astype(np.float32)
         up = (pv[:, 2] >= cfg.min_height_m) & (pv[:, 2] <= cfg.max_height_m)
-        return StandingPoints(u[up], v[up], d[up], pv[up, 0], pv[up, 1], pv[up, 2])
+        return StandingPoints(u[up], v[up], d[up], pv[up, 0], pv[up, 1], pv[up, 2], s[up])

@@ -21,6 +21,7 @@ from percept.sensors import EGO_LENGTH_M, EgoPath, Frame, Neighbour, Neighbours,
 
 from .clusters import DEFAULT_LANE_WIDTH_M, VEHICLE_LENGTH_M, Detection
 from .finder import RigFinder
+from .points import PointsConfig
 from .tracker import NeighbourTracker, Track, TrackerConfig
 
 
@@ -58,7 +59,7 @@ class NeighbourSlot:
         self.cfg = cfg
         # faces lie half the ego's length beyond the gap
         reach = EGO_LENGTH_M / 2 + 2.0
-        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m + reach)
+        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m + reach, PointsConfig(drop_near_speckles=True))
         self.rear = RigFinder(rear_rig, -cfg.behind_m - reach, cfg.rear_near_m) if rear_rig else None
         self.tracker = NeighbourTracker(dt_s, tracker)
         self._index: int | None = None  # the lane estimate's index on the last frame with one

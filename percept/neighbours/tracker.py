@@ -5,87 +5,20 @@ Constant velocity with white acceleration noise (Bar-Shalom, Li & Kirubarajan 20
 confirmed after ``confirm_hits`` detections, dropped after ``max_misses`` frames unseen where a rig could see it; in
 the blind band beside the ego, which neither rig sees, it is kept by prediction (held inside the band, its position
 uncertainty growing) until a rig takes it over as it comes out, so a lane is never reported free while a vehicle may
-be beside the ego.
+be beside the ego; a car in the ego lane too near for the front rig to find is held the same way for a while.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from .clusters import DEFAULT_LANE_WIDTH_M, Detection
+from percept.sensors import EGO_LENGTH_M
 
-
-@dataclass(frozen=True)
-class TrackerConfig:
-    """How tracks are made, kept and dropped."""
-
-    accel_noise_mps2: float = 2.0  # along-lane white acceleration (1-sigma) [m/s^2]
-    lateral_accel_noise_mps2: float = 0.8  # lateral white acceleration (1-sigma) [m/s^2]
-    manoeuvre_accel_noise_mps2: float = 4.0  # ... while the track manoeuvres sideways (a car pulling out) [m/s^2]
-    manoeuvre_sigmas: float = 1.0  # a lateral innovation beyond this many sigmas ...
-    manoeuvre_frames: int = 2  # ... of one sign this many detections in a row starts a manoeuvre, which lasts
-    # until an innovation of that sign falls under it [-]
-    lateral_sigma_m: float = 0.12  # a detection's lateral position noise near by (1-sigma), added in quadrature to
-    # the detection's own range-dependent sigma_lat_m [m]
-    outlier_sigmas: float = 3.0  # a lateral innovation beyond this many sigmas is down-weighted to this size [-]
-    gate_x_m: float = 3.0  # association gate along the lane, plus gate_x_rel of the range [m]
-    gate_x_rel: float = 0.08  # ... [-]
-    gate_l_m: float = 1.4  # association gate across it [m]
-    confirm_hits: int = 3  # detections that confirm a track
-    max_misses: int = 6  # frames unseen (where a rig looks) that drop a track
-    blind_behind_m: float = -14.0  # the blind band beside the ego, where a rig sees too little of a car to find it:
-    # centres from here ...
-    blind_ahead_m: float = 12.0  # ... to here, along the lane, in the lanes beside [m]
-    fringe_m: float = 10.0  # beyond each end of the band, where a rig sees a car beside only in part (cut off by the
-    # image's edge): an established track there heading for the band coasts unseen instead of counting misses [m]
-    max_blind_s: float = 60.0  # longest a track is kept by prediction alone in the blind band [s]
-    min_settled: int = 10  # detections in a row in one lane, since the track was laterally still in it, that make it
-    # a settled neighbour there (a car still moving over from the lane beyond is not) [-]
-    still_mps: float = 0.3  # a track is laterally still once its lateral speed is below this [m/s] ...
-    still_frames: int = 3  # ... on this many detections in a row since it was confirmed (its filter starts at rest) [-]
-    blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
-    recent_s: float = 1.0  # the window over which a track's detections are counted (Track.seen) [s]
-
-
-@dataclass
-class Track:
-    """One vehicle's filter and bookkeeping."""
-
-    track_id: int
-    kf: KalmanFilter
-    hits: int = 1
-    misses: int = 0
-    blind_s: float = 0.0  # how long it has been held in the blind band (0: not held) [s]
-    takeover: int = 0  # detections in a row since a rig saw it again while it was held
-    camera: str | None = None
-    box_px: tuple | None = None
-    confirmed: bool = False
-    cut_off: bool = False  # its last detection was cut off by the image's edge
-    lane: int | None = None  # the lane its centre was in at its last detection (-1, 0, +1 ...)
-    settled: int = 0  # detections in a row in that lane since it was laterally still there
-    still: bool = False  # it has been laterally still in that lane
-    calm: int = 0  # detections in a row with its lateral speed under TrackerConfig.still_mps
-    warning: bool = False  # flagged as cutting in at the last report
-    veer: int = 0  # signed count of the lateral innovations in a row beyond TrackerConfig.manoeuvre_sigmas, all of
-    # one sign (+ left) [-]
-    seen_bits: int = 1  # one bit a frame, the newest lowest: whether a rig found it (the last TrackerConfig.recent_s)
-
-    @property
-    def x(self) -> float:
-        return float(self.kf.x[0, 0])
-
-    @property
-    def lat(self) -> float:
-        return float(self.kf.x[2, 0])
-
-    @property
-    def seen(self) -> int:
-        """On how many of the last ``TrackerConfig.recent_s`` of frames a rig found it."""
-        return self.seen_bits.bit_count()
+from .clusters import DEFAULT_LANE_WIDTH_M, VEHICLE_LENGTH_M, Detection
+from .track import Track, TrackerConfig
 
 
 class NeighbourTracker:
@@ -247,18 +180,25 @@ class NeighbourTracker:
             var_l = max(var_l, (nu / k) ** 2 - float(t.kf.P[2, 2]))
         return np.diag([max(d.sigma_x_m, 0.05) ** 2, var_l])
 
-    def _hold_in_band(self, t: Track) -> None:
-        """One frame of a track held in the blind band: nothing says it moves sideways, so it keeps its lateral place;
-        if its prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed
-        somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
-        c = self.cfg
+    def _hold_in_band(self, t: Track, lo_m: float, hi_m: float) -> None:
+        """One frame of a track held unseen in a band from ``lo_m`` to ``hi_m`` along the lane [m]: nothing says it
+        moves sideways, so it keeps its lateral place; if its prediction reaches the band's edge with no rig seeing it
+        come out, it has matched the ego's speed somewhere in the band: it stops there, anywhere in the band as far as
+        its uncertainty goes."""
         t.kf.x[3, 0] = 0.0
         t.takeover = 0
-        held = float(np.clip(t.x, c.blind_behind_m, c.blind_ahead_m))
+        held = float(np.clip(t.x, lo_m, hi_m))
         if held != t.x:
             t.kf.x[0, 0], t.kf.x[1, 0] = held, 0.0
-            t.kf.P[0, 0] = max(t.kf.P[0, 0], ((c.blind_ahead_m - c.blind_behind_m) / 2) ** 2)
+            t.kf.P[0, 0] = max(t.kf.P[0, 0], ((hi_m - lo_m) / 2) ** 2)
         t.blind_s += self.dt
+
+    def _near_ahead(self, t: Track, width_m: float) -> bool:
+        """Whether an unseen track is an established one ahead in the ego lane nearer than ``near_ahead_m``, held
+        there for less than ``near_hold_s``."""
+        c = self.cfg
+        return (t.hits >= c.min_settled and abs(t.lat) < 0.5 * width_m and 0.0 < t.x <= c.near_ahead_m
+                and t.blind_s < c.near_hold_s)
 
     def _heading_for_band(self, t: Track) -> bool:
         """Whether a track lies in the band's fringe (``_in_fringe``) and moves towards the band."""
@@ -280,8 +220,9 @@ class NeighbourTracker:
         """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until a
         rig takes it over; one heading for the band from its fringe, established or last seen cut off by the image's
         edge, coasts; one last seen cut off in the fringe and not heading for the band (its speed read from faces that
-        are only in part in view) is held too (a car at the edge that vanishes has gone on into the band); any other
-        counts a miss, and too many drop it."""
+        are only in part in view) is held too (a car at the edge that vanishes has gone on into the band); an
+        established one in the ego lane nearer than ``near_ahead_m`` is held there for up to ``near_hold_s`` (a car
+        that close may touch the ego's bumper unseen); any other counts a miss, and too many drop it."""
         c = self.cfg
         kept = []
         for t in self.tracks:
@@ -292,7 +233,10 @@ class NeighbourTracker:
                 into = self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0 or (
                     t.cut_off and self._in_fringe(t) and not heading)
                 if beside and into and t.blind_s < c.max_blind_s:
-                    self._hold_in_band(t)
+                    self._hold_in_band(t, c.blind_behind_m, c.blind_ahead_m)
+                elif not beside and self._near_ahead(t, width_m):
+                    # no nearer than touching: x >= (L_ego + L_v) / 2
+                    self._hold_in_band(t, (EGO_LENGTH_M + VEHICLE_LENGTH_M) / 2, c.near_ahead_m)
                 elif not coasts:
                     t.misses += 1
             if t.misses <= (c.max_misses if t.confirmed else 1):

@@ -1,6 +1,8 @@
 """The finder's geometry on synthetic detections and points: a car seen past a nearer one, and groups too wide to be
 one vehicle."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -65,3 +67,18 @@ def test_a_face_is_placed_across_the_lane_at_its_refined_range():
     assert (lo, hi) == pytest.approx(tuple(y), abs=1e-4)
     # too few points at the face's disparity: no extent
     assert finder._lateral_extent(pts, np.arange(5), float(pts.d[0]), 0.5, d) is None
+
+
+def test_a_group_too_wide_with_speckles_is_grouped_again_without_them():
+    # a car and, joined to it, speckles across the road (fewer points than the car's)
+    car, noise = _slab(20.0, -1.0, 1.0), _slab(19.0, -4.0, 4.0)
+    pts = StandingPoints(*(np.concatenate([getattr(car, k), getattr(noise, k)[::8]]) for k in "uvdxyz"))
+    flags = np.r_[np.zeros(len(car), bool), np.ones(len(pts) - len(car), bool)]
+    measure = lambda p, idx, group: Face(20.0, 0.1, (float(p.y[group].min()), float(p.y[group].max())))
+    assert find_vehicles(pts, None, 3.0, 90.0, measure) == []
+    (found,) = find_vehicles(replace(pts, speckle=flags), None, 3.0, 90.0, measure)
+    assert found.lat_m == pytest.approx(0.0, abs=0.05)
+    # mostly speckles: noise, and what is left of it would be noise too
+    mostly = StandingPoints(*(np.concatenate([getattr(car, k), getattr(noise, k)]) for k in "uvdxyz"))
+    assert find_vehicles(replace(mostly, speckle=np.r_[flags[:len(car)], np.ones(len(noise), bool)]), None, 3.0,
+                         90.0, measure) == []
