@@ -107,12 +107,15 @@ def find_vehicles(pts: StandingPoints, lane: LaneEstimate | None, x_lo: float, x
     x, lat, width = lane_coordinates(pts, lane)
     half = 1.5 * width + 1.0
     keep = (x >= x_lo) & (x <= x_hi) & (np.abs(lat) <= half)
+    def measure(g: np.ndarray) -> Detection | None:
+        return _measure(pts, g, x[g], lat[g], x_lo >= 0, width, face, cfg, camera_height_m)
+
     out = []
     for group in _groups(x, lat, np.flatnonzero(keep), x_lo, x_hi, half, cfg):
-        det = _measure(pts, group, x[group], lat[group], x_lo >= 0, width, face, cfg, camera_height_m)
+        det = measure(group)
         if det is None and pts.speckle is not None and _joined_to_speckles(pts.speckle[group], lat[group], cfg):
-            out += [d for g in _groups(x, lat, group[~pts.speckle[group]], x_lo, x_hi, half, cfg)
-                    if (d := _measure(pts, g, x[g], lat[g], x_lo >= 0, width, face, cfg, camera_height_m))]
+            parts = [measure(g) for g in _groups(x, lat, group[~pts.speckle[group]], x_lo, x_hi, half, cfg)]
+            out += [d for d in parts if d is not None]
         elif det is not None:
             out.append(det)
     return out
