@@ -8,13 +8,18 @@ flickers with perception's noise starts nothing) and ``min_interval_s`` after th
 lane that opened beside the car less than ``new_lane_m`` back (an acceleration lane's end is not marked before it
 comes). The path is planned in the frame of the lane the change started from; the lane estimate moves to the target
 lane as the car's centre crosses the boundary (its ``index`` changes), and the reference moves with it: offset in
-the current lane = offset in the start lane - (index - index_start) w.
+the current lane = offset in the start lane - (index - index_start) w. A change goes back while a gentle return
+(within the lane, within the jerk bound) exists; past that point, about a second in, going back is harsher than going
+on, so it goes on unless the target lane turns unsafe by looser bounds (a car beside, a gap under half a second, the
+new follower braking harder than 3 m/s²).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from enum import Enum
+
+import numpy as np
 
 from percept.sensors import EgoPath, Neighbours
 
@@ -42,11 +47,15 @@ class LaneChangeConfig:
     """When to change lanes and how."""
 
     duration_s: float = 5.0  # T: how long a change takes, and a return at least [s]
-    return_jerk_mps3: float = 2.0  # a return's path is stretched beyond duration_s until its peak jerk is at most
-    # this (a 4 m change from rest in 5 s asks 1.92); lane keeping adds its own on top [m/s³]
-    return_max_s: float = 8.0  # ... up to this long [s]
-    return_margin_m: float = 0.3  # ... so long as it keeps the car's centre this far inside the boundary of the lane
-    # it left (a longer return turns back later): else it takes duration_s [m]
+    return_jerk_mps3: float = 2.0  # a gentle return's path asks at most this peak jerk (a 4 m change from rest in
+    # 5 s asks 1.92); lane keeping adds its own on top [m/s³]
+    return_max_s: float = 8.0  # a return takes from the swerve's time (evasion.duration_s) up to this long [s]
+    return_margin_m: float = 0.3  # ... and keeps the car's centre this far inside the boundary of the lane it left
+    # (a longer return turns back later) [m]
+    commit_gap_s: float = 0.5  # past the point where a gentle return exists, a change goes on unless a gap in the
+    # target lane is under this at the ego's speed ... [s]
+    commit_braking_mps2: float = 3.0  # ... or the new follower would brake harder than this, or a car is beside
+    # [m/s²]
     settle_s: float = 1.0  # how long MOBIL must favour the same side before a change starts [s]
     min_interval_s: float = 8.0  # least time from the end of one change to the start of the next [s]
     new_lane_m: float = 500.0  # a lane that opened beside the car (its boundary was the road's edge, a solid line)
@@ -176,7 +185,11 @@ class LaneChange(Controller):
             verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
             verdicts, reason = (verdict,), verdict.reason
             if not verdict.safe:  # the gain may fade without ending it
-                self.phase, event, self.t_s, self.path = Phase.RETURN, "aborted", 0.0, self._return(planned)
+                back, gentle = self._return(planned)
+                if gentle or not self._loosely_safe(neighbours, speed_mps):
+                    self.phase, event, self.t_s, self.path = Phase.RETURN, "aborted", 0.0, back
+                else:
+                    reason = f"committed ({verdict.reason})"
         # offset in the current lane = offset in the start lane - (index - index_start) w (the width planned with)
         shift = crossed * self.width0
         ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2)
@@ -185,17 +198,28 @@ class LaneChange(Controller):
         into = self.side if self.phase is not Phase.RETURN and not crossed else 0
         return ref, LaneChangeDebug(self.phase, self.side, reason, verdicts, event, ref, plan, into)
 
-    def _return(self, at: LateralRef) -> MinJerkPath:
-        """The path back to the centre of the lane the change left, from ``at`` (in its frame): the shortest from
-        ``duration_s`` whose jerk is within ``return_jerk_mps3``, if it keeps the car's centre ``return_margin_m``
-        inside the boundary all along; else (a longer path turns back later) the ``duration_s`` one."""
+    def _return(self, at: LateralRef) -> tuple[MinJerkPath, bool]:
+        """The path back to the centre of the lane the change left, from ``at`` (in its frame), and whether it is
+        gentle. Of the quintics from the swerve's time up to ``return_max_s`` (0.25 s apart) that keep the car's centre
+        ``return_margin_m`` inside the lane: the shortest whose peak jerk is within ``return_jerk_mps3`` (gentle), else
+        the one with the least jerk; when none keeps inside (the car is nearly across), the shortest."""
         c = self.cfg
         y0, v0, a0 = at.offset_m, at.rate_mps, at.accel_mps2
-        gentle = MinJerkPath.within_jerk(y0, v0, a0, 0.0, c.duration_s, c.return_jerk_mps3, c.return_max_s)
+        durations = np.arange(c.evasion.duration_s, c.return_max_s + 1e-9, 0.25)
+        paths = [MinJerkPath.between(y0, v0, a0, 0.0, float(T)) for T in durations]
         # |y| <= w/2 - margin all along the path
-        if max(abs(y) for y in gentle.extent_m) <= self.width0 / 2 - c.return_margin_m:
-            return gentle
-        return MinJerkPath.between(y0, v0, a0, 0.0, c.duration_s)
+        inside = [p for p in paths if max(abs(y) for y in p.extent_m) <= self.width0 / 2 - c.return_margin_m]
+        gentle = [p for p in inside if p.peak_jerk_mps3 <= c.return_jerk_mps3]
+        if gentle:
+            return gentle[0], True
+        return (min(inside, key=lambda p: p.peak_jerk_mps3) if inside else paths[0]), False
+
+    def _loosely_safe(self, neighbours: Neighbours, speed_mps: float) -> bool:
+        """Whether the target lane passes MOBIL's safety test with the commitment's looser bounds (``commit_gap_s``,
+        ``commit_braking_mps2``): a change past its gentle return goes on while it does."""
+        c = self.cfg
+        loose = replace(c.mobil, min_time_gap_s=c.commit_gap_s, safe_braking_mps2=c.commit_braking_mps2)
+        return judge(self.side, True, neighbours, speed_mps, self.set_speed, loose).safe
 
     def _end(self, crossed: int) -> tuple[None, LaneChangeDebug]:
         """The path's end: a change is completed when the lane estimate has moved to the target lane, else (it never

@@ -43,19 +43,6 @@ class MinJerkPath:
         c3, c4, c5 = np.linalg.solve(A, b)
         return cls((c0, c1, c2, float(c3), float(c4), float(c5)), T)
 
-    @classmethod
-    def within_jerk(cls, y0: float, v0: float, a0: float, y1: float, min_duration_s: float, max_jerk_mps3: float,
-                    max_duration_s: float, step_s: float = 0.25) -> "MinJerkPath":
-        """The shortest of the quintics from ``min_duration_s`` up to ``max_duration_s`` [s], in steps of ``step_s``,
-        whose peak jerk is at most ``max_jerk_mps3`` [m/s³] (the longest when none is): a path that starts in motion,
-        as a return from a change under way does, asks more jerk than one from rest over the same time."""
-        T = min_duration_s
-        path = cls.between(y0, v0, a0, y1, T)
-        while path.peak_jerk_mps3 > max_jerk_mps3 and T + step_s <= max_duration_s + 1e-9:
-            T += step_s
-            path = cls.between(y0, v0, a0, y1, T)
-        return path
-
     @property
     def extent_m(self) -> tuple[float, float]:
         """The least and the largest offset the path reaches [m]."""

@@ -64,8 +64,10 @@ def build_dense(env, rng) -> Road:
 
 
 def build_overtake(env, rng) -> Road:
-    """3 lanes: a slow car ahead in the ego lane, faster traffic closing from behind on the left, and on the right
-    a car that comes up from behind and stays beside the ego, where neither rig sees it, for 6-10 s."""
+    """3 lanes: a slow car ahead in the ego lane; on the left two faster cars closing from behind, within the rear
+    rig's reach, and traffic from 150 m ahead on; on the right a car that comes up from behind and stays beside the
+    ego, where neither rig sees it, for 6-10 s. Once the two have passed, the left lane is open for an overtake; the
+    ego lane's own followers start 200 m back or more."""
     road = new_road(env, straight_road(3, 3000.0))
     env.road = road
     ego_s = 300.0
@@ -75,10 +77,10 @@ def build_overtake(env, rng) -> Road:
     # the one beside: centre 0-2 m behind the ego's (the blind band is ~7.7 m behind to 6 m ahead)
     place_idm(road, ("0", "1", 2), ego_s - float(rng.uniform(40.0, 60.0)), 30.0, cls=ScriptedVehicle,
               pace_offset_m=-float(rng.uniform(0.0, 2.0)), pace_s=float(rng.uniform(6.0, 10.0)))
-    place_traffic(road, rng, [0], ego_s - 300.0, ego_s - 30.0, 5, (29.0, 33.0), [], lane_change=True)
-    place_traffic(road, rng, [0], ego_s + 40.0, ego_s + 600.0, 5, (26.0, 30.0), [], lane_change=True)
+    place_traffic(road, rng, [0], ego_s - 85.0, ego_s - 35.0, 2, (29.0, 33.0), [], lane_change=True)
+    place_traffic(road, rng, [0], ego_s + 150.0, ego_s + 700.0, 4, (27.0, 31.0), [], lane_change=True)
     place_traffic(road, rng, [2], ego_s + 40.0, ego_s + 600.0, 4, (22.0, 26.0), [], lane_change=True)
-    place_traffic(road, rng, [1], ego_s - 250.0, ego_s - 60.0, 2, (25.0, 28.0), [], lane_change=True)
+    place_traffic(road, rng, [1], ego_s - 350.0, ego_s - 200.0, 2, (25.0, 28.0), [], lane_change=True)
     return road
 
 
