@@ -52,6 +52,9 @@ class LaneChangeConfig:
     return_max_s: float = 8.0  # a return takes from the swerve's time (evasion.duration_s) up to this long [s]
     return_margin_m: float = 0.3  # ... and keeps the car's centre this far inside the boundary of the lane it left
     # (a longer return turns back later) [m]
+    max_jerk_mps3: float = 2.5  # the most lateral jerk lane keeping may command on a change's path or a gentle
+    # return's, its corrections included (the path itself asks up to return_jerk_mps3); a swerve and a harsh return
+    # are not bounded [m/s³]
     commit_gap_s: float = 0.5  # past the point where a gentle return exists, a change goes on unless a gap in the
     # target lane is under this at the ego's speed ... [s]
     commit_braking_mps2: float = 3.0  # ... or the new follower would brake harder than this, or a car is beside
@@ -103,6 +106,7 @@ class LaneChange(Controller):
         self.path: MinJerkPath | None = None  # in the start lane's frame
         self.index0 = 0  # the lane index the change started from
         self.width0 = 0.0  # the lane width it was planned with [m]
+        self.jerk_bound: float | None = None  # the jerk bound handed to lane keeping on this path [m/s³]
         self.evasion.reset()
 
     def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float, dt: float,
@@ -167,7 +171,8 @@ class LaneChange(Controller):
         lane = path.lane
         self.phase, self.side, self.t_s, self.index0, self.width0 = phase, side, 0.0, lane.index, lane.width_m
         self.path = MinJerkPath.between(lane.offset_m, 0.0, 0.0, side * lane.width_m, duration_s)
-        ref = self.path.at(0.0)
+        self.jerk_bound = self.cfg.max_jerk_mps3 if phase is Phase.CHANGE else None
+        ref = replace(self.path.at(0.0), max_jerk_mps3=self.jerk_bound)
         event = "started" if evasion is None else evasion.event
         return ref, LaneChangeDebug(phase, side, reason, verdicts, event, ref, into_lane=side, evasion=evasion)
 
@@ -188,11 +193,12 @@ class LaneChange(Controller):
                 back, gentle = self._return(planned)
                 if gentle or not self._loosely_safe(neighbours, speed_mps):
                     self.phase, event, self.t_s, self.path = Phase.RETURN, "aborted", 0.0, back
+                    self.jerk_bound = self.cfg.max_jerk_mps3 if gentle else None
                 else:
                     reason = f"committed ({verdict.reason})"
         # offset in the current lane = offset in the start lane - (index - index_start) w (the width planned with)
         shift = crossed * self.width0
-        ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2)
+        ref = LateralRef(planned.offset_m - shift, planned.rate_mps, planned.accel_mps2, self.jerk_bound)
         ahead = [self.t_s + k * (self.path.duration_s - self.t_s) / (PLAN_POINTS - 1) for k in range(PLAN_POINTS)]
         plan = tuple((speed_mps * (t - self.t_s), self.path.at(t).offset_m - shift) for t in ahead)
         into = self.side if self.phase is not Phase.RETURN and not crossed else 0

@@ -4,7 +4,9 @@ Lateral error dynamics of a path-following car: y' = v sin(theta), theta' = v (k
 Choosing kappa_cmd = kappa_lane - 2 w sin(theta) / v - w^2 y / v^2 gives y'' + 2 w y' + w^2 y = 0:
 critically damped with time constant T = 1/w (Rajamani, *Vehicle Dynamics and Control*, 2nd ed., ch. 3).
 Following a lateral reference r(t) (a lane change's path, ``lateral_path``) the error e = y - r obeys the same
-equation with kappa_cmd = kappa_lane + (r'' - 2 w (v sin(theta) - r') - w^2 (y - r)) / v^2.
+equation with kappa_cmd = kappa_lane + (r'' - 2 w (v sin(theta) - r') - w^2 (y - r)) / v^2. A reference may bound the
+lateral jerk, v^2 d(kappa)/dt: the command's curvature then moves by at most j_max dt / v^2 a frame, so that a lane
+estimate's frame-to-frame jitter, through the feedback, does not jerk the car during a lane change.
 """
 
 from __future__ import annotations
@@ -27,8 +29,11 @@ class LaneKeepingDebug:
     offset_1pm: float  # the offset feedback term, -w^2 (y - r) / v^2 [1/m]
     heading_1pm: float  # the heading feedback term, -2 w (v sin(theta) - r') / v^2 [1/m]
     steering_rad: float  # the front-wheel angle asked for, before the vehicle's steering range [rad]
-    limited_by: str  # "path" (no lane: hold straight), "steer_limit" (outside the steering range) or "none"
+    limited_by: str  # "path" (no lane: hold straight), "jerk" (the reference's jerk bound), "steer_limit" (outside
+    # the steering range) or "none"
     reference_1pm: float = 0.0  # the reference's own term, r'' / v^2 (0 without one) [1/m]
+    curvature_1pm: float = 0.0  # the curvature asked for: the terms' sum, moved no further than the jerk bound allows
+    # [1/m]
 
 
 class LaneKeeping(Controller):
@@ -41,11 +46,18 @@ class LaneKeeping(Controller):
             raise ValueError(f"time_constant_s must be positive, got {time_constant_s}")
         self.T = time_constant_s
         self.v_min = min_speed_mps
+        self.reset()
 
-    def update(self, path: EgoPath, ref: LateralRef | None = None) -> tuple[float, LaneKeepingDebug]:
+    def reset(self) -> None:
+        self._kappa: float | None = None  # the curvature asked for on the last frame [1/m]
+
+    def update(self, path: EgoPath, ref: LateralRef | None = None,
+               dt_s: float | None = None) -> tuple[float, LaneKeepingDebug]:
         """Front-wheel angle [rad], ISO 8855 (positive turns left), and how it was made; ``ref``: where across the
-        lane to hold the car (None: its centre)."""
+        lane to hold the car (None: its centre); ``dt_s``: the time since the last call [s], which a reference's jerk
+        bound needs (None: no bound)."""
         if path.lane is None:
+            self._kappa = None
             return 0.0, LaneKeepingDebug(0.0, 0.0, 0.0, 0.0, "path")
         lane = path.lane
         r = ref or LateralRef(0.0, 0.0, 0.0)
@@ -58,6 +70,13 @@ class LaneKeeping(Controller):
         k_ref = r.accel_mps2 / (v * v)
         # kappa_cmd = kappa_lane + (r'' - 2 w (v sin(theta) - r') - w^2 (y - r)) / v^2
         kappa = lane.curvature_1pm + k_ref - k_heading - k_offset
+        limited = "none"
+        if r.max_jerk_mps3 is not None and dt_s is not None and self._kappa is not None:
+            # |kappa - kappa_prev| <= j_max dt / v^2
+            step = r.max_jerk_mps3 * dt_s / (v * v)
+            bounded = min(max(kappa, self._kappa - step), self._kappa + step)
+            limited, kappa = ("jerk" if bounded != kappa else "none"), bounded
+        self._kappa = kappa
         steer = steering_for_curvature(kappa)
-        limited = "steer_limit" if not STEER_RANGE_RAD[0] <= steer <= STEER_RANGE_RAD[1] else "none"
-        return steer, LaneKeepingDebug(lane.curvature_1pm, -k_offset, -k_heading, steer, limited, k_ref)
+        limited = "steer_limit" if not STEER_RANGE_RAD[0] <= steer <= STEER_RANGE_RAD[1] else limited
+        return steer, LaneKeepingDebug(lane.curvature_1pm, -k_offset, -k_heading, steer, limited, k_ref, kappa)

@@ -20,6 +20,8 @@ class LateralRef:
     offset_m: float  # the offset from the lane centre to hold [m] (+ left, as LaneEstimate.offset_m)
     rate_mps: float  # its rate of change [m/s]
     accel_mps2: float  # its second derivative [m/s²]
+    max_jerk_mps3: float | None = None  # the most lateral jerk lane keeping may add up to while following it, its
+    # corrections included [m/s³] (None: unbounded, as on a swerve)
 
 
 @dataclass(frozen=True)

@@ -69,7 +69,7 @@ class Agent:
         ahead = nearest_target(lead, request, neighbours)
         ref, change = (self.changing.update(path, neighbours, speed, self.dt_s, ahead) if self.changing
                        else (None, None))
-        steer, keeping = self.keeping.update(path, ref)
+        steer, keeping = self.keeping.update(path, ref, self.dt_s)
         # during a change, the target lane's nearest car ahead as well
         target = nearer(ahead, in_target_lane(neighbours, change.into_lane)) if change else ahead
         follow, following = self.following.update(target, speed)

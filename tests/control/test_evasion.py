@@ -74,3 +74,5 @@ def test_the_lane_change_law_flies_the_swerve_at_once_and_fast():
     assert [d.event for d in dbgs] == [None, "swerve", None]
     assert dbgs[1].phase is Phase.EVADE and dbgs[1].side == 1 and dbgs[1].into_lane == 1
     assert law.path.duration_s == EvasionConfig().duration_s
+    # lane keeping may jerk the car as hard as the swerve asks
+    assert all(d.ref.max_jerk_mps3 is None for d in dbgs[1:])

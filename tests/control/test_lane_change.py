@@ -2,6 +2,7 @@
 manoeuvre, and lane keeping on a lateral reference."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -225,6 +226,23 @@ def test_past_its_gentle_return_a_change_still_returns_from_a_car_beside_keeping
     # no gentle return is left: the one with the least jerk that keeps the car inside its lane
     assert dbgs[0].event == "aborted" and dbgs[0].reason == "beside"
     assert _inside(law.path) and law.path.peak_jerk_mps3 > 2.0
+
+
+def test_a_changes_path_bounds_lane_keepings_jerk_against_a_jittering_lane_estimate():
+    law = LaneChange(30.0, LaneChangeConfig(duration_s=5.0, settle_s=0.2, max_jerk_mps3=2.5))
+    dbgs, _ = run_law(law, int(2.0 / DT), around(car(0, 35.0, rel=-6.0)))
+    assert dbgs[-1].phase is Phase.CHANGE
+    assert all(d.ref.max_jerk_mps3 == 2.5 for d in dbgs if d.phase is Phase.CHANGE)
+    ref = LateralRef(1.0, 0.5, 0.0, max_jerk_mps3=2.5)
+    for bound, most in ((2.5, 2.5 * DT / V ** 2), (None, math.inf)):
+        keeping = LaneKeeping(time_constant_s=0.8)
+        # the offset estimate jumps 0.3 m for a frame and back
+        kappas = [keeping.update(path(y), replace(ref, max_jerk_mps3=bound), DT)[1].curvature_1pm
+                  for y in (1.0, 1.3, 1.0, 1.0)]
+        steps = np.abs(np.diff(kappas))
+        assert steps.max() <= most + 1e-12
+    # unbounded, the jump asks w^2 0.3 / v^2 at once: more than twice the bound's step
+    assert steps.max() > 2 * 2.5 * DT / V ** 2
 
 
 def test_lane_keeping_follows_a_reference_with_its_feed_forward():
