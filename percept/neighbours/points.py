@@ -34,8 +34,8 @@ class PointsConfig:
     speckle_range_px: float = 1.0  # ... whose disparity steps by no more than this inside is a speckle [px]
     drop_far_speckles: bool = True  # leave the far strip's speckles out of the points and its map (far away they
     # are phantoms), not just flag them ...
-    drop_near_speckles: bool = False  # ... and the near map's (ahead, a car pulling out close by at night or in rain
-    # is found only without them; behind, a car's lamps at night may be matched only in small patches)
+    drop_near_speckles: bool = False  # ... and the near map's (flagged, they are left out only of a group too wide
+    # for a vehicle; close by, a car's lamps at night or its wet side in rain may be matched only in small patches)
     split_m: float = 32.0  # beyond this camera depth, points come from a strip matched at full resolution [m]
 
 

@@ -3,13 +3,15 @@ lanes beside it, ahead, beside and behind, out (``Neighbours``).
 
 Each frame each rig's vehicles are found (``finder``: band stereo, ground-grid groups, the face's subpixel range) in
 the ego lane's coordinates, tracked (``tracker``), and each confirmed track reported with its lane, gap, relative
-speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside whose lateral
-speed (beyond ``speed_sigmas`` of its estimate) takes its centre to the ego lane's boundary within ``horizon_s``, and
-which was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row since it was
-laterally still there: a car changing into it from the lane beyond, or a ramp's car arriving in the acceleration lane,
-is not cutting in to the ego's), is flagged as cutting in, with the predicted time to that crossing, so the following
-law can treat it as a lead before it arrives; the flag stays on while it is tracked in the ego lane after, so that the
-car is not lost before the lead's own slot takes it up close by.
+speed, lateral position and speed in its lane, and uncertainties. Intent: a neighbour in a lane beside, going along
+the road (at least ``min_ground_speed_mps`` over the ground: a person crossing is the pedestrian task's), whose
+lateral speed (beyond ``speed_sigmas`` of its estimate) takes its centre to the ego lane's boundary within
+``horizon_s``, and which was a settled neighbour first (seen in that lane ``TrackerConfig.min_settled`` times in a row
+since it was laterally still there: a car changing into it from the lane beyond, or a ramp's car arriving in the
+acceleration lane, is not cutting in to the ego's) or, not settled, has gone on ``through_shift_m`` past its lane's
+centre towards the ego lane (a ramp's car merging straight on), is flagged as cutting in, with the predicted time to
+that crossing, so the following law can treat it as a lead before it arrives; the flag stays on while it is tracked
+in the ego lane after, so that the car is not lost before the lead's own slot takes it up close by.
 """
 
 from __future__ import annotations
@@ -21,7 +23,6 @@ from percept.sensors import EGO_LENGTH_M, EgoPath, Frame, Neighbour, Neighbours,
 
 from .clusters import DEFAULT_LANE_WIDTH_M, VEHICLE_LENGTH_M, Detection
 from .finder import RigFinder
-from .points import PointsConfig
 from .tracker import NeighbourTracker, Track, TrackerConfig
 
 
@@ -41,6 +42,11 @@ class NeighbourConfig:
     # car in view is found on nearly every frame; stereo's phantoms, from edges on the road or a guard rail, come
     # and go) [-]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
+    min_ground_speed_mps: float = 5.0  # a cut-in is a vehicle going along the road: anything slower there (a person
+    # crossing, whom the pedestrian task watches) is not flagged [m/s]
+    through_shift_m: float = 0.7  # a track not settled in its lane (moving over from the lane beyond, or a ramp's
+    # car) cuts in once it is this far past its lane's centre towards the ego lane, still moving: one that settles
+    # in its lane stops short of that [m]
 
 
 @dataclass(frozen=True)
@@ -59,7 +65,7 @@ class NeighbourSlot:
         self.cfg = cfg
         # faces lie half the ego's length beyond the gap
         reach = EGO_LENGTH_M / 2 + 2.0
-        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m + reach, PointsConfig(drop_near_speckles=True))
+        self.front = RigFinder(rig, cfg.front_near_m, cfg.ahead_m + reach)
         self.rear = RigFinder(rear_rig, -cfg.behind_m - reach, cfg.rear_near_m) if rear_rig else None
         self.tracker = NeighbourTracker(dt_s, tracker)
         self._index: int | None = None  # the lane estimate's index on the last frame with one
@@ -86,19 +92,21 @@ class NeighbourSlot:
             detections["rear"], pts = self.rear.find(frame.rear_left_gray, frame.rear_right_gray, lane)
             points["rear"] = len(pts)
         self.tracker.step(detections, width)
-        tracks = [self._report(t, width) for t in self.tracker.tracks if t.confirmed]
+        tracks = [self._report(t, width, path.speed_mps) for t in self.tracker.tracks if t.confirmed]
         tracks = [n for n in tracks if n is not None]
         tracks.sort(key=lambda n: (n.lane, abs(n.x_m)))
         rear = self.rear is not None and frame.has_rear
         return Neighbours(tuple(tracks), self.cfg.ahead_m, self.cfg.behind_m, rear), NeighbourDebug(detections, points)
 
-    def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float
+    def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float, ground_mps: float
                 ) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside, or in the ego lane
-        after a warning: it starts when the track, settled in its lane, measured this frame (a face cut off by the
-        image's edge counts: a car pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves
-        towards the ego lane faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it,
-        has left its lane's centre by ``min_shift_m`` towards it and will reach the boundary within ``horizon_s``; it
+        after a warning; ``ground_mps``: its along-lane speed over the ground [m/s]. It starts when the track, going
+        at least ``min_ground_speed_mps``, measured this frame (a face cut off by the image's edge counts: a car
+        pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves towards the ego lane faster
+        than both ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's centre
+        towards it by ``min_shift_m`` (settled in its lane) or ``through_shift_m`` (not settled) and will reach the
+        boundary within ``horizon_s``; it
         holds while the car stays shifted that way and does not move back (a merging car may pause on the line), and
         once it is in the ego lane (time to crossing 0)."""
         c = self.cfg
@@ -110,9 +118,10 @@ class NeighbourSlot:
         if t.warning:
             holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
         else:
-            holds = (t.settled >= self.tracker.cfg.min_settled and t.camera is not None
-                     and t.seen >= c.min_seen_share * self.tracker.recent_frames
-                     and shift >= c.min_shift_m
+            settled = t.settled >= self.tracker.cfg.min_settled
+            holds = (t.camera is not None and t.seen >= c.min_seen_share * self.tracker.recent_frames
+                     and ground_mps >= c.min_ground_speed_mps
+                     and shift >= (c.min_shift_m if settled else c.through_shift_m)
                      and toward > max(c.min_lateral_speed_mps, c.speed_sigmas * sig_vl))
         if not holds:
             return False, None
@@ -120,7 +129,9 @@ class NeighbourSlot:
         ttc = max(abs(lat) - width / 2, 0.0) / max(toward, c.min_lateral_speed_mps)
         return (True, ttc) if t.warning or ttc <= c.horizon_s else (False, None)
 
-    def _report(self, t: Track, width: float) -> Neighbour | None:
+    def _report(self, t: Track, width: float, speed_mps: float) -> Neighbour | None:
+        """The record of track ``t`` for an ego at ``speed_mps`` [m/s] (its along-lane speed over ground is
+        speed_mps + x'), or None when it is beyond the lanes and ranges reported."""
         x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
         lane = int(round(lat / width))
         zone, gap = zone_and_gap(x, VEHICLE_LENGTH_M)
@@ -128,7 +139,8 @@ class NeighbourSlot:
             return None
         P = t.kf.P
         warn = (lane != 0 or t.warning) and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
-        cut_in, ttc = self._intent(t, lat, vl, lane, width, math.sqrt(max(P[3, 3], 0.0))) if warn else (False, None)
+        sig_vl = math.sqrt(max(P[3, 3], 0.0))
+        cut_in, ttc = self._intent(t, lat, vl, lane, width, sig_vl, speed_mps + vx) if warn else (False, None)
         t.warning = cut_in
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
                          self.tracker.sigma_x(t), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),

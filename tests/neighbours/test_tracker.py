@@ -124,22 +124,6 @@ def test_tracks_move_with_the_ego_into_the_next_lane():
     assert t.lane == 0 and t.lat == pytest.approx(0.2, abs=0.05)
 
 
-def test_a_car_coming_over_from_the_lane_beyond_is_not_cutting_in():
-    slot = NeighbourSlot(StereoRig(), None, DT)
-    # 30 m ahead two lanes to the left, moving right at 1 m/s into the next lane and half a metre past its centre (a
-    # ramp's car arriving in the acceleration lane), then keeping there
-    lat = [1.6 * W - 1.0 * k * DT for k in range(int((0.6 * W + 0.5) / DT))]
-    lat += [lat[-1]] * 45
-    slot.front = _FakeFinder([det(32.0, y) for y in lat])
-    frame = type("F", (), {"dropped": False, "has_rear": False, "left_gray": None, "right_gray": None})()
-    for _ in lat:
-        nb, _ = slot.step(frame, {EgoPath: EgoPath.straight(25.0)})
-        assert nb.cutting_in() is None
-    # it is a settled neighbour in its lane once it has kept still there
-    (track,) = slot.tracker.tracks
-    assert track.lane == 1 and track.settled >= TrackerConfig().min_settled
-
-
 def test_a_face_far_away_is_placed_less_surely_across_the_lane():
     from percept.neighbours.clusters import VEHICLE_WIDTH_M
     from percept.neighbours.finder import EDGE_SIGMA_PX, RigFinder
