@@ -42,6 +42,8 @@ class NeighbourConfig:
     # car in view is found on nearly every frame; stereo's phantoms, from edges on the road or a guard rail, come
     # and go) [-]
     warn_ahead_m: float = 60.0  # cut-ins are flagged up to this far ahead [m]
+    max_ground_speed_mps: float = 50.0  # a track faster than this over the ground (180 km/h) is no car on the road but
+    # things matched by chance, such as posts, strung into one track: it is not reported [m/s]
     min_ground_speed_mps: float = 5.0  # a cut-in is a vehicle going along the road: anything slower there (a person
     # crossing, whom the pedestrian task watches) is not flagged [m/s]
     through_shift_m: float = 0.7  # a track not settled in its lane (moving over from the lane beyond, or a ramp's
@@ -131,11 +133,13 @@ class NeighbourSlot:
 
     def _report(self, t: Track, width: float, speed_mps: float) -> Neighbour | None:
         """The record of track ``t`` for an ego at ``speed_mps`` [m/s] (its along-lane speed over ground is
-        speed_mps + x'), or None when it is beyond the lanes and ranges reported."""
+        speed_mps + x'), or None when it is beyond the lanes and ranges reported or faster than any car."""
         x, vx, lat, vl = (float(v) for v in t.kf.x[:, 0])
         lane = int(round(lat / width))
         zone, gap = zone_and_gap(x, VEHICLE_LENGTH_M)
         if abs(lane) > 1 or gap > (self.cfg.ahead_m if zone is Zone.AHEAD else self.cfg.behind_m):
+            return None
+        if speed_mps + vx > self.cfg.max_ground_speed_mps:
             return None
         P = t.kf.P
         warn = (lane != 0 or t.warning) and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
