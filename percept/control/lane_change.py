@@ -16,6 +16,7 @@ new follower braking harder than 3 m/s²).
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass, field, replace
 from enum import Enum
 
@@ -61,6 +62,9 @@ class LaneChangeConfig:
     # [m/s²]
     settle_s: float = 1.0  # how long MOBIL must favour the same side before a change starts [s]
     min_interval_s: float = 8.0  # least time from the end of one change to the start of the next [s]
+    unseen_window_s: float = 10.0  # with no follower in view in the target lane, one is assumed at the rear view's
+    # edge going the fastest the ego went in this long (traffic the ego braked out of, closing fast from beyond the
+    # view) [s]
     new_lane_m: float = 500.0  # a lane that opened beside the car (its boundary was the road's edge, a solid line)
     # less than this far back may be an acceleration lane, whose end is not marked: no change goes into it [m]
     mobil: MobilConfig = field(default_factory=MobilConfig)  # the decision's parameters
@@ -107,6 +111,7 @@ class LaneChange(Controller):
         self.index0 = 0  # the lane index the change started from
         self.width0 = 0.0  # the lane width it was planned with [m]
         self.jerk_bound: float | None = None  # the jerk bound handed to lane keeping on this path [m/s³]
+        self.speeds: deque[float] = deque()  # the ego's speed on each frame of the last unseen_window_s [m/s]
         self.evasion.reset()
 
     def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float, dt: float,
@@ -116,6 +121,7 @@ class LaneChange(Controller):
         period ``dt`` [s] and the longitudinal laws' nearest target (``nearest_target`` with no change under way;
         None: nothing ahead), which evasion judges while the car keeps its lane. Without a view behind
         (``Neighbours.rear`` False) no change starts either."""
+        self._watch_speeds(speed_mps, dt)
         if not path.follows_lane:  # nothing to steer along: a path under way runs on unseen
             self.favour, self.favour_s = 0, 0.0
             self.t_s += dt if self.phase is not Phase.KEEP else 0.0
@@ -148,6 +154,13 @@ class LaneChange(Controller):
             return None, LaneChangeDebug(self.phase, 0, "too soon", verdicts, None, None)
         return self._start(Phase.CHANGE, side, path, self.cfg.duration_s, reason, None, verdicts)
 
+    def _watch_speeds(self, speed_mps: float, dt: float) -> None:
+        """Keep the ego's speed ``speed_mps`` [m/s] over the last ``unseen_window_s``: a car going as fast as the ego
+        went lately may come from beyond the rear view into a lane the ego, slowed down, changes into."""
+        self.speeds.append(speed_mps)
+        while len(self.speeds) > max(round(self.cfg.unseen_window_s / dt), 1):
+            self.speeds.popleft()
+
     def _watch_edges(self, index: int, beside: tuple, moved_m: float) -> None:
         """Count how far the car has gone (``moved_m`` this frame [m]) since each boundary of lane ``index`` was
         last the road's edge (``beside``: the lane estimate's (left, right) verdicts); a new lane forgets them."""
@@ -162,7 +175,7 @@ class LaneChange(Controller):
         ago = self.edge_ago_m[side]
         if lane_there and ago is not None and ago < self.cfg.new_lane_m:
             return Judgement(side, 0.0, 0.0, "new lane")
-        return judge(side, lane_there, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
+        return judge(side, lane_there, neighbours, speed_mps, self.set_speed, self.cfg.mobil, max(self.speeds))
 
     def _start(self, phase: Phase, side: int, path: EgoPath, duration_s: float, reason: str,
                evasion: EvasionDebug | None,
@@ -187,7 +200,7 @@ class LaneChange(Controller):
         if self.t_s >= self.path.duration_s:
             return self._end(crossed)
         if self.phase is Phase.CHANGE and not crossed and neighbours is not None:
-            verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil)
+            verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil, max(self.speeds))
             verdicts, reason = (verdict,), verdict.reason
             if not verdict.safe:  # the gain may fade without ending it
                 back, gentle = self._return(planned)

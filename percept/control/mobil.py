@@ -8,7 +8,9 @@ with c the ego, n the new follower (behind in the target lane), o the old one (b
 the change. highway-env's own traffic decides with the same model and these parameters (its ``IDMVehicle``).
 Perception is not truth: every gap is taken ``sigmas`` standard deviations shorter and every closing speed that
 much faster before the test, a lane with any track beside the ego (in the blind zone, seen by neither rig) is never
-a target, and the gaps ahead and behind must each hold ``min_time_gap_s`` at the ego's speed.
+a target, and the gaps ahead and behind must each hold ``min_time_gap_s`` at the ego's speed. With no follower in
+view in the target lane, one may still come from beyond the rear view: given ``unseen_speed_mps``, a follower at that
+speed is assumed at the view's edge (``Neighbours.behind_m``).
 """
 
 from __future__ import annotations
@@ -63,7 +65,7 @@ class Judgement:
     gain_mps2: float  # the incentive's left-hand side less the bias (+ favours the change) [m/s²]
     imposed_mps2: float  # the new follower's acceleration after the change (pessimistic) [m/s²]
     reason: str  # "ok", or why not: "no lane", "new lane" (LaneChange's), "beside", "gap ahead", "gap behind",
-    # "follower brakes", "no gain"
+    # "follower brakes", "unseen follower" (one assumed beyond the rear view would), "no gain"
 
     @property
     def go(self) -> bool:
@@ -89,9 +91,10 @@ def _closing(n: Neighbour, behind: bool, k: float) -> float:
 
 
 def judge(side: int, lane_there: bool | None, neighbours: Neighbours, speed_mps: float, set_speed_mps: float,
-          cfg: MobilConfig = MobilConfig()) -> Judgement:
+          cfg: MobilConfig = MobilConfig(), unseen_speed_mps: float | None = None) -> Judgement:
     """MOBIL's verdict on changing into the lane on ``side`` (+1 left, -1 right), that ``lane_there`` says exists, for
-    an ego at ``speed_mps`` wanting ``set_speed_mps`` among ``neighbours``."""
+    an ego at ``speed_mps`` wanting ``set_speed_mps`` among ``neighbours``; with no follower in view there, one at
+    ``unseen_speed_mps`` [m/s] (None: no one) is assumed at the rear view's edge."""
     k, v = cfg.sigmas, speed_mps
     if lane_there is not True:
         return Judgement(side, 0.0, 0.0, "no lane")
@@ -110,8 +113,11 @@ def judge(side: int, lane_there: bool | None, neighbours: Neighbours, speed_mps:
     if follow_new is not None and _gap(follow_new, k) < cfg.min_time_gap_s * (v + max(follow_new.rel_speed_mps, 0)):
         return Judgement(side, 0.0, 0.0, "gap behind")
     imposed = _behind_ego(follow_new, v, k)
+    if follow_new is None and unseen_speed_mps is not None:
+        # a car at v_u, behind_m back: a~_n = IDM(v_u, v_u, behind_m, v_u - v)
+        imposed = idm_accel(unseen_speed_mps, unseen_speed_mps, neighbours.behind_m, unseen_speed_mps - v)
     if imposed < -cfg.safe_braking_mps2:
-        return Judgement(side, 0.0, imposed, "follower brakes")
+        return Judgement(side, 0.0, imposed, "follower brakes" if follow_new is not None else "unseen follower")
     # the new follower n goes from behind lead_new to behind the ego; the old one o from behind the ego to behind
     # lead_old
     polite = (imposed - _behind(follow_new, lead_new, v)) + (_behind(follow_old, lead_old, v)
