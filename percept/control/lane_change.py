@@ -112,6 +112,7 @@ class LaneChange(Controller):
         self.width0 = 0.0  # the lane width it was planned with [m]
         self.jerk_bound: float | None = None  # the jerk bound handed to lane keeping on this path [m/s³]
         self.speeds: deque[float] = deque()  # the ego's speed on each frame of the last unseen_window_s [m/s]
+        self.unseen_mps = 0.0  # the fastest of them: the speed of a follower assumed beyond the rear view [m/s]
         self.evasion.reset()
 
     def update(self, path: EgoPath, neighbours: Neighbours | None, speed_mps: float, dt: float,
@@ -160,6 +161,7 @@ class LaneChange(Controller):
         self.speeds.append(speed_mps)
         while len(self.speeds) > max(round(self.cfg.unseen_window_s / dt), 1):
             self.speeds.popleft()
+        self.unseen_mps = max(self.speeds)
 
     def _watch_edges(self, index: int, beside: tuple, moved_m: float) -> None:
         """Count how far the car has gone (``moved_m`` this frame [m]) since each boundary of lane ``index`` was
@@ -175,7 +177,7 @@ class LaneChange(Controller):
         ago = self.edge_ago_m[side]
         if lane_there and ago is not None and ago < self.cfg.new_lane_m:
             return Judgement(side, 0.0, 0.0, "new lane")
-        return judge(side, lane_there, neighbours, speed_mps, self.set_speed, self.cfg.mobil, max(self.speeds))
+        return judge(side, lane_there, neighbours, speed_mps, self.set_speed, self.cfg.mobil, self.unseen_mps)
 
     def _start(self, phase: Phase, side: int, path: EgoPath, duration_s: float, reason: str,
                evasion: EvasionDebug | None,
@@ -200,7 +202,7 @@ class LaneChange(Controller):
         if self.t_s >= self.path.duration_s:
             return self._end(crossed)
         if self.phase is Phase.CHANGE and not crossed and neighbours is not None:
-            verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil, max(self.speeds))
+            verdict = judge(self.side, True, neighbours, speed_mps, self.set_speed, self.cfg.mobil, self.unseen_mps)
             verdicts, reason = (verdict,), verdict.reason
             if not verdict.safe:  # the gain may fade without ending it
                 back, gentle = self._return(planned)

@@ -12,6 +12,10 @@ DT = 1 / 15
 W = 4.0
 
 
+FRONT_ONLY = type("F", (), {"dropped": False, "has_rear": False, "left_gray": None, "right_gray": None})()
+"""A frame the slot's fake finders read: the forward pair only."""
+
+
 def det(x: float, lat: float, sigma: float = 0.1) -> Detection:
     face = x - 2.5 if x > 0 else x + 2.5
     return Detection(x, lat, face, 1.8, (0, 0, 10, 10), 50, sigma)
@@ -81,10 +85,9 @@ def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
     # 30 m ahead in the left lane, then drifting right at 1 m/s from t = 1 s
     lat = [W] * 15 + [W - 1.0 * k * DT for k in range(1, 60)]
     slot.front = _FakeFinder([det(32.0, y) for y in lat])
-    frame = type("F", (), {"dropped": False, "has_rear": False, "left_gray": None, "right_gray": None})()
     flagged_at, crossed_at = None, None
     for k, y in enumerate(lat):
-        nb, _ = slot.step(frame, {EgoPath: EgoPath.straight(25.0)})
+        nb, _ = slot.step(FRONT_ONLY, {EgoPath: EgoPath.straight(25.0)})
         cut = nb.cutting_in()
         if cut is not None and flagged_at is None:
             flagged_at = k
@@ -104,9 +107,8 @@ def test_something_found_on_one_frame_in_three_is_not_flagged():
     # settled in the lane beside, then the same motion as a car moving over, but found on a third of the frames
     lat = [W] * 30 + [W - 1.0 * k * DT for k in range(1, 60)]
     slot.front = _FakeFinder([det(32.0, y) if k < 30 or k % 3 == 0 else None for k, y in enumerate(lat)])
-    frame = type("F", (), {"dropped": False, "has_rear": False, "left_gray": None, "right_gray": None})()
     for k in range(len(lat)):
-        nb, _ = slot.step(frame, {EgoPath: EgoPath.straight(25.0)})
+        nb, _ = slot.step(FRONT_ONLY, {EgoPath: EgoPath.straight(25.0)})
         assert nb.cutting_in() is None
         if k == 29:  # a settled neighbour before it moves
             assert slot.tracker.tracks[0].settled >= TrackerConfig().min_settled
