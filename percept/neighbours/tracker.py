@@ -135,12 +135,18 @@ class NeighbourTracker:
             t.lane = lane
             t.confirmed = t.confirmed or t.hits >= c.confirm_hits
         # a detection left over inside the gate of a track this rig measured this frame is another part of that car
-        # (far away a car's face breaks into several groups): it makes no track of its own
+        # (far away a car's face breaks into several groups): it makes no track of its own, nor does a sliver
         parts = {j for _, i, j in pairs if i in used_t}
         for j, d in enumerate(dets):
-            if j not in used_d and j not in parts:
+            if j not in used_d and j not in parts and not self._sliver(d):
                 self.tracks.append(Track(self._next_id, self._new_filter(d), camera=rig, box_px=d.box_px))
                 self._next_id += 1
+
+    def _sliver(self, d: Detection) -> bool:
+        """Whether detection ``d`` is too narrow for a car's face seen whole at its range (``min_face_width_m``
+        within ``whole_face_m``): it may update a track but starts none."""
+        c = self.cfg
+        return not d.cut_off and abs(d.x_m) <= c.whole_face_m and d.width_m < c.min_face_width_m
 
     def manoeuvring(self, t: Track) -> bool:
         """Whether a track's lateral innovations say it moves sideways faster than its filter follows: then its

@@ -80,11 +80,13 @@ class _FakeFinder:
         return ([] if d is None else [d]), np.zeros(0)
 
 
-def test_a_neighbour_moving_over_is_flagged_before_it_crosses():
+@pytest.mark.parametrize("x_m", [32.0, 70.0])
+def test_a_neighbour_moving_over_is_flagged_before_it_crosses(x_m):
     slot = NeighbourSlot(StereoRig(), None, DT)
-    # 30 m ahead in the left lane, then drifting right at 1 m/s from t = 1 s
+    # ahead in the left lane (near, and beyond the 60 m within which cut-ins are scored), then drifting right at
+    # 1 m/s from t = 1 s
     lat = [W] * 15 + [W - 1.0 * k * DT for k in range(1, 60)]
-    slot.front = _FakeFinder([det(32.0, y) for y in lat])
+    slot.front = _FakeFinder([det(x_m, y) for y in lat])
     flagged_at, crossed_at = None, None
     for k, y in enumerate(lat):
         nb, _ = slot.step(FRONT_ONLY, {EgoPath: EgoPath.straight(25.0)})
