@@ -279,3 +279,16 @@ def test_bad_points_config_is_refused():
 
     with pytest.raises(ValueError, match="shrink must be 1 or 2"):
         BandStereo(StereoRig(), PointsConfig(shrink=3))
+
+
+def test_a_car_pulling_out_in_the_band_missed_on_one_frame_in_three_keeps_its_lateral_speed():
+    tr = NeighbourTracker(DT)
+    # 10 m ahead in the lane to the right (inside the band), settled, then pulling out left at 2 m/s, found by the
+    # front rig on two frames in three (rain)
+    for k in range(30):
+        tr.step({"front": [det(10.0, -W)]}, W)
+    for k in range(1, 13):
+        tr.step({"front": [det(10.0, -W + 2.0 * k * DT)] if k % 3 else []}, W)
+    (t,) = tr.tracks
+    # a miss that reset its lateral speed to rest would leave it under half the true speed
+    assert float(t.kf.x[3, 0]) > 1.2
