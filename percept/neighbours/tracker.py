@@ -228,8 +228,9 @@ class NeighbourTracker:
     def _keep_or_drop(self, width_m: float) -> None:
         """Unseen tracks: a confirmed one in (or come out of) the blind band is held in the band by prediction until a
         rig takes it over; one heading for the band from its fringe, established or last seen cut off by the image's
-        edge, coasts; one last seen cut off in the fringe and not heading for the band (its speed read from faces that
-        are only in part in view) is held too (a car at the edge that vanishes has gone on into the band); an
+        edge, coasts; an established one last seen cut off in the fringe and not heading for the band (its speed read
+        from faces that are only in part in view) is held too (a car at the edge that vanishes has gone on into the
+        band; a young one may be rain or a guard rail matched by chance at the edge, held beside for a minute); an
         established one in the ego lane nearer than ``near_ahead_m`` is held there for up to ``near_hold_s`` (a car
         that close may touch the ego's bumper unseen); any other counts a miss, and too many drop it."""
         c = self.cfg
@@ -240,7 +241,7 @@ class NeighbourTracker:
                 heading = self._heading_for_band(t)
                 coasts = beside and (t.hits >= c.min_settled or t.cut_off) and heading
                 into = self.in_blind_band(t.x, t.lat, width_m) or t.blind_s > 0 or (
-                    t.cut_off and self._in_fringe(t) and not heading)
+                    t.cut_off and self._in_fringe(t) and not heading and t.hits >= c.min_settled)
                 if beside and into and t.blind_s < c.max_blind_s:
                     self._hold_in_band(t, c.blind_behind_m, c.blind_ahead_m)
                 elif not beside and self._near_ahead(t, width_m):
