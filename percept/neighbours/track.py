@@ -23,10 +23,10 @@ class TrackerConfig:
     gate_x_m: float = 3.0  # association gate along the lane, plus gate_x_rel of the range [m]
     gate_x_rel: float = 0.08  # ... [-]
     gate_l_m: float = 1.4  # association gate across it [m]
-    confirm_hits: int = 3  # detections that confirm a track
+    confirm_hits: int = 3  # detections that confirm a track, slivers not counted
     min_face_width_m: float = 0.8  # a face seen whole (not cut off by the image's edge) narrower than this ...
-    whole_face_m: float = 60.0  # ... within this range along the lane starts no track: a car's face is wider there,
-    # while a post, a marking's edge or a patch of road matched by chance is not; farther away a car's face breaks into
+    whole_face_m: float = 60.0  # ... within this range along the lane is a sliver: a car's face is wider there, while
+    # a post, a marking's edge, rain or a patch of road matched by chance is not; farther away a car's face breaks into
     # narrower groups [m]
     max_misses: int = 6  # frames unseen (where a rig looks) that drop a track
     blind_behind_m: float = -14.0  # the blind band beside the ego, where a rig sees too little of a car to find it:
@@ -57,6 +57,7 @@ class Track:
     track_id: int
     kf: KalmanFilter
     hits: int = 1
+    solid: int = 1  # its detections that were no slivers (TrackerConfig.min_face_width_m)
     misses: int = 0
     blind_s: float = 0.0  # how long it has been held in the blind band (0: not held) [s]
     takeover: int = 0  # detections in a row since a rig saw it again while it was held

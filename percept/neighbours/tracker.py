@@ -2,10 +2,11 @@
 position and speed, in the ego lane's coordinates, fed by both rigs' detections.
 
 Constant velocity with white acceleration noise (Bar-Shalom, Li & Kirubarajan 2001, sec. 6.3.2). A track is
-confirmed after ``confirm_hits`` detections, dropped after ``max_misses`` frames unseen where a rig could see it; in
-the blind band beside the ego, which neither rig sees, it is kept by prediction (held inside the band, its position
-uncertainty growing) until a rig takes it over as it comes out, so a lane is never reported free while a vehicle may
-be beside the ego; a car in the ego lane too near for the front rig to find is held the same way for a while.
+confirmed after ``confirm_hits`` detections that are no slivers (too narrow for a car's face at their range), dropped
+after ``max_misses`` frames unseen where a rig could see it; in the blind band beside the ego, which neither rig sees,
+it is kept by prediction (held inside the band, its position uncertainty growing) until a rig takes it over as it
+comes out, so a lane is never reported free while a vehicle may be beside the ego; a car in the ego lane too near for
+the front rig to find is held the same way for a while.
 """
 
 from __future__ import annotations
@@ -133,7 +134,8 @@ class NeighbourTracker:
             t.still = lane == t.lane and t.still or t.calm >= c.still_frames
             t.settled = t.settled + 1 if lane == t.lane and t.still else int(t.still)
             t.lane = lane
-            t.confirmed = t.confirmed or t.hits >= c.confirm_hits
+            t.solid += int(not self._sliver(d))
+            t.confirmed = t.confirmed or t.solid >= c.confirm_hits
         # a detection left over inside the gate of a track this rig measured this frame is another part of that car
         # (far away a car's face breaks into several groups): it makes no track of its own, nor does a sliver
         parts = {j for _, i, j in pairs if i in used_t}
@@ -144,7 +146,7 @@ class NeighbourTracker:
 
     def _sliver(self, d: Detection) -> bool:
         """Whether detection ``d`` is too narrow for a car's face seen whole at its range (``min_face_width_m``
-        within ``whole_face_m``): it may update a track but starts none."""
+        within ``whole_face_m``): it may update a track but starts none, nor helps confirm one."""
         c = self.cfg
         return not d.cut_off and abs(d.x_m) <= c.whole_face_m and d.width_m < c.min_face_width_m
 

@@ -1,5 +1,5 @@
-"""A sliver (a face too narrow for a car's, seen whole within ``whole_face_m``) starts no track: posts, markings' edges
-and patches of road matched by chance are such slivers, a car's face is not."""
+"""A sliver (a face too narrow for a car's, seen whole within ``whole_face_m``) starts no track and helps confirm none:
+posts, markings' edges, rain and patches of road matched by chance are such slivers, a car's face is not."""
 
 from dataclasses import replace
 
@@ -40,3 +40,14 @@ def test_a_sliver_still_updates_a_car_s_track():
     # the car's face shrinks to a sliver for a frame (a lit part of it lost at night)
     tr.step({"rear": [replace(det(-40.0, W), width_m=0.4)]}, W)
     assert tr.tracks == [t] and t.hits == hits + 1 and t.misses == 0
+
+
+def test_slivers_do_not_confirm_a_track_a_cut_off_face_started():
+    # rain at the rear image's edge beside the ego: one face cut off by the edge, then slivers
+    cut = replace(det(-18.0, W), width_m=0.0, cut_off=True)
+    sliver = replace(det(-18.0, W), width_m=0.4)
+    tr = NeighbourTracker(DT)
+    for d in (cut, sliver, sliver, sliver):
+        tr.step({"rear": [d]}, W)
+    (t,) = tr.tracks
+    assert t.hits == 4 and not t.confirmed
