@@ -41,7 +41,8 @@ class NeighbourConfig:
     min_seen_share: float = 0.5  # and a rig found it on at least this share of the last TrackerConfig.recent_s (a
     # car in view is found on nearly every frame; stereo's phantoms, from edges on the road or a guard rail, come
     # and go) [-]
-    warn_ahead_m: float = 80.0  # cut-ins are flagged up to this far ahead [m]
+    warn_ahead_m: float = 70.0  # cut-ins are flagged for centres up to this far ahead: a car crossing at a 60 m gap
+    # (65 m centre) a second after its warning, closing at 5 m/s; beyond, its lateral position is too uncertain [m]
     max_ground_speed_mps: float = 50.0  # a track faster than this over the ground (180 km/h) is no car on the road but
     # things matched by chance, such as posts, strung into one track: it is not reported [m/s]
     min_ground_speed_mps: float = 5.0  # a cut-in is a vehicle going along the road: anything slower there (a person

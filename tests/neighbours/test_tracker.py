@@ -80,7 +80,7 @@ class _FakeFinder:
         return ([] if d is None else [d]), np.zeros(0)
 
 
-@pytest.mark.parametrize("x_m", [32.0, 70.0])
+@pytest.mark.parametrize("x_m", [32.0, 66.0])
 def test_a_neighbour_moving_over_is_flagged_before_it_crosses(x_m):
     slot = NeighbourSlot(StereoRig(), None, DT)
     # ahead in the left lane (near, and beyond the 60 m within which cut-ins are scored), then drifting right at
