@@ -44,8 +44,9 @@ class TrackerConfig:
     # a settled neighbour there (a car still moving over from the lane beyond is not) [-]
     still_mps: float = 0.3  # a track is laterally still once its lateral speed is below this [m/s] ...
     still_frames: int = 3  # ... on this many detections in a row since it was confirmed (its filter starts at rest) [-]
-    lateral_coast_s: float = 0.2  # a held track seen by a rig this recently keeps its lateral speed: in rain a car
-    # pulling out near the band is missed on one frame in three, and each miss would reset its speed to rest [s]
+    lateral_coast_s: float = 0.2  # a held track seen by a rig this recently keeps its lateral speed while it
+    # manoeuvres: in rain a car pulling out near the band is missed on one frame in three, and each miss would reset
+    # its speed to rest; a still one's speed, read from rain-blurred faces, is noise that would carry it sideways [s]
     blind_spread_mps: float = 2.0  # how fast the along-lane uncertainty of a track in the band grows [m/s]
     recent_s: float = 1.0  # the window over which a track's detections are counted (Track.seen) [s]
 

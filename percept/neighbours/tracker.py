@@ -189,13 +189,13 @@ class NeighbourTracker:
         return np.diag([max(d.sigma_x_m, 0.05) ** 2, var_l])
 
     def _hold_in_band(self, t: Track, lo_m: float, hi_m: float) -> None:
-        """One frame of a track held unseen in a band from ``lo_m`` to ``hi_m`` along the lane [m]: once no rig has
-        seen it for ``lateral_coast_s``, nothing says it moves sideways, so it keeps its lateral place; if its
-        prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed somewhere in
-        the band: it stops there, anywhere in the band as far as its uncertainty goes."""
+        """One frame of a track held unseen in a band from ``lo_m`` to ``hi_m`` along the lane [m]: unless it
+        manoeuvres and a rig saw it within ``lateral_coast_s``, nothing says it moves sideways, so it keeps its lateral
+        place; if its prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed
+        somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
         # seen on one of the frames within lateral_coast_s before this one: bits 1..k of seen_bits
         coast = round(self.cfg.lateral_coast_s / self.dt)
-        if not t.seen_bits & (((1 << coast) - 1) << 1):
+        if not (self.manoeuvring(t) and t.seen_bits & (((1 << coast) - 1) << 1)):
             t.kf.x[3, 0] = 0.0
         t.takeover = 0
         held = float(np.clip(t.x, lo_m, hi_m))
