@@ -140,12 +140,13 @@ class NeighbourSlot:
         zone, gap = zone_and_gap(x, VEHICLE_LENGTH_M)
         if abs(lane) > 1 or gap > (self.cfg.ahead_m if zone is Zone.AHEAD else self.cfg.behind_m):
             return None
-        if speed_mps + vx > self.cfg.max_ground_speed_mps:
+        ground_mps = speed_mps + vx
+        if ground_mps > self.cfg.max_ground_speed_mps:
             return None
         P = t.kf.P
         warn = (lane != 0 or t.warning) and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
         sig_vl = math.sqrt(max(P[3, 3], 0.0))
-        cut_in, ttc = self._intent(t, lat, vl, lane, width, sig_vl, speed_mps + vx) if warn else (False, None)
+        cut_in, ttc = self._intent(t, lat, vl, lane, width, sig_vl, ground_mps) if warn else (False, None)
         t.warning = cut_in
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
                          self.tracker.sigma_x(t), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),

@@ -32,6 +32,8 @@ class NeighbourTracker:
         self.width = DEFAULT_LANE_WIDTH_M  # the lane width of the last frame [m]
         # white acceleration: Q = q^2 [[dt^4/4, dt^3/2], [dt^3/2, dt^2]] per axis
         self._block = np.array([[dt_s ** 4 / 4, dt_s ** 3 / 2], [dt_s ** 3 / 2, dt_s ** 2]])
+        # Track.seen_bits of the frames within lateral_coast_s before the current one: bits 1..k
+        self._coast_bits = ((1 << round(cfg.lateral_coast_s / dt_s)) - 1) << 1
 
     def reset(self) -> None:
         self.tracks.clear()
@@ -193,9 +195,7 @@ class NeighbourTracker:
         manoeuvres and a rig saw it within ``lateral_coast_s``, nothing says it moves sideways, so it keeps its lateral
         place; if its prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed
         somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
-        # seen on one of the frames within lateral_coast_s before this one: bits 1..k of seen_bits
-        coast = round(self.cfg.lateral_coast_s / self.dt)
-        if not (self.manoeuvring(t) and t.seen_bits & (((1 << coast) - 1) << 1)):
+        if not (self.manoeuvring(t) and t.seen_bits & self._coast_bits):
             t.kf.x[3, 0] = 0.0
         t.takeover = 0
         held = float(np.clip(t.x, lo_m, hi_m))

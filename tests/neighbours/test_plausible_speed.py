@@ -1,5 +1,5 @@
 """A track faster over the ground than any car (``NeighbourConfig.max_ground_speed_mps``) is not reported: behind the
-ego, three narrow things matched by chance along the lane beside, strung into one track, read 35 m/s closing."""
+ego, three car-wide faces matched by chance along the lane beside, strung into one track, read 35 m/s closing."""
 
 import pytest
 
