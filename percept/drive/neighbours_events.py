@@ -31,8 +31,9 @@ SEEN_BEFORE_S = 2.0
 crossed sooner after it came into view (a car already moving over as the run begins) is counted apart, in
 ``cut_ins_unscored`` [s]."""
 CROSSED_FIRST_S = 1.0
-"""A warning run goes on for up to this long after its track has crossed into the ego lane in the estimate (the flag
-ends there: the car is now a lead) while the true car has not yet [s]."""
+"""The estimate and the truth may see a car cross into the ego lane up to this far apart: a warning run goes on for up
+to this long after its track has crossed in the estimate (the flag ends there: the car is now a lead) while the true
+car has not yet, and a warning begun up to this long after its car crossed in truth is late, not false [s]."""
 COLLISION_WINDOW_S = 1.0
 """Lateral speeds before a collision are averaged over this [s]."""
 LATERAL_MOVE_MPS = 0.3
@@ -67,6 +68,7 @@ class CutInEvents:
         self.unscored = 0  # cut-ins whose car crossed less than SEEN_BEFORE_S after a rig first saw it
         self._clear: set = set()  # vehicles clear of the ego lane since they were last in it
         self._in_lane: dict = {}  # track id -> when its warning run's track came into the ego lane (estimate) [s]
+        self._entered_s: dict = {}  # vehicle id -> when it last moved into the ego lane (truth) [s]
 
     def update(self, gt, truth: dict, tracks, matched: dict) -> None:
         """One frame of ground truth ``gt``: ``truth`` vehicle id -> its true ``Neighbour``; ``tracks`` the estimated
@@ -81,6 +83,7 @@ class CutInEvents:
                    and v in self._clear]
         self._follow_clear(gt, truth)
         self.crossings += len(crossed)
+        self._entered_s.update((v, time_s) for v in entered)
         for v, n in truth.items():
             if n.camera is not None:
                 self._first_seen.setdefault(v, time_s)
@@ -90,7 +93,7 @@ class CutInEvents:
                     self.unscored += 1
                     continue
                 self._score_crossing(time_s, v, matched)
-            self._follow_warnings(time_s, tracks, matched, entered)
+            self._follow_warnings(time_s, tracks, matched)
         self._lanes = {v: n.lane for v, n in truth.items()}
         self._lane_id = lane_id
         self._matched = dict(matched)
@@ -116,10 +119,11 @@ class CutInEvents:
         self.leads_s.append(lead)
         self.missed += int(not onsets)
 
-    def _follow_warnings(self, time_s: float, tracks, matched: dict, entered: list) -> None:
+    def _follow_warnings(self, time_s: float, tracks, matched: dict) -> None:
         """Onsets of warning runs, and the judgement of each FALSE_WARNING_S after it. A run goes on while its track
         is flagged, and for CROSSED_FIRST_S once its track is in the ego lane (the estimate may see the car cross a
-        frame or two before the truth does)."""
+        frame or two before the truth does). A run is justified when its vehicle moves into the ego lane while it is
+        judged, or had done so at most CROSSED_FIRST_S before its onset (a late warning, not a false one)."""
         warning = {n.track_id for n in tracks if n.cut_in}
         # runs whose track the estimate already has in the ego lane: since when
         crossed = ({n.track_id for n in tracks if n.lane == 0} & self._since.keys()) - warning
@@ -132,8 +136,8 @@ class CutInEvents:
         keep = []
         for o in self._pending:
             o.vehicle_id = matched.get(o.track_id) if o.vehicle_id is None else o.vehicle_id
-            if o.vehicle_id is not None and o.vehicle_id in entered:
-                continue  # justified: its vehicle moved into the ego lane within the window or the warning
+            if self._entered_s.get(o.vehicle_id, -math.inf) >= o.time_s - CROSSED_FIRST_S:
+                continue  # justified: its vehicle moved into the ego lane within the window or the warning, or late
             if time_s - o.time_s > FALSE_WARNING_S and o.track_id not in warning:
                 self.false_warnings += 1
             else:

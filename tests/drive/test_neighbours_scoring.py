@@ -290,3 +290,10 @@ def test_a_car_that_turns_back_halfway_out_of_the_ego_lane_is_no_cut_in(vehicle,
     out = [0.3 * k for k in range(12)] + [3.3 - 0.3 * k for k in range(1, 12)]
     frames = [(truth([vehicle(1, 30.0, y)], time_s=k * DT), []) for k, y in enumerate([0.0] * 30 + out)]
     assert run(frames)["cut_ins"] == 1
+
+
+@pytest.mark.parametrize("onset_s, false", [(3.0, 0), (3.8, 1)])
+def test_a_warning_begun_just_after_its_car_crossed_is_late_not_false(vehicle, truth, onset_s, false):
+    # the car crosses between 2.5 and 2.6 s; a warning from 3.0 s is late (within 1 s), one from 3.8 s is false
+    r = run(cut_in_run(vehicle, truth, lambda t: t >= onset_s, seconds=8.0))
+    assert r["cut_ins"] == 1 and r["cut_ins_missed"] == 1 and r["false_warnings"] == false
