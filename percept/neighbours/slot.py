@@ -94,7 +94,7 @@ class NeighbourSlot:
         if self.rear is not None and frame.has_rear:
             detections["rear"], pts = self.rear.find(frame.rear_left_gray, frame.rear_right_gray, lane)
             points["rear"] = len(pts)
-        self.tracker.step(detections, width)
+        self.tracker.step(detections, width, path.speed_mps)
         tracks = [self._report(t, width, path.speed_mps) for t in self.tracker.tracks if t.confirmed]
         tracks = [n for n in tracks if n is not None]
         tracks.sort(key=lambda n: (n.lane, abs(n.x_m)))

@@ -30,6 +30,9 @@ class NeighbourTracker:
         self.tracks: list[Track] = []
         self._next_id = 1
         self.width = DEFAULT_LANE_WIDTH_M  # the lane width of the last frame [m]
+        self._ego_speed: float | None = None  # the ego's speed over the ground at the last frame [m/s]
+        # the ego's speed change dv over a frame moves every track's relative state: x -= dv dt / 2, x' -= dv
+        self._B = np.array([[-dt_s / 2], [-1.0], [0.0], [0.0]])
         # white acceleration: Q = q^2 [[dt^4/4, dt^3/2], [dt^3/2, dt^2]] per axis
         self._block = np.array([[dt_s ** 4 / 4, dt_s ** 3 / 2], [dt_s ** 3 / 2, dt_s ** 2]])
         # Track.seen_bits of the frames within lateral_coast_s before the current one: bits 1..k
@@ -38,6 +41,7 @@ class NeighbourTracker:
     def reset(self) -> None:
         self.tracks.clear()
         self._next_id = 1
+        self._ego_speed = None
 
     def _new_filter(self, det: Detection) -> KalmanFilter:
         dt, c = self.dt, self.cfg
@@ -69,14 +73,20 @@ class NeighbourTracker:
         """Whether a centre at (x_m, lat_m) lies where neither rig sees: beside the ego in a lane beside it."""
         return self.cfg.blind_behind_m <= x_m <= self.cfg.blind_ahead_m and abs(lat_m) >= 0.5 * width_m
 
-    def step(self, detections: dict[str, list[Detection]], width_m: float) -> None:
+    def step(self, detections: dict[str, list[Detection]], width_m: float, ego_speed_mps: float | None = None
+             ) -> None:
         """One frame: predict every track, associate each rig's detections (``detections``: rig name -> its
-        detections), make new tracks, keep the blind band's tracks and drop the lost ones."""
+        detections), make new tracks, keep the blind band's tracks and drop the lost ones. ``ego_speed_mps``: the
+        ego's speed over the ground [m/s]; its change since the last frame moves every track's relative speed (a
+        braking ego closes on a car it no longer sees more slowly), None: taken as unchanged."""
         window = (1 << self.recent_frames) - 1
+        # the ego's speed change over the frame, the prediction's control input [m/s]
+        dv = 0.0 if ego_speed_mps is None or self._ego_speed is None else ego_speed_mps - self._ego_speed
+        self._ego_speed = ego_speed_mps
         for t in self.tracks:
             q = self.cfg.manoeuvre_accel_noise_mps2 if self.manoeuvring(t) else self.cfg.lateral_accel_noise_mps2
             t.kf.Q[2:, 2:] = self._block * q ** 2
-            t.kf.predict()
+            t.kf.predict(u=np.array([[dv]]), B=self._B)
             t.camera, t.box_px = None, None
             t.seen_bits = (t.seen_bits << 1) & window
         self.width = width_m
@@ -191,11 +201,12 @@ class NeighbourTracker:
         return np.diag([max(d.sigma_x_m, 0.05) ** 2, var_l])
 
     def _hold_in_band(self, t: Track, lo_m: float, hi_m: float) -> None:
-        """One frame of a track held unseen in a band from ``lo_m`` to ``hi_m`` along the lane [m]: unless it
-        manoeuvres and a rig saw it within ``lateral_coast_s``, nothing says it moves sideways, so it keeps its lateral
-        place; if its prediction reaches the band's edge with no rig seeing it come out, it has matched the ego's speed
-        somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
-        if not (self.manoeuvring(t) and t.seen_bits & self._coast_bits):
+        """One frame of a track held unseen in a band from ``lo_m`` to ``hi_m`` along the lane [m]: unless it is
+        flagged as cutting in (a car pulling out close by, in rain missed on several frames in a row, goes on moving
+        over), or manoeuvres and a rig saw it within ``lateral_coast_s``, nothing says it moves sideways, so it keeps
+        its lateral place; if its prediction reaches the band's edge with no rig seeing it come out, it has matched the
+        ego's speed somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
+        if not (t.warning or self.manoeuvring(t) and t.seen_bits & self._coast_bits):
             t.kf.x[3, 0] = 0.0
         t.takeover = 0
         held = float(np.clip(t.x, lo_m, hi_m))
