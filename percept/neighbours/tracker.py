@@ -31,7 +31,7 @@ class NeighbourTracker:
         self._next_id = 1
         self.width = DEFAULT_LANE_WIDTH_M  # the lane width of the last frame [m]
         self._ego_speed: float | None = None  # the ego's speed over the ground at the last frame [m/s]
-        # the ego's speed change dv over a frame moves every track's relative state: x -= dv dt / 2, x' -= dv
+        # the ego's speed change dv over a frame, for a car keeping its own speed: x -= dv dt / 2, x' -= dv
         self._B = np.array([[-dt_s / 2], [-1.0], [0.0], [0.0]])
         # white acceleration: Q = q^2 [[dt^4/4, dt^3/2], [dt^3/2, dt^2]] per axis
         self._block = np.array([[dt_s ** 4 / 4, dt_s ** 3 / 2], [dt_s ** 3 / 2, dt_s ** 2]])
@@ -77,16 +77,16 @@ class NeighbourTracker:
              ) -> None:
         """One frame: predict every track, associate each rig's detections (``detections``: rig name -> its
         detections), make new tracks, keep the blind band's tracks and drop the lost ones. ``ego_speed_mps``: the
-        ego's speed over the ground [m/s]; its change since the last frame moves every track's relative speed (a
-        braking ego closes on a car it no longer sees more slowly), None: taken as unchanged."""
+        ego's speed over the ground [m/s]; its change since the last frame moves the relative speed of a track flagged
+        as cutting in (``_ego_input``), None: taken as unchanged."""
         window = (1 << self.recent_frames) - 1
-        # the ego's speed change over the frame, the prediction's control input [m/s]
+        # the ego's speed change over the frame [m/s]
         dv = 0.0 if ego_speed_mps is None or self._ego_speed is None else ego_speed_mps - self._ego_speed
         self._ego_speed = ego_speed_mps
         for t in self.tracks:
             q = self.cfg.manoeuvre_accel_noise_mps2 if self.manoeuvring(t) else self.cfg.lateral_accel_noise_mps2
             t.kf.Q[2:, 2:] = self._block * q ** 2
-            t.kf.predict(u=np.array([[dv]]), B=self._B)
+            t.kf.predict(u=np.array([[self._ego_input(t, dv)]]), B=self._B)
             t.camera, t.box_px = None, None
             t.seen_bits = (t.seen_bits << 1) & window
         self.width = width_m
@@ -94,6 +94,15 @@ class NeighbourTracker:
             self._associate(rig, dets)
         self._merge()
         self._keep_or_drop(width_m)
+
+    @staticmethod
+    def _ego_input(t: Track, dv_mps: float) -> float:
+        """The prediction's control input for track ``t`` when the ego's speed changed by ``dv_mps`` [m/s] over the
+        frame: ``dv_mps`` for a track flagged as cutting in, 0 for any other. The car cutting in is what the ego brakes
+        for and keeps its own speed over the ground, so a braking ego closes on it more slowly, and once it is too
+        near to be seen its gap would otherwise be predicted shut; the other neighbours mostly slow with the ego (it
+        brakes when the traffic does), and their relative speed is kept."""
+        return dv_mps if t.warning else 0.0
 
     def _merge(self) -> None:
         """Two tracks in one lane, each within the other's association gate, are one car tracked twice (far away its
