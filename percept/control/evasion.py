@@ -3,7 +3,8 @@ swerve into a free lane beside if there is one; else it is full braking's to han
 
 Braking falls short when the emergency-braking law's own demand, ``STOP_GAIN`` c² / (2 (g - margin)) for a gap g
 closing at c, exceeds the strongest deceleration a law may command (``MAX_BRAKE_MPS2``): the law would be clipped
-at its limit. A lane beside is free when it exists and MOBIL's safety test passes there (no track beside the ego,
+at its limit. A lane beside is free when it exists, is not barred by the lane-change law (one that opened beside the
+car lately may be an acceleration lane, whose end nothing marks) and MOBIL's safety test passes there (no track beside the ego,
 both gaps at least ``MobilConfig.min_time_gap_s``, the new follower braking no harder than ``safe_braking_mps2``);
 the side away from the vehicle cutting in is taken first. The law reads records only and decides; the lane-change
 law (``lane_change.py``) flies the swerve.
@@ -72,28 +73,31 @@ class Evasion(Controller):
         return STOP_GAIN * target.closing_mps ** 2 / (2 * room)
 
     def update(self, target: Target | None, path: EgoPath, neighbours: Neighbours | None,
-               speed_mps: float) -> tuple[int, EvasionDebug]:
+               speed_mps: float, barred: frozenset = frozenset()) -> tuple[int, EvasionDebug]:
         """The side to swerve to this frame (+1, -1; 0: none) and the debug record. target: the nearest target before
         any lane change (``nearest_target``); path: the ego path (which lanes exist beside); neighbours: the
-        neighbours record (None, or no view behind: no lane is known free); speed_mps: the ego's speed."""
+        neighbours record (None, or no view behind: no lane is known free); speed_mps: the ego's speed; barred: the
+        sides never swerved to (lanes that opened beside the car lately, which may be acceleration lanes whose end
+        nothing marks)."""
         need = self.needed(target)
         self.short = self.short + 1 if need is not None and need > MAX_BRAKE_MPS2 else 0
         if self.short < self.cfg.confirm_frames:
             self.acting = False
             return 0, EvasionDebug(need, self.short, 0, "braking suffices", None)
-        side = self._free_side(target, path, neighbours, speed_mps)
+        side = self._free_side(target, path, neighbours, speed_mps, barred)
         event = None if self.acting else EVASIVE_EVENTS[0 if side else 1]
         self.acting = True
         reason = f"swerve {'left' if side > 0 else 'right'}" if side else "no free lane: full braking"
         return side, EvasionDebug(need, self.short, side, reason, event)
 
-    def _free_side(self, target: Target, path: EgoPath, neighbours: Neighbours | None, speed_mps: float) -> int:
-        """The free lane beside (+1, -1; 0 none), the one away from a vehicle cutting in first."""
+    def _free_side(self, target: Target, path: EgoPath, neighbours: Neighbours | None, speed_mps: float,
+                   barred: frozenset) -> int:
+        """The free lane beside (+1, -1; 0 none) and not ``barred``, the one away from a vehicle cutting in first."""
         if neighbours is None or not neighbours.rear or not path.follows_lane:
             return 0
         cutter = neighbours.cutting_in() if target.source == "cut-in" else None
         order = (-cutter.lane, cutter.lane) if cutter is not None else (1, -1)
-        for side in order:
+        for side in (s for s in order if s not in barred):
             if judge(side, path.lane.lane_beside(side), neighbours, speed_mps, self.set_speed, self.mobil).safe:
                 return side
         return 0

@@ -129,7 +129,8 @@ class LaneChange(Controller):
             return None, LaneChangeDebug(self.phase, self.side, "no lane estimate", (), None, None)
         self._watch_edges(path.lane.index, path.lane.beside, speed_mps * dt)
         if self.phase is Phase.KEEP:
-            side, evasion = self.evasion.update(target, path, neighbours, speed_mps)
+            barred = frozenset(s for s in (1, -1) if self._new_lane(s, path.lane.lane_beside(s)))
+            side, evasion = self.evasion.update(target, path, neighbours, speed_mps, barred)
             if side:
                 return self._start(Phase.EVADE, side, path, self.cfg.evasion.duration_s, evasion.reason, evasion)
             ref, debug = self._keep(path, neighbours, speed_mps, dt)
@@ -172,10 +173,14 @@ class LaneChange(Controller):
             ago = self.edge_ago_m[side]
             self.edge_ago_m[side] = 0.0 if there is False else None if ago is None else ago + moved_m
 
+    def _new_lane(self, side: int, lane_there: bool | None) -> bool:
+        """Whether the lane on ``side`` opened less than ``new_lane_m`` back (its boundary was the road's edge)."""
+        ago = self.edge_ago_m[side]
+        return bool(lane_there) and ago is not None and ago < self.cfg.new_lane_m
+
     def _judge(self, side: int, lane_there: bool | None, neighbours: Neighbours, speed_mps: float) -> Judgement:
         """MOBIL's verdict on ``side``, or "new lane" for a lane that opened less than ``new_lane_m`` back."""
-        ago = self.edge_ago_m[side]
-        if lane_there and ago is not None and ago < self.cfg.new_lane_m:
+        if self._new_lane(side, lane_there):
             return Judgement(side, 0.0, 0.0, "new lane")
         return judge(side, lane_there, neighbours, speed_mps, self.set_speed, self.cfg.mobil, self.unseen_mps)
 
@@ -237,9 +242,12 @@ class LaneChange(Controller):
 
     def _loosely_safe(self, neighbours: Neighbours, speed_mps: float) -> bool:
         """Whether the target lane passes MOBIL's safety test with the commitment's looser bounds (``commit_gap_s``,
-        ``commit_braking_mps2``): a change past its gentle return goes on while it does."""
+        ``commit_braking_mps2``) on the estimates themselves, not shortened by their sigmas: a change past its gentle
+        return goes on while it does. A harsh return is a hazard of its own, for a threat the estimates show, not one
+        their uncertainty allows (a track just born 90 m behind, its speed uncertain by several m/s, had turned a
+        change back at 5 m/s²)."""
         c = self.cfg
-        loose = replace(c.mobil, min_time_gap_s=c.commit_gap_s, safe_braking_mps2=c.commit_braking_mps2)
+        loose = replace(c.mobil, min_time_gap_s=c.commit_gap_s, safe_braking_mps2=c.commit_braking_mps2, sigmas=0.0)
         return judge(self.side, True, neighbours, speed_mps, self.set_speed, loose).safe
 
     def _end(self, crossed: int) -> tuple[None, LaneChangeDebug]:

@@ -76,3 +76,15 @@ def test_the_lane_change_law_flies_the_swerve_at_once_and_fast():
     assert law.path.duration_s == EvasionConfig().duration_s
     # lane keeping may jerk the car as hard as the swerve asks
     assert all(d.ref.max_jerk_mps3 is None for d in dbgs[1:])
+
+
+@pytest.mark.parametrize("opened", [True, False])
+def test_no_swerve_into_a_lane_that_opened_beside_the_car_lately(opened):
+    # a lead closing at 14 m/s 14 m ahead, no lane on the left; on the right a lane that has just opened (an
+    # acceleration lane, whose end nothing marks: full braking) or one that was always there (a swerve into it)
+    law = LaneChange(30.0)
+    lead = vehicle(14.0, 14.0, "lead")
+    law.update(path(beside=(False, not opened)), around(), V, DT)
+    dbgs = [law.update(path(beside=(False, True)), around(), V, DT, lead)[1] for _ in range(3)]
+    events = [d.event for d in dbgs]
+    assert events == ([None, "full braking", None] if opened else [None, "swerve", None])

@@ -220,6 +220,17 @@ def test_past_its_gentle_return_a_change_goes_on_while_the_target_lane_is_loosel
     assert dbgs[0].event is None and law.phase is Phase.CHANGE and dbgs[0].reason == "committed (follower brakes)"
 
 
+@pytest.mark.parametrize("x, rel, sigma_v, goes_on", [(-74.0, 4.0, 4.0, True), (-65.0, 6.0, 0.0, False)])
+def test_past_its_gentle_return_a_change_judges_its_commitment_on_the_estimates_not_their_sigmas(x, rel, sigma_v,
+                                                                                                goes_on):
+    law = _change_under_way(1.6)
+    # a follower 69 m back closing at 4 m/s would brake 2.5 m/s², within the commitment's 3, though its speed, just
+    # found, is uncertain by 4 m/s: the change goes on; one 60 m back closing at 6 m/s would brake over 3: it returns
+    closing = car(1, x, rel=rel, sigma_x=0.0, sigma_v=sigma_v, track_id=2)
+    dbgs, _ = run_law(law, 1, around(car(0, 35.0, rel=-6.0), closing))
+    assert (dbgs[0].event is None and law.phase is Phase.CHANGE) if goes_on else dbgs[0].event == "aborted"
+
+
 def test_past_its_gentle_return_a_change_still_returns_from_a_car_beside_keeping_inside_the_lane():
     law = _change_under_way(1.6)
     dbgs, _ = run_law(law, 1, around(car(0, 35.0, rel=-6.0), car(1, 1.0, rel=1.0, track_id=2)))
