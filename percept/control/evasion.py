@@ -2,12 +2,12 @@
 swerve into a free lane beside if there is one; else it is full braking's to handle.
 
 Braking falls short when the emergency-braking law's own demand, ``STOP_GAIN`` c² / (2 (g - margin)) for a gap g
-closing at c, exceeds the strongest deceleration a law may command (``MAX_BRAKE_MPS2``): the law would be clipped
-at its limit. A lane beside is free when it exists, is not barred by the lane-change law (one that opened beside the
-car lately may be an acceleration lane, whose end nothing marks) and MOBIL's safety test passes there (no track beside the ego,
-both gaps at least ``MobilConfig.min_time_gap_s``, the new follower braking no harder than ``safe_braking_mps2``);
-the side away from the vehicle cutting in is taken first. The law reads records only and decides; the lane-change
-law (``lane_change.py``) flies the swerve.
+closing at c, exceeds the strongest deceleration a law may command (``MAX_BRAKE_MPS2``): the law would be clipped at
+its limit. A lane beside is free when it exists, is not barred by the lane-change law (one that opened beside the car
+lately may be an acceleration lane, whose end nothing marks) and MOBIL's safety test passes there (no track beside the
+ego, both gaps at least ``MobilConfig.min_time_gap_s``, the new follower braking no harder than
+``safe_braking_mps2``); the side away from the vehicle cutting in is taken first. The law reads records only and
+decides; the lane-change law (``lane_change.py``) flies the swerve.
 """
 
 from __future__ import annotations
