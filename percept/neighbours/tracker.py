@@ -78,15 +78,16 @@ class NeighbourTracker:
         """One frame: predict every track, associate each rig's detections (``detections``: rig name -> its
         detections), make new tracks, keep the blind band's tracks and drop the lost ones. ``ego_speed_mps``: the
         ego's speed over the ground [m/s]; its change since the last frame moves the relative speed of a track flagged
-        as cutting in (``_ego_input``), None: taken as unchanged."""
+        as cutting in (``_takes_ego_input``), None: taken as unchanged."""
         window = (1 << self.recent_frames) - 1
         # the ego's speed change over the frame [m/s]
         dv = 0.0 if ego_speed_mps is None or self._ego_speed is None else ego_speed_mps - self._ego_speed
         self._ego_speed = ego_speed_mps
+        inputs = {True: np.array([[dv]]), False: np.zeros((1, 1))}  # made once a frame, not once a track
         for t in self.tracks:
             q = self.cfg.manoeuvre_accel_noise_mps2 if self.manoeuvring(t) else self.cfg.lateral_accel_noise_mps2
             t.kf.Q[2:, 2:] = self._block * q ** 2
-            t.kf.predict(u=np.array([[self._ego_input(t, dv)]]), B=self._B)
+            t.kf.predict(u=inputs[self._takes_ego_input(t)], B=self._B)
             t.camera, t.box_px = None, None
             t.seen_bits = (t.seen_bits << 1) & window
         self.width = width_m
@@ -96,13 +97,13 @@ class NeighbourTracker:
         self._keep_or_drop(width_m)
 
     @staticmethod
-    def _ego_input(t: Track, dv_mps: float) -> float:
-        """The prediction's control input for track ``t`` when the ego's speed changed by ``dv_mps`` [m/s] over the
-        frame: ``dv_mps`` for a track flagged as cutting in, 0 for any other. The car cutting in is what the ego brakes
+    def _takes_ego_input(t: Track) -> bool:
+        """Whether the ego's speed change over the frame is the prediction's control input for track ``t``: for a
+        track flagged as cutting in only. The car cutting in is what the ego brakes
         for and keeps its own speed over the ground, so a braking ego closes on it more slowly, and once it is too
         near to be seen its gap would otherwise be predicted shut; the other neighbours mostly slow with the ego (it
         brakes when the traffic does), and their relative speed is kept."""
-        return dv_mps if t.warning else 0.0
+        return t.warning
 
     def _merge(self) -> None:
         """Two tracks in one lane, each within the other's association gate, are one car tracked twice (far away its
