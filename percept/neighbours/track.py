@@ -62,6 +62,7 @@ class Track:
     misses: int = 0
     blind_s: float = 0.0  # how long it has been held in the blind band (0: not held) [s]
     takeover: int = 0  # detections in a row since a rig saw it again while it was held
+    held: tuple | None = None  # while a takeover is under way: (its filter as held unseen, predicted on; its lane)
     camera: str | None = None
     box_px: tuple | None = None
     confirmed: bool = False

@@ -11,6 +11,7 @@ the front rig to find is held the same way for a while.
 
 from __future__ import annotations
 
+from copy import deepcopy
 from itertools import combinations
 
 import numpy as np
@@ -87,7 +88,10 @@ class NeighbourTracker:
         for t in self.tracks:
             q = self.cfg.manoeuvre_accel_noise_mps2 if self.manoeuvring(t) else self.cfg.lateral_accel_noise_mps2
             t.kf.Q[2:, 2:] = self._block * q ** 2
-            t.kf.predict(u=inputs[self._takes_ego_input(t)], B=self._B)
+            u = inputs[self._takes_ego_input(t)]
+            t.kf.predict(u=u, B=self._B)
+            if t.held is not None:
+                t.held[0].predict(u=u, B=self._B)
             t.camera, t.box_px = None, None
             t.seen_bits = (t.seen_bits << 1) & window
         self.width = width_m
@@ -139,6 +143,9 @@ class NeighbourTracker:
             used_t.add(i)
             used_d.add(j)
             t, d = self.tracks[i], dets[j]
+            if t.blind_s > 0 and t.takeover == 0 and not t.seen_bits:
+                # a track held unseen for recent_s kept aside: a takeover that fails is undone (_hold_in_band)
+                t.held = (deepcopy(t.kf), t.lane)
             R = self._noise(t, d)
             self._count_veer(t, d.lat_m - t.lat, float(t.kf.P[2, 2]) + R[1, 1])
             t.kf.update(np.array([[d.x_m], [d.lat_m]]), R=R)
@@ -148,7 +155,7 @@ class NeighbourTracker:
             # something else does not carry it off (the next unseen frame puts it back in the band)
             t.takeover = t.takeover + 1 if t.blind_s > 0 else 0
             if t.takeover >= c.confirm_hits:
-                t.blind_s, t.takeover = 0.0, 0
+                t.blind_s, t.takeover, t.held = 0.0, 0, None
             t.camera, t.box_px, t.cut_off = rig, d.box_px, d.cut_off
             # its lane: round(l / w)
             lane = int(round(t.lat / self.width))
@@ -215,7 +222,13 @@ class NeighbourTracker:
         flagged as cutting in (a car pulling out close by, in rain missed on several frames in a row, goes on moving
         over), or manoeuvres and a rig saw it within ``lateral_coast_s``, nothing says it moves sideways, so it keeps
         its lateral place; if its prediction reaches the band's edge with no rig seeing it come out, it has matched the
-        ego's speed somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes."""
+        ego's speed somewhere in the band: it stops there, anywhere in the band as far as its uncertainty goes. A
+        takeover of a track held unseen for ``recent_s`` that is begun and not confirmed is undone: the detections that
+        began it may have been of something else (a stray match at a rig's edge) and must not move the track across its
+        lane or into the next (one missed on a frame or two, as in rain, takes its detections as they come)."""
+        if t.held is not None:
+            t.kf, t.lane = t.held
+            t.held = None
         if not (t.warning or self.manoeuvring(t) and t.seen_bits & self._coast_bits):
             t.kf.x[3, 0] = 0.0
         t.takeover = 0
