@@ -239,11 +239,13 @@ class NeighbourTracker:
         t.blind_s += self.dt
 
     def _near_ahead(self, t: Track, width_m: float) -> bool:
-        """Whether an unseen track is an established one ahead in the ego lane nearer than ``near_ahead_m``, held
-        there for less than ``near_hold_s``."""
+        """Whether an unseen track is an established one ahead in the ego lane nearer than ``near_ahead_m``, or held
+        already (its prediction reaching ``near_ahead_m`` stops there, as at the blind band's edge: a car pulling away
+        too near to be found reads its gap long and would otherwise be dropped while still too near), held there for
+        less than ``near_hold_s``."""
         c = self.cfg
-        return (t.hits >= c.min_settled and abs(t.lat) < 0.5 * width_m and 0.0 < t.x <= c.near_ahead_m
-                and t.blind_s < c.near_hold_s)
+        near = 0.0 < t.x <= c.near_ahead_m or t.blind_s > 0
+        return t.hits >= c.min_settled and abs(t.lat) < 0.5 * width_m and near and t.blind_s < c.near_hold_s
 
     def _heading_for_band(self, t: Track) -> bool:
         """Whether a track lies in the band's fringe (``_in_fringe``) and moves towards the band."""

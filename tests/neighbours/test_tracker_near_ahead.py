@@ -68,3 +68,20 @@ def test_a_car_behind_in_the_ego_lane_is_not_held_ahead():
         assert t.x < 0.0 and t.blind_s == 0.0
     tr.step({}, W)
     assert tr.tracks == []
+
+
+def test_a_held_car_pulling_away_stays_held_at_the_near_range_edge():
+    # a car pulling away at 1.5 m/s, found up to 7.8 m ahead, then unseen: its prediction reaches near_ahead_m and
+    # stops there, held for near_hold_s like a car closing, not dropped after max_misses
+    cfg = TrackerConfig()
+    tr = NeighbourTracker(DT, cfg)
+    for k in range(20):
+        tr.step({"front": [det(5.9 + 1.5 * k * DT, 0.5)]}, W)
+    held = 0
+    while tr.tracks:
+        tr.step({}, W)
+        if tr.tracks:
+            (t,) = tr.tracks
+            assert t.x <= cfg.near_ahead_m + 1.5 * DT * cfg.max_misses
+            held += 1
+    assert held == pytest.approx(cfg.near_hold_s / DT + cfg.max_misses, abs=1)
