@@ -227,7 +227,8 @@ class NeighbourTracker:
         began it may have been of something else (a stray match at a rig's edge) and must not move the track across its
         lane or into the next (one missed on a frame or two, as in rain, takes its detections as they come)."""
         if t.held is not None:
-            t.kf, t.lane = t.held
+            # unseen since it was kept aside, but for the detections undone
+            t.kf, t.lane, t.seen_bits = *t.held, 0
             t.held = None
         if not (t.warning or self.manoeuvring(t) and t.seen_bits & self._coast_bits):
             t.kf.x[3, 0] = 0.0
