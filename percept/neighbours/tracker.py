@@ -245,7 +245,7 @@ class NeighbourTracker:
         too near to be found reads its gap long and would otherwise be dropped while still too near), held there for
         less than ``near_hold_s``."""
         c = self.cfg
-        near = 0.0 < t.x <= c.near_ahead_m or t.blind_s > 0
+        near = 0.0 < t.x and (t.x <= c.near_ahead_m or t.blind_s > 0)
         return t.hits >= c.min_settled and abs(t.lat) < 0.5 * width_m and near and t.blind_s < c.near_hold_s
 
     def _heading_for_band(self, t: Track) -> bool:

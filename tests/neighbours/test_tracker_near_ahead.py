@@ -85,3 +85,20 @@ def test_a_held_car_pulling_away_stays_held_at_the_near_range_edge():
             assert t.x <= cfg.near_ahead_m + 1.5 * DT * cfg.max_misses
             held += 1
     assert held == pytest.approx(cfg.near_hold_s / DT + cfg.max_misses, abs=1)
+
+
+def test_a_car_held_beside_behind_the_ego_that_moves_into_its_lane_is_not_held_ahead():
+    # a car flagged as cutting in, held in the blind band 6 m behind the ego's centre, moves on into the ego lane
+    # unseen: it is not a car near ahead, and is not put ahead of the ego's bumper
+    cfg = TrackerConfig()
+    tr = NeighbourTracker(DT, cfg)
+    for k in range(30):
+        tr.step({"rear": [det(-16.0 + 3.0 * k * DT, -W)]}, W)
+    for _ in range(40):
+        tr.step({}, W)
+    (t,) = tr.tracks
+    assert t.blind_s > 0 and t.x < 0.0
+    t.warning = True
+    t.kf.x[2, 0], t.kf.x[3, 0] = -0.3, 0.0  # now in the ego lane
+    tr.step({}, W)
+    assert all(u.x < 0.0 for u in tr.tracks)
