@@ -69,6 +69,7 @@ class Detection:
     sigma_x_m: float  # 1-sigma of x_m from the disparity noise [m]
     cut_off: bool = False  # the image's side edge cuts the face off: its lateral centre is inferred from one edge
     sigma_lat_m: float = 0.0  # 1-sigma of lat_m from the face's edges' pixel noise at its range [m]
+    near_limit: bool = False  # the face is at the matcher's nearest depth: the car may be nearer than read
 
 
 @dataclass(frozen=True)

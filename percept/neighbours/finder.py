@@ -27,6 +27,10 @@ HIDDEN_SHARE = 0.5
 what the rest of a whole car's face would span, and more of it than on the other side [-]."""
 FULL_FACE_M = 1.6
 """A face at least this wide is seen whole [m]."""
+NEAR_LIMIT_MARGIN_M = 1.0
+"""A face read within this of the nearest camera depth matched is at the near limit: the parts of the car nearer than
+that depth go unmatched and those beyond are what is read, so the car may be nearer than read, by up to a couple of
+metres at night or in rain [m]."""
 EDGE_SIGMA_PX = 1.5
 """1-sigma of a whole face's edges in the image [px], so the lateral place of a face at range Z is uncertain by
 Z EDGE_SIGMA_PX / f (at night and in rain the lit or wet parts of a car, not its outline, bound its points: the
@@ -43,6 +47,7 @@ class RigFinder:
         self.fb = rig.camera.fx * rig.baseline_m
         self.cam = np.asarray(rig.camera_position(Side.LEFT), dtype=np.float32)
         self.cam_x = float(self.cam[0])
+        self.near_m = points.near_m
         self._pair: tuple[np.ndarray, np.ndarray] | None = None
         self._lane: LaneEstimate | None = None
 
@@ -55,7 +60,13 @@ class RigFinder:
                               self.rig.mount_height_m)
         found = [self.cut_off(d) for d in found]
         shadows = [self.shadow(d) for d in found]
-        return [self.lateral_sigma(self.occluded(d, shadows)) for d in found], pts
+        return [self.near_limit(self.lateral_sigma(self.occluded(d, shadows))) for d in found], pts
+
+    def near_limit(self, det: Detection) -> Detection:
+        """``det`` flagged ``near_limit`` when its face's camera depth is within ``NEAR_LIMIT_MARGIN_M`` of the nearest
+        matched (``PointsConfig.near_m``)."""
+        # camera depth along the lane: |x_face - x_cam|
+        return replace(det, near_limit=abs(det.face_x_m - self.cam_x) < self.near_m + NEAR_LIMIT_MARGIN_M)
 
     def shadow(self, det: Detection) -> tuple[float, float, float]:
         """(range of its face along the lane [m], least and greatest bearing [-]) of the corners of a detected car's
@@ -70,9 +81,9 @@ class RigFinder:
     def occluded(self, det: Detection, shadows: list[tuple[float, float, float]]) -> Detection:
         """``det`` with its lateral centre put half a car's width beyond its free edge when its face is narrower than
         a whole one and a nearer car (``shadows``: each detection's ``shadow``) hides, as the rig sees it, at least
-        ``HIDDEN_SHARE`` of what the rest of a whole car's face would span beyond its other edge, and more than beyond the free one (a car seen
-        past another shows only the part the nearer one leaves, and a dark face's points are only at its edges: the
-        middle of the part seen is off by up to half a car's width)."""
+        ``HIDDEN_SHARE`` of what the rest of a whole car's face would span beyond its other edge, and more than beyond
+        the free one (a car seen past another shows only the part the nearer one leaves, and a dark face's points are
+        only at its edges: the middle of the part seen is off by up to half a car's width)."""
         if det.cut_off or det.width_m >= FULL_FACE_M:
             return det
         lo, hi = (self._bearing(det.face_x_m, det.lat_m + s * det.width_m / 2) for s in (-1, 1))

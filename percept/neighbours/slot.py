@@ -106,12 +106,12 @@ class NeighbourSlot:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside, or in the ego lane
         after a warning; ``ground_mps``: its along-lane speed over the ground [m/s]. It starts when the track, going
         at least ``min_ground_speed_mps``, measured this frame (a face cut off by the image's edge counts: a car
-        pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves towards the ego lane faster
-        than both ``min_lateral_speed_mps`` and ``speed_sigmas`` as a rig measures it, has left its lane's centre
-        towards it by ``min_shift_m`` (settled in its lane) or ``through_shift_m`` (not settled) and will reach the
-        boundary within ``horizon_s``; it
-        holds while the car stays shifted that way and does not move back (a merging car may pause on the line), and
-        once it is in the ego lane (time to crossing 0)."""
+        pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves towards the ego lane
+        faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` of that speed's estimate (or than the former
+        alone while its filter's innovations say it manoeuvres that way: ``NeighbourTracker.manoeuvring``), has left
+        its lane's centre towards it by ``min_shift_m`` (settled in its lane) or ``through_shift_m`` (not settled) and
+        will reach the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move
+        back (a merging car may pause on the line), and once it is in the ego lane (time to crossing 0)."""
         c = self.cfg
         if lane == 0:  # flagged on its way in: it stays a target while it is tracked in the ego lane
             return True, 0.0
@@ -122,10 +122,13 @@ class NeighbourSlot:
             holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
         else:
             settled = t.settled >= self.tracker.cfg.min_settled
+            # a manoeuvre towards the ego lane (a run of innovations that way: -sign(l) veer > 0) already tells a
+            # move from noise, and its larger process noise widens sig_vl just as the car starts over
+            veering = self.tracker.manoeuvring(t) and -math.copysign(1.0, lat) * t.veer > 0
             holds = (t.camera is not None and t.seen >= c.min_seen_share * self.tracker.recent_frames
                      and ground_mps >= c.min_ground_speed_mps
                      and shift >= (c.min_shift_m if settled else c.through_shift_m)
-                     and toward > max(c.min_lateral_speed_mps, c.speed_sigmas * sig_vl))
+                     and toward > max(c.min_lateral_speed_mps, 0.0 if veering else c.speed_sigmas * sig_vl))
         if not holds:
             return False, None
         # its centre reaches the boundary |l| = w/2 after t = (|l| - w/2) / max(-sign(l) l', v_min)

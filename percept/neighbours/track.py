@@ -17,6 +17,10 @@ class TrackerConfig:
     manoeuvre_sigmas: float = 1.0  # a lateral innovation beyond this many sigmas ...
     manoeuvre_frames: int = 2  # ... of one sign this many detections in a row starts a manoeuvre, which lasts
     # until an innovation of that sign falls under it [-]
+    near_limit_sigma_m: float = 2.0  # the along-lane 1-sigma of a face at the matcher's near limit, or of a sliver
+    # within near_sliver_m, read farther away than its track: it bounds the car's range from above only (a car nearer
+    # is read at that limit; a sliver near by is a part of a car, whose face may be nearer) [m]
+    near_sliver_m: float = 15.0  # a sliver nearer than this along the lane is read as such a bound [m]
     lateral_sigma_m: float = 0.12  # a detection's lateral position noise near by (1-sigma), added in quadrature to
     # the detection's own range-dependent sigma_lat_m [m]
     outlier_sigmas: float = 3.0  # a lateral innovation beyond this many sigmas is down-weighted to this size [-]
