@@ -221,7 +221,7 @@ class NeighbourTracker:
             var_l = max(var_l, (nu / k) ** 2 - float(t.kf.P[2, 2]))
         var_x = max(d.sigma_x_m, 0.05) ** 2
         one_sided = d.near_limit or self._sliver(d) and abs(d.x_m) < c.near_sliver_m
-        # ... read farther from the ego than the track: (x_d - x) sign(x_d) > 0
+        # such a reading farther from the ego than the track, (x_d - x) sign(x_d) > 0, bounds its range from above only
         if one_sided and (d.x_m - t.x) * np.sign(d.x_m) > 0:
             var_x = max(var_x, c.near_limit_sigma_m ** 2)
         return np.diag([var_x, var_l])
