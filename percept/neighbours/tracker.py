@@ -207,9 +207,7 @@ class NeighbourTracker:
         latter widened so that an innovation beyond ``outlier_sigmas`` counts as that many sigmas (Huber's weighting):
         a face that briefly takes in a car's side, or loses a lit part of its rear, jumps sideways by a metre; the
         along-lane one of a face at the near limit (``Detection.near_limit``), or of a sliver within ``near_sliver_m``,
-        read farther away than the track widened to ``near_limit_sigma_m`` (a one-sided measurement: the car is there
-        or nearer; at night and in rain a car close by is matched on its lit or wet parts, a metre or more beyond its
-        face)."""
+        read farther away than the track widened to ``near_limit_sigma_m`` (the car is there or nearer)."""
         c = self.cfg
         # sigma_l^2 = sigma_0^2 + sigma_d^2; innovation variance S_l = P_ll + sigma_l^2
         var_l = c.lateral_sigma_m ** 2 + d.sigma_lat_m ** 2
@@ -220,9 +218,8 @@ class NeighbourTracker:
             # widen R_l until nu = k sqrt(P_ll + R_l)
             var_l = max(var_l, (nu / k) ** 2 - float(t.kf.P[2, 2]))
         var_x = max(d.sigma_x_m, 0.05) ** 2
-        one_sided = d.near_limit or self._sliver(d) and abs(d.x_m) < c.near_sliver_m
         # such a reading farther from the ego than the track, (x_d - x) sign(x_d) > 0, bounds its range from above only
-        if one_sided and (d.x_m - t.x) * np.sign(d.x_m) > 0:
+        if (d.near_limit or self._sliver(d) and abs(d.x_m) < c.near_sliver_m) and (d.x_m - t.x) * np.sign(d.x_m) > 0:
             var_x = max(var_x, c.near_limit_sigma_m ** 2)
         return np.diag([var_x, var_l])
 
