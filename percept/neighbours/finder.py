@@ -60,13 +60,7 @@ class RigFinder:
                               self.rig.mount_height_m)
         found = [self.cut_off(d) for d in found]
         shadows = [self.shadow(d) for d in found]
-        return [self.near_limit(self.lateral_sigma(self.occluded(d, shadows))) for d in found], pts
-
-    def near_limit(self, det: Detection) -> Detection:
-        """``det`` flagged ``near_limit`` when its face's camera depth is within ``NEAR_LIMIT_MARGIN_M`` of the nearest
-        matched (``PointsConfig.near_m``)."""
-        # camera depth along the lane: |x_face - x_cam|
-        return replace(det, near_limit=abs(det.face_x_m - self.cam_x) < self.near_m + NEAR_LIMIT_MARGIN_M)
+        return [self.at_depth(self.occluded(d, shadows)) for d in found], pts
 
     def shadow(self, det: Detection) -> tuple[float, float, float]:
         """(range of its face along the lane [m], least and greatest bearing [-]) of the corners of a detected car's
@@ -115,16 +109,17 @@ class RigFinder:
         seen = det.lat_m - missing * det.width_m / 2
         return seen + missing * VEHICLE_WIDTH_M / 2
 
-    def lateral_sigma(self, det: Detection) -> Detection:
-        """``det`` with the lateral 1-sigma of its centre: its face's edges' pixel noise at its range and, for a face
-        seen only in part and not cut off by the image's edge, half the width it lacks of a whole car's (the part
-        seen may be either side of the car, or its middle)."""
-        # sigma_l = Z sigma_u / f, Z the face's range from the camera along the lane
+    def at_depth(self, det: Detection) -> Detection:
+        """``det`` with what its face's camera depth Z says: the lateral 1-sigma of its centre (its face's edges' pixel
+        noise at Z and, for a face seen only in part and not cut off by the image's edge, half the width it lacks of a
+        whole car's: the part seen may be either side of the car, or its middle), and ``near_limit`` when Z is within
+        ``NEAR_LIMIT_MARGIN_M`` of the nearest depth matched (``PointsConfig.near_m``)."""
+        # Z = |x_face - x_cam| along the lane; sigma_l = Z sigma_u / f
         z = abs(det.face_x_m - self.cam_x)
         edges = z * EDGE_SIGMA_PX / self.rig.camera.fx
         # (W_v - w) / 2 for a face of width w < W_v, in quadrature
         lacks = 0.0 if det.cut_off else max(VEHICLE_WIDTH_M - det.width_m, 0.0) / 2
-        return replace(det, sigma_lat_m=float(np.hypot(edges, lacks)))
+        return replace(det, sigma_lat_m=float(np.hypot(edges, lacks)), near_limit=z < self.near_m + NEAR_LIMIT_MARGIN_M)
 
     def cut_off(self, det: Detection) -> Detection:
         """``det`` marked as cut off when it reaches the image's side edge (a car coming alongside); when its face is

@@ -135,14 +135,14 @@ def test_a_face_far_away_is_placed_less_surely_across_the_lane():
     rig = StereoRig()
     finder = RigFinder(rig, 3.0, 90.0)
     whole = lambda x: replace(det(x, W), width_m=VEHICLE_WIDTH_M)
-    near, far = finder.lateral_sigma(whole(12.5)), finder.lateral_sigma(whole(62.5))
+    near, far = finder.at_depth(whole(12.5)), finder.at_depth(whole(62.5))
     # sigma_l = Z sigma_u / f, Z the face's range from the camera
     cam_x = float(rig.camera_position()[0])
     edges = (60.0 - cam_x) * EDGE_SIGMA_PX / rig.camera.fx
     assert far.sigma_lat_m == pytest.approx(edges)
     assert near.sigma_lat_m < far.sigma_lat_m
     # a face seen over half its width: the half it lacks, (W_v - w) / 2, in quadrature
-    half = finder.lateral_sigma(replace(det(62.5, W), width_m=VEHICLE_WIDTH_M / 2))
+    half = finder.at_depth(replace(det(62.5, W), width_m=VEHICLE_WIDTH_M / 2))
     assert half.sigma_lat_m == pytest.approx(np.hypot(edges, VEHICLE_WIDTH_M / 4))
 
 

@@ -12,6 +12,9 @@ from percept.sensors import StereoRig
 
 from .test_tracker import DT, det
 
+TRUE_X = 12.0 - 3.0 * 29 * DT
+"""The car's centre on the last frame of ``_closing`` [m]."""
+
 
 def _closing(reading) -> NeighbourTracker:
     """A tracker following a car in the ego lane from 12 m, closing at 3 m/s for 2 s to 6 m, whose detections over
@@ -31,12 +34,11 @@ def _long(x: float, **flags):
 @pytest.mark.parametrize("flags", [{"near_limit": True}, {"width_m": 0.4}], ids=["near-limit", "sliver"])
 def test_a_car_read_too_far_at_the_near_limit_or_as_a_sliver_close_by_stays_near(flags):
     (t,) = _closing(lambda x: _long(x, **flags)).tracks
-    true_x = 12.0 - 3.0 * 29 * DT
     # a second of readings 2 m long moves it by under a third of that ...
-    assert abs(t.x - true_x) < 2.0 / 3
+    assert abs(t.x - TRUE_X) < 2.0 / 3
     # ... while a whole face read as long drags the track most of the way
     (plain,) = _closing(_long).tracks
-    assert plain.x - true_x > 1.5
+    assert plain.x - TRUE_X > 1.5
 
 
 def test_a_sliver_farther_away_is_taken_as_it_is():
@@ -52,8 +54,7 @@ def test_a_sliver_farther_away_is_taken_as_it_is():
 
 def test_a_near_limit_face_nearer_than_the_track_pulls_it_in():
     (t,) = _closing(lambda x: replace(det(x - 1.0, 0.0, sigma=0.03), near_limit=True)).tracks
-    true_x = 12.0 - 3.0 * 29 * DT
-    assert t.x < true_x - 0.7
+    assert t.x < TRUE_X - 0.7
 
 
 def test_the_finder_flags_faces_at_its_nearest_depth():
@@ -62,6 +63,6 @@ def test_the_finder_flags_faces_at_its_nearest_depth():
     cam_x = float(rig.camera_position()[0])
     # camera depth of the face = face_x - cam_x; the limit is near_m + NEAR_LIMIT_MARGIN_M
     limit = cam_x + PointsConfig().near_m + NEAR_LIMIT_MARGIN_M
-    at = finder.near_limit(replace(det(0.0, 0.0), face_x_m=limit - 0.1))
-    beyond = finder.near_limit(replace(det(0.0, 0.0), face_x_m=limit + 0.1))
+    at = finder.at_depth(replace(det(0.0, 0.0), face_x_m=limit - 0.1))
+    beyond = finder.at_depth(replace(det(0.0, 0.0), face_x_m=limit + 0.1))
     assert at.near_limit and not beyond.near_limit
