@@ -47,6 +47,8 @@ class NeighbourConfig:
     # things matched by chance, such as posts, strung into one track: it is not reported [m/s]
     min_ground_speed_mps: float = 5.0  # a cut-in is a vehicle going along the road: anything slower there (a person
     # crossing, whom the pedestrian task watches) is not flagged [m/s]
+    veer_shift_sigmas: float = 3.0  # a manoeuvre stands in for the lateral speed's significance only once the car
+    # has left its lane's centre by this many sigmas of its lateral place (far away a face's place wanders in runs) [-]
     through_shift_m: float = 0.7  # a track not settled in its lane (moving over from the lane beyond, or a ramp's
     # car) cuts in once it is this far past its lane's centre towards the ego lane, still moving: one that settles
     # in its lane stops short of that [m]
@@ -108,7 +110,8 @@ class NeighbourSlot:
         at least ``min_ground_speed_mps``, measured this frame (a face cut off by the image's edge counts: a car
         pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves towards the ego lane
         faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` of that speed's estimate (or than the former
-        alone while its filter's innovations say it manoeuvres that way: ``NeighbourTracker.manoeuvring``), has left
+        alone while its filter's innovations say it manoeuvres that way, ``NeighbourTracker.manoeuvring``, and it is
+        ``veer_shift_sigmas`` of its lateral place off its lane's centre towards the ego lane), has left
         its lane's centre towards it by ``min_shift_m`` (settled in its lane) or ``through_shift_m`` (not settled) and
         will reach the boundary within ``horizon_s``; it holds while the car stays shifted that way and does not move
         back (a merging car may pause on the line), and once it is in the ego lane (time to crossing 0)."""
@@ -123,8 +126,10 @@ class NeighbourSlot:
         else:
             settled = t.settled >= self.tracker.cfg.min_settled
             # a manoeuvre towards the ego lane (a run of innovations that way: -sign(l) veer > 0) already tells a
-            # move from noise, and its larger process noise widens sig_vl just as the car starts over
-            veering = self.tracker.manoeuvring(t) and -math.copysign(1.0, lat) * t.veer > 0
+            # move from noise, and its larger process noise widens sig_vl just as the car starts over; it counts once
+            # the car is off its lane's centre beyond its place's noise: shift > k sqrt(P_ll)
+            veering = (self.tracker.manoeuvring(t) and -math.copysign(1.0, lat) * t.veer > 0
+                       and shift > c.veer_shift_sigmas * math.sqrt(max(float(t.kf.P[2, 2]), 0.0)))
             holds = (t.camera is not None and t.seen >= c.min_seen_share * self.tracker.recent_frames
                      and ground_mps >= c.min_ground_speed_mps
                      and shift >= (c.min_shift_m if settled else c.through_shift_m)

@@ -54,3 +54,25 @@ def test_a_car_whose_face_jitters_across_its_lane_is_never_flagged():
     for _ in range(int(60 / DT)):
         nb, _ = slot.step(FRONT_ONLY, {EgoPath: EgoPath.straight(25.0)})
         assert nb.cutting_in() is None
+
+
+def _far_veer(sigma_lat_m: float) -> bool:
+    """Whether a car 69 m ahead in the left lane is flagged when its filter reads it 0.40 m off its lane's centre
+    towards the ego lane at 0.66 m/s (1-sigma 0.40 m/s), after three lateral innovations that way in a row, with its
+    lateral place known to ``sigma_lat_m`` [m]."""
+    slot = NeighbourSlot(StereoRig(), None, DT)
+    slot.front = _FakeFinder([det(69.0, W) for _ in range(30)])
+    for _ in range(30):
+        slot.step(FRONT_ONLY, {EgoPath: EgoPath.straight(25.0)})
+    (t,) = slot.tracker.tracks
+    t.kf.x[2, 0], t.kf.x[3, 0], t.kf.P[2, 2] = W - 0.40, -0.66, sigma_lat_m**2
+    t.veer = -slot.tracker.cfg.manoeuvre_frames - 1
+    assert slot.tracker.manoeuvring(t)
+    cut_in, _ = slot._intent(t, t.lat, -0.66, 1, W, 0.40, 25.0)
+    return cut_in
+
+
+def test_a_far_manoeuvre_counts_only_once_the_car_has_left_its_lane_centre_beyond_its_place_uncertainty():
+    # 0.40 m is within three sigma of a place known to 0.15 m (a far face in rain), beyond three of one known to 0.10 m
+    assert not _far_veer(0.15)
+    assert _far_veer(0.10)
