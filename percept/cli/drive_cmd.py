@@ -22,7 +22,7 @@ def drive(
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
     rear: opt.Rear = None,
-    lane_changes: opt.LaneChanges = "off",
+    lane_changes: opt.LaneChanges = "on",
     record: Annotated[Optional[Path], typer.Option(
         "--record", dir_okay=False, help="Rerun recording path (default runs/<scenario>-<condition>-<seed>.rrd); "
                                          "an interrupted run is kept beside it as RUN.partial.rrd.")] = None,

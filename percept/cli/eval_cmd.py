@@ -35,7 +35,7 @@ def eval_(
     detector: opt.Detector = "sim",
     privileged: opt.Privileged = False,
     rear: opt.Rear = None,
-    lane_changes: opt.LaneChanges = "off",
+    lane_changes: opt.LaneChanges = "on",
     ego: Annotated[str, typer.Option("--ego", help="Who drives: percept (its agent on its slots) or mobil "
                                                    "(highway-env's IDM car changing lanes by MOBIL in the ego's place, "
                                                    "on truth: the anchor for progress).")] = "percept",
@@ -76,7 +76,7 @@ def eval_(
             _strict(summary)
 
 
-def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources, rear=None, lane_changes=False,
+def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources, rear=None, lane_changes=True,
           ego="percept"):
     """The checked options as (EvalPlan, Engine), the model file included; one-line exit 2 otherwise."""
     from percept.evaluate.plan import Engine, EvalPlan, parse_seeds

@@ -31,7 +31,8 @@ Rear = Annotated[Optional[bool], typer.Option("--rear/--no-rear", help="The rear
                                               "bumper, on or off (default: on where the scenario's traffic changes "
                                               "lanes).", show_default=False)]
 LaneChanges = Annotated[str, typer.Option("--lane-changes", help="on: the car changes lanes when MOBIL on what it "
-                                          "sees favours it and it is safe; off: it keeps its lane.")]
+                                          "sees favours it and it is safe, and swerves into a free lane when braking "
+                                          "alone falls short (never without the rear rig); off: it keeps its lane.")]
 
 
 def lane_changes_on(value: str) -> bool:

@@ -27,8 +27,8 @@ class DriveConfig:
     # default (on where its traffic changes lanes, or as ``world.rear_rig`` says); resolved to True or False, and
     # ``world.rear_rig`` set to match
     rear: bool | None = None
-    lane_changes: bool = False  # the car changes lanes when MOBIL favours it (control.LaneChange); False: it keeps
-    # its lane
+    lane_changes: bool = True  # the car changes lanes when MOBIL favours it, and swerves into a free lane when braking
+    # alone falls short (control.LaneChange; without a view behind it never does either); False: it keeps its lane
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "world", with_rear(self.world, self.rear))

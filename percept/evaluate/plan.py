@@ -76,7 +76,7 @@ class EvalPlan:
     detector: str = "sim"  # people model of the vision pedestrian slot
     default: Source = Source.VISION  # the source of a task not in slots (as in DriveConfig)
     rear: bool | None = None  # the rear stereo rig: True on, False off, None each scenario's default (DriveConfig.rear)
-    lane_changes: bool = False  # the car changes lanes (DriveConfig.lane_changes)
+    lane_changes: bool = True  # the car changes lanes (DriveConfig.lane_changes)
     ego: str = "percept"  # who drives: "percept" (its agent) or "mobil" (highway-env's IDM with MOBIL lane changes in
     # the ego's place, every slot privileged: the anchor for progress)
 

@@ -59,8 +59,8 @@ def reproduce_command(run: dict, settings: dict) -> str:
         cmd.append(f"--detector {settings['detector']}")
     if settings.get("rear") is not None:
         cmd.append("--rear" if settings["rear"] else "--no-rear")
-    if settings.get("lane_changes"):
-        cmd.append("--lane-changes on")
+    if not settings.get("lane_changes", False):  # on by default; a batch that predates the option kept its lane
+        cmd.append("--lane-changes off")
     if settings.get("ego", "percept") != "percept":  # another driver: only evaluation puts it in the ego's place
         cmd = [f"percept eval --ego {settings['ego']}", f"--scenario {run['scenario']}", f"--seeds {run['seed']}",
                f"--condition {run['condition']}"] + cmd[4:]

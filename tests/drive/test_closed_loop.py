@@ -6,16 +6,17 @@ from percept.drive import DriveConfig, run_drive
 from percept.sims import WorldConfig
 
 
-def drive(scenario, seed, duration=None, **kw):
+def drive(scenario, seed, duration=None, lane_changes=True, **kw):
     return run_drive(DriveConfig(WorldConfig(scenario, seed, scenery=False), duration_s=duration, sources=kw,
-                                 default="privileged"),
+                                 default="privileged", lane_changes=lane_changes),
                      render=False)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
 @pytest.mark.slow
 def test_highway_follows_at_the_set_time_gap(seed):
-    r = drive("highway", seed, duration=40.0)
+    # kept in its lane behind the lead: with lane changes on, the privileged planner overtakes it
+    r = drive("highway", seed, duration=40.0, lane_changes=False)
     assert r["collisions"] == 0 and r["lane_departures"] == 0
     lon = r["longitudinal"]
     assert lon["time_gap_steady_s"] == pytest.approx(lon["time_gap_setting_s"], abs=0.2)

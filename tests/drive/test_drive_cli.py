@@ -32,6 +32,7 @@ def test_drive_records_a_valid_rrd_and_writes_the_json(tmp_path):
     assert d["timing_ms"]["render"] > 0
     # every slot sees by default, and each one's stage is timed
     assert d["slots"] == {t.name: "vision" for t in TASKS}
+    assert d["lane_changes_on"]  # the lane-change law runs by default
     assert all(d["timing_ms"][t.name] > 0 for t in TASKS)
     assert rrd.exists() and not (tmp_path / "run.rrd.part").exists()
     # a finished recording passes Rerun's own check as it is, footer included

@@ -15,7 +15,7 @@ from percept.evaluate.report import (listed_runs, metric_rows, reproduce_command
                                   write_reports)
 
 runner = CliRunner()
-SETTINGS = {"percept": "0.1.0", "duration_s": 12.0, "detector": None,
+SETTINGS = {"percept": "0.1.0", "duration_s": 12.0, "detector": None, "lane_changes": True,
             "slots": {"lanes": "vision", "longitudinal": "privileged", "pedestrians": "privileged",
                       "odometry": "privileged"}}
 
@@ -64,6 +64,10 @@ def test_unsafe_runs_come_with_the_command_that_reproduces_them():
     assert reproduce_command(bad[0][0], vision).endswith("--condition clear --duration 12 --detector inria")
     assert reproduce_command(bad[0][0], {**vision, "rear": True}).endswith("--detector inria --rear")
     assert reproduce_command(bad[0][0], {**SETTINGS, "rear": False}).endswith("--duration 12 --no-rear")
+    # lane changes are on by default; a batch that kept its lane, or predates the option, says so
+    assert reproduce_command(bad[0][0], {**SETTINGS, "lane_changes": False}).endswith("--lane-changes off")
+    legacy = {k: v for k, v in SETTINGS.items() if k != "lane_changes"}
+    assert reproduce_command(bad[0][0], legacy).endswith("--lane-changes off")
 
 
 def test_stops_for_no_one_are_listed_and_summed_but_do_not_fail_strict(tmp_path):
