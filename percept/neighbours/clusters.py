@@ -19,7 +19,7 @@ import numpy as np
 from percept.sensors import LaneEstimate
 
 from .points import StandingPoints
-from .quantiles import quantiles
+from .quantiles import median, quantiles
 
 VEHICLE_WIDTH_M = 2.0
 """The width assumed for every vehicle (highway-env's Vehicle.WIDTH): where only its side, or one edge of its face,
@@ -204,9 +204,10 @@ def _side_view(pts: StandingPoints, idx: np.ndarray, x: np.ndarray, lat: np.ndar
     """A car in a lane beside seen only along its side (coming alongside, where the image's edge cuts its face off):
     most of the group's points lie on one line along the lane. Its centre is half a car's width beyond that line,
     away from the ego; its along-lane place is the side's, with little weight. None for any other group."""
-    mid = float(np.median(lat))
-    if (abs(mid) <= 0.5 * width or np.min(np.abs(x)) > cfg.side_reach_m
-            or np.mean(np.abs(lat - mid) <= cfg.side_band_m) < cfg.side_share):
+    if np.min(np.abs(x)) > cfg.side_reach_m:  # the cheap test first: most groups are far
+        return None
+    mid = float(median(lat))
+    if abs(mid) <= 0.5 * width or np.mean(np.abs(lat - mid) <= cfg.side_band_m) < cfg.side_share:
         return None
     on_side = np.abs(lat - mid) <= cfg.side_band_m
     measured = face_range(pts, idx[on_side], idx[on_side])

@@ -11,7 +11,7 @@ from percept.sensors import LaneEstimate, Side, StereoRig
 
 from .clusters import VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ClusterConfig, Detection, Face, find_vehicles, lane_coordinates
 from .points import BandStereo, PointsConfig, StandingPoints
-from .quantiles import quantiles
+from .quantiles import median, quantiles
 from .refine import refine_face
 
 
@@ -145,7 +145,7 @@ class RigFinder:
         """The face of points ``idx`` measured at its refined disparity: its along-lane position and 1-sigma, and the
         lateral extent of the points of its ``group`` at that disparity, each moved along its ray to the refined
         range (a point's own block-matching disparity puts a car beside a few tenths of a metre off at 50 m)."""
-        d0 = float(np.median(pts.d[idx]))
+        d0 = float(median(pts.d[idx]))
         tol = min(1.0, 0.05 * d0)
         # every matched pixel of the face's box within 5 % (at most a pixel) of its median disparity
         box = (int(pts.u[idx].min()), int(pts.v[idx].min()), int(pts.u[idx].max()) + 1, int(pts.v[idx].max()) + 1)
@@ -158,7 +158,7 @@ class RigFinder:
         x = self.cam_x + (pts.x[idx] - self.cam_x) * (pts.d[idx] / d)
         # sigma_Z = Z^2 sigma_d / (f b)
         z = self.fb / d
-        return Face(float(np.median(x)), float(z * z * sigma_d / self.fb), self._lateral_extent(pts, group, d0, tol, d))
+        return Face(float(median(x)), float(z * z * sigma_d / self.fb), self._lateral_extent(pts, group, d0, tol, d))
 
     def _lateral_extent(self, pts: StandingPoints, group: np.ndarray, d0: float, tol: float, d: float
                         ) -> tuple[float, float] | None:

@@ -24,3 +24,16 @@ def quantiles(values: np.ndarray, q):
     if scalar:
         return b - diff * (1 - g) if g >= 0.5 else a + diff * g
     return np.where(g >= 0.5, b - diff * (1 - g), a + diff * g)
+
+
+def median(values: np.ndarray):
+    """``np.median(values)``, bit for bit and of the same dtype, for a 1-D array ``values`` (n >= 1) without NaNs: one
+    partition and the mean of the middle one or two, where numpy's general reduction costs several times as much on
+    a face's few hundred points."""
+    n = len(values)
+    k = n // 2
+    if n % 2:
+        return np.partition(values, k)[k]
+    p = np.partition(values, (k - 1, k))
+    # the mean of the two middle order statistics, summed in the array's dtype as numpy's mean does
+    return (p[k - 1] + p[k]) / 2
