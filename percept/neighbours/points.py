@@ -75,6 +75,9 @@ class _Matcher:
             self.bm.setSpeckleWindowSize(self.speckle[0])
             self.bm.setSpeckleRange(self.speckle[1])
         self.disparity: np.ndarray | None = None  # the last map, int16 in 1/16 px of its resolution
+        # the full-resolution pixels one matched pixel stands for: offsets (du, dv), each (shrink^2,) [px]
+        du, dv = np.meshgrid(np.arange(shrink), np.arange(shrink))
+        self._block = (du.ravel()[None, :], dv.ravel()[None, :])
 
     def match(self, left_gray: np.ndarray, right_gray: np.ndarray) -> tuple[np.ndarray, ...]:
         """Full-resolution (u, v, d) of every matched pixel [px], and whether it lies in a speckle: a small patch that
@@ -106,9 +109,9 @@ class _Matcher:
         r0, r1 = max(box[1] - self.v0, 0) // k, max(box[3] - self.v0, 0) // k + 1
         sub = self.disparity[r0:r1, c0:c1].astype(np.float32) * np.float32(k / 16.0)
         rows, cols = np.nonzero(np.abs(sub - np.float32(d0)) <= np.float32(tol_px))
-        du, dv = np.meshgrid(np.arange(k), np.arange(k))
-        u = ((cols + c0)[:, None] * k + du.ravel()[None, :]).ravel()
-        v = ((rows + r0)[:, None] * k + self.v0 + dv.ravel()[None, :]).ravel()
+        du, dv = self._block
+        u = ((cols + c0)[:, None] * k + du).ravel()
+        v = ((rows + r0)[:, None] * k + self.v0 + dv).ravel()
         return u, v
 
 
