@@ -103,10 +103,11 @@ class NeighbourSlot:
         rear = self.rear is not None and frame.has_rear
         return Neighbours(tuple(tracks), self.cfg.ahead_m, self.cfg.behind_m, rear), NeighbourDebug(detections, points)
 
-    def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_vl: float, ground_mps: float
-                ) -> tuple[bool, float | None]:
+    def _intent(self, t: Track, lat: float, vl: float, lane: int, width: float, sig_l: float, sig_vl: float,
+                ground_mps: float) -> tuple[bool, float | None]:
         """(cutting in, predicted time to the ego lane's boundary [s]) of a track in a lane beside, or in the ego lane
-        after a warning; ``ground_mps``: its along-lane speed over the ground [m/s]. It starts when the track, going
+        after a warning; ``sig_l``, ``sig_vl``: the 1-sigmas of its lateral place [m] and speed [m/s]; ``ground_mps``:
+        its along-lane speed over the ground [m/s]. It starts when the track, going
         at least ``min_ground_speed_mps``, measured this frame (a face cut off by the image's edge counts: a car
         pulling out close by always is) and on ``min_seen_share`` of the recent ones, moves towards the ego lane
         faster than both ``min_lateral_speed_mps`` and ``speed_sigmas`` of that speed's estimate (or than the former
@@ -119,17 +120,16 @@ class NeighbourSlot:
         if lane == 0:  # flagged on its way in: it stays a target while it is tracked in the ego lane
             return True, 0.0
         # towards the ego lane: -sign(l) l' > 0; shift from its lane's centre towards it: -sign(l) (l - lane w)
-        toward = -math.copysign(1.0, lat) * vl
-        shift = -math.copysign(1.0, lat) * (lat - lane * width)
+        inward = -math.copysign(1.0, lat)
+        toward, shift = inward * vl, inward * (lat - lane * width)
         if t.warning:
             holds = shift >= c.min_shift_m and toward > -c.min_lateral_speed_mps
         else:
             settled = t.settled >= self.tracker.cfg.min_settled
             # a manoeuvre towards the ego lane (a run of innovations that way: -sign(l) veer > 0) already tells a
             # move from noise, and its larger process noise widens sig_vl just as the car starts over; it counts once
-            # the car is off its lane's centre beyond its place's noise: shift > k sqrt(P_ll)
-            veering = (self.tracker.manoeuvring(t) and -math.copysign(1.0, lat) * t.veer > 0
-                       and shift > c.veer_shift_sigmas * math.sqrt(max(float(t.kf.P[2, 2]), 0.0)))
+            # the car is off its lane's centre beyond its place's noise: shift > k sigma_l
+            veering = self.tracker.manoeuvring(t) and inward * t.veer > 0 and shift > c.veer_shift_sigmas * sig_l
             holds = (t.camera is not None and t.seen >= c.min_seen_share * self.tracker.recent_frames
                      and ground_mps >= c.min_ground_speed_mps
                      and shift >= (c.min_shift_m if settled else c.through_shift_m)
@@ -153,9 +153,8 @@ class NeighbourSlot:
             return None
         P = t.kf.P
         warn = (lane != 0 or t.warning) and zone is not Zone.BEHIND and x <= self.cfg.warn_ahead_m
-        sig_vl = math.sqrt(max(P[3, 3], 0.0))
-        cut_in, ttc = self._intent(t, lat, vl, lane, width, sig_vl, ground_mps) if warn else (False, None)
+        sig_l, sig_vl = math.sqrt(max(P[2, 2], 0.0)), math.sqrt(max(P[3, 3], 0.0))
+        cut_in, ttc = self._intent(t, lat, vl, lane, width, sig_l, sig_vl, ground_mps) if warn else (False, None)
         t.warning = cut_in
         return Neighbour(t.track_id, lane, zone, x, gap, vx, lat - lane * width, vl, VEHICLE_LENGTH_M,
-                         self.tracker.sigma_x(t), math.sqrt(max(P[1, 1], 0.0)), math.sqrt(max(P[2, 2], 0.0)),
-                         t.camera, t.box_px, cut_in, ttc)
+                         self.tracker.sigma_x(t), math.sqrt(max(P[1, 1], 0.0)), sig_l, t.camera, t.box_px, cut_in, ttc)

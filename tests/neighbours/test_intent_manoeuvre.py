@@ -68,7 +68,7 @@ def _far_veer(sigma_lat_m: float) -> bool:
     t.kf.x[2, 0], t.kf.x[3, 0], t.kf.P[2, 2] = W - 0.40, -0.66, sigma_lat_m**2
     t.veer = -slot.tracker.cfg.manoeuvre_frames - 1
     assert slot.tracker.manoeuvring(t)
-    cut_in, _ = slot._intent(t, t.lat, -0.66, 1, W, 0.40, 25.0)
+    cut_in, _ = slot._intent(t, t.lat, -0.66, 1, W, sigma_lat_m, 0.40, 25.0)
     return cut_in
 
 
