@@ -75,9 +75,10 @@ class PerceptEnv(AbstractEnv):
         self.road = scenario.build(self, rng)
         # AbstractEnv.reset sets the road's neighbour search from the config after this: keep the scenario's own
         self.config["neighbour_vehicles_connected_lanes"] = self.road.neighbour_vehicles_connected_lanes
-        if not self.config["autopilot"]:
+        if not self.config["autopilot"] or self.config["autopilot_lane_changes"]:
             # MOBIL weighs the braking a lane change imposes on the new follower at the follower's target speed: the
-            # ego's is its set speed (highway-env's kinematic Vehicle has none, and IDM would read none as 0 m/s)
+            # ego's is its set speed (highway-env's kinematic Vehicle has none, and IDM would read none as 0 m/s);
+            # highway-env's MOBIL car in the ego's place, the anchor for progress, wants that speed too
             self.vehicle.target_speed = self.cruise_speed_mps
         self.pedestrians = [o for o in self.road.objects if isinstance(o, Pedestrian)]
         self.scripted = [v for v in self.road.vehicles if isinstance(v, ScriptedVehicle)]

@@ -20,8 +20,9 @@ TRAFFIC = ["dense", "overtake", "merge"]
 BLIND_BAND_M = (-7.7, 6.0)  # centre of a car in the next lane, relative to the ego's: seen by neither rig [m]
 
 
-def _env(name: str, seed: int, autopilot: bool = True) -> PerceptEnv:
-    e = PerceptEnv(config={"scenario": SCENARIOS[name], "scenario_seed": seed, "autopilot": autopilot})
+def _env(name: str, seed: int, autopilot: bool = True, mobil: bool = False) -> PerceptEnv:
+    e = PerceptEnv(config={"scenario": SCENARIOS[name], "scenario_seed": seed, "autopilot": autopilot,
+                           "autopilot_lane_changes": mobil})
     e.reset(seed=seed)
     return e
 
@@ -66,6 +67,14 @@ def test_the_driven_ego_has_its_set_speed_as_target_speed_for_mobil():
     for name in TRAFFIC + ["highway"]:
         e = _env(name, 1, autopilot=False)
         assert e.vehicle.target_speed == e.cruise_speed_mps
+
+
+def test_highway_envs_mobil_car_in_the_egos_place_wants_the_set_speed():
+    # the anchor for progress wants what the percept car wants (dense: 30 m/s, above its 25 m/s start)
+    for name in TRAFFIC:
+        e = _env(name, 1, mobil=True)
+        assert e.vehicle.enable_lane_change and e.vehicle.target_speed == e.cruise_speed_mps
+    assert _env("dense", 1, mobil=True).vehicle.target_speed == 30.0
 
 
 def test_dense_is_highway_v0_like():
