@@ -11,9 +11,12 @@ exception propagates; whatever the target held before is left untouched.
 - ``atomic_path``: a context manager yielding a temporary path (same suffix as the target, so libraries that pick
   a format by extension work) for writers that need a file name (``cv2.VideoWriter``); renamed into place only
   when the block completes without an exception.
-- ``folder_lock``: a context manager that makes one process the only writer of a folder for as long as it runs.
 
-A leaf module: it imports nothing from percept, so every package may use it.
+A target that is a symbolic link is written through it (the link stays, its file is replaced); one that is no
+regular file (a FIFO, a device such as /dev/null) is written to directly, as no rename can replace it.
+
+A leaf module: it imports nothing from percept, so every package may use it. ``percept.folder_lock`` makes one
+process the only writer of a folder.
 """
 
 from __future__ import annotations
@@ -21,12 +24,10 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import socket
-import sys
+import stat
 import tempfile
-import time
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping
+from typing import Any, Iterator, Mapping
 
 from .held_signals import stop_signals_held
 
@@ -50,6 +51,22 @@ def _temporary(path: Path) -> tuple[int, Path]:
     except (AttributeError, OSError):  # pragma: no cover - Windows, or a file system without modes
         pass
     return fd, Path(name)
+
+
+def destination(path: Path | str) -> Path:
+    """Where a write to ``path`` lands: the file a symbolic link points to (so that the link stays a link), else
+    ``path``."""
+    path = Path(path)
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def _special(path: Path) -> bool:
+    """Whether ``path`` exists and is neither a regular file nor a folder (a FIFO, a device, a socket)."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    return not stat.S_ISREG(mode) and not stat.S_ISDIR(mode)
 
 
 def _write_all(fd: int, data: bytes | bytearray | memoryview) -> None:
@@ -119,9 +136,13 @@ def write_files_atomic(files: Mapping[Path | str, bytes]) -> None:
 def _write_files(files: Mapping[Path | str, bytes]) -> None:
     staged: list[tuple[Path, Path]] = []
     renamed: list[Path] = []
+    targets = {destination(path): data for path, data in files.items()}
+    for path in [p for p in targets if _special(p)]:  # nothing to stage: written through
+        with open(path, "wb") as f:
+            f.write(targets.pop(path))
     try:
-        for path, data in files.items():
-            staged.append((_stage(Path(path), data), Path(path)))
+        for path, data in targets.items():
+            staged.append((_stage(path, data), path))
         for tmp, path in staged:
             os.replace(tmp, path)
             renamed.append(path)
@@ -145,7 +166,10 @@ def atomic_path(path: Path | str) -> Iterator[Path]:
     The writer must have closed the file (e.g. ``VideoWriter.release()``) by the end of the block. A writer that
     reports failure by a return value must raise inside the block, or nothing tells this manager to discard.
     """
-    path = Path(path)
+    path = destination(path)
+    if _special(path):  # no temporary can be renamed over it: the writer writes to it
+        yield path
+        return
     tmp = None
     try:
         fd, tmp = _temporary(path)
@@ -183,100 +207,3 @@ def npy_bytes(array) -> bytes:
     buf = io.BytesIO()
     np.save(buf, array)
     return buf.getvalue()
-
-
-LOCK_NAME = ".percept-lock"  # the owner file of a folder that a command is writing (``folder_lock``)
-
-
-class FolderBusy(ValueError):
-    """Another live process is writing the folder; the message names it."""
-
-
-@contextlib.contextmanager
-def folder_lock(folder: Path | str, command: str, warn: Callable[[str], None] = lambda line: None) -> Iterator[Path]:
-    """Be the only writer of ``folder`` (created if missing) for the block: ``folder/.percept-lock`` holds the pid,
-    host, start time and ``command`` and is file-locked meanwhile. FolderBusy when a live process (or one on another
-    host) owns it; one left by a process that no longer runs here is taken over, said through ``warn``. The owner
-    file is removed however the block ends."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    lock = folder / LOCK_NAME
-    me = json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "command": command, "argv": sys.argv,
-                     "started": time.strftime("%Y-%m-%d %H:%M:%S")}).encode()
-    with stop_signals_held():
-        fd = _take_lock(lock, me, warn)
-    try:
-        yield lock
-    finally:
-        with stop_signals_held():
-            if _same_file(fd, lock):
-                lock.unlink(missing_ok=True)
-            os.close(fd)
-
-
-def _take_lock(lock: Path, me: bytes, warn: Callable[[str], None]) -> int:
-    """The open, file-locked owner file ``lock`` holding ``me``: made (linked into place once written) or taken over."""
-    import fcntl
-
-    for _ in range(50):  # another process may take or drop the lock between the steps below
-        fd, tmp = _temporary(lock)
-        try:
-            _write_all(fd, me)
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            os.link(tmp, lock)
-            return fd
-        except BaseException as e:
-            os.close(fd)
-            if not isinstance(e, FileExistsError):
-                raise
-        finally:
-            tmp.unlink(missing_ok=True)
-        if (owner := _read_owner(lock)) is None:
-            continue
-        who = (f"{owner.get('command', '?')} (pid {owner.get('pid', '?')}, started {owner.get('started', '?')} on "
-               f"{owner.get('host', '?')})")
-        if owner.get("host") != socket.gethostname() or _running(owner.get("pid")):
-            raise FolderBusy(f"{lock.parent} is being written by {who}; wait for it or choose another --out")
-        with contextlib.suppress(FileNotFoundError):
-            fd = os.open(lock, os.O_RDWR)
-            try:
-                # a live owner holds the file lock: getting it, on the same file and owner, proves the owner gone
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                if _same_file(fd, lock) and _read_owner(lock) == owner:
-                    os.ftruncate(fd, 0)
-                    os.pwrite(fd, me, 0)
-                    warn(f"{lock} was left by {who}, which no longer runs; taking the folder over")
-                    return fd
-            except BlockingIOError:
-                pass
-            os.close(fd)
-    raise FolderBusy(f"{lock.parent} is being locked and unlocked by other processes; choose another --out")
-
-
-def _read_owner(lock: Path) -> dict | None:
-    """The owner record in ``lock``; None when it is gone. Any other content counts as a stopped process's."""
-    try:
-        owner = json.loads(lock.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        return None
-    except (OSError, ValueError):
-        owner = None
-    return owner if isinstance(owner, dict) else {"pid": "?", "host": socket.gethostname(), "command": "unknown"}
-
-
-def _running(pid) -> bool:
-    """Whether process ``pid`` runs on this host (another user's process counts)."""
-    try:
-        os.kill(pid, 0)
-    except (ProcessLookupError, OverflowError, TypeError):
-        return False
-    except PermissionError:
-        pass
-    return isinstance(pid, int) and pid > 0
-
-
-def _same_file(fd: int, path: Path) -> bool:
-    """Whether ``path`` is still the file open as ``fd``."""
-    with contextlib.suppress(OSError):
-        return os.path.samestat(os.stat(path), os.fstat(fd))
-    return False

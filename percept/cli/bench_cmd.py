@@ -45,6 +45,8 @@ def bench(
     opt.check_number("--seconds", seconds, 1, 600)
     opt.check_number("--repeats", repeats, 1, 20)
     opt.check_number("--soak-minutes", soak_minutes, 0, 600)
+    if scenario and not stack:
+        fail("--scenario chooses the scenarios of the whole stack: add --stack")
     scenarios = _scenarios(scenario) if stack else []
     check_outputs([json_path])
     tasks = [t for t in TASKS if t.vision is not None]

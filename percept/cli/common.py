@@ -82,7 +82,7 @@ def check_outputs(outputs: Iterable[Optional[Path]], inputs: Iterable[Optional[P
         if r in seen:
             fail(f"{seen[r]} is given for two outputs; give each its own path")
         if r in ins:
-            fail(f"output {p} is also an input; writing it would destroy the input")
+            fail(f"output {p} is also an input; writing it would destroy the input: give the output another path")
         seen[r] = Path(p)
         if r.is_dir():
             fail(f"output {p} is a folder; give a file path")
@@ -102,9 +102,9 @@ def check_outputs(outputs: Iterable[Optional[Path]], inputs: Iterable[Optional[P
 
 @contextlib.contextmanager
 def only_writer(folder: Path, command: str) -> Iterator[None]:
-    """Hold ``folder``'s lock (``percept.outputs.folder_lock``) for the block: a one-line exit 2 naming the process
+    """Hold ``folder``'s lock (``percept.folder_lock``) for the block: a one-line exit 2 naming the process
     that writes it already, a warning line when a lock left by a stopped process is taken over."""
-    from percept.outputs import FolderBusy, folder_lock
+    from percept.folder_lock import FolderBusy, folder_lock
 
     def warn(line: str) -> None:
         err.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True)

@@ -36,6 +36,7 @@ def drive(
     json_path: opt.JsonOut = None,
 ):
     """Drive a scenario in closed loop from the cameras, score it against ground truth and record it to Rerun."""
+    from percept.detection import LinearModel
     from percept.drive import DriveConfig, run_drive
     from percept.review import partial_path
     from percept.sims import WorldConfig
@@ -48,8 +49,12 @@ def drive(
                           lane_changes=opt.lane_changes_on(lane_changes))
     except ValueError as e:
         fail(str(e))
+    if no_record and record is not None:
+        fail("--record and --no-record contradict each other; give one")
+    if record is not None and record.suffix != ".rrd":
+        fail(f"--record {record}: a Rerun recording is a .rrd file; give a path ending in .rrd")
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
-    check_outputs([rec_path, rec_path and partial_path(rec_path), json_path])
+    check_outputs([rec_path, rec_path and partial_path(rec_path), json_path], [LinearModel.file_of(detector)])
     recording = Recording(rec_path, cfg, camera_hz, camera_quality, camera_scale)
     with progress_bar() as bar:
         task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)

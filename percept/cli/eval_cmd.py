@@ -61,9 +61,10 @@ def eval_(
     """
     plan, eng = _plan(scenario, condition, seeds, workers, engine, duration, detector,
                       opt.slot_sources(sources, privileged), rear, opt.lane_changes_on(lane_changes), ego)
+    _refuse_unused(ego, sources, detector, address, eng)
     with only_writer(out, "percept eval"):
         files = _scan(plan, out, redo)
-        check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path])
+        _check_outputs(plan, out, json_path)
         for path, why in files.damaged:
             err.print(f"[yellow]redoing[/] {escape(str(path))}: {why}", highlight=False, soft_wrap=True)
         summary = _run(plan, out, workers, eng, address, redo, files)
@@ -74,6 +75,45 @@ def eval_(
         _report_failures(summary, len(plan.jobs), out)
         if strict:
             _strict(summary)
+
+
+def _check_outputs(plan, out: Path, json_path: Path | None) -> None:
+    """``check_outputs`` of the batch's files, with the people model as an input; a one-line exit 2 for a --json
+    that is one of the files eval writes in ``out`` (its summaries, its lock, anything in runs/ or plots/)."""
+    from percept.detection import LinearModel
+    from percept.folder_lock import LOCK_NAME
+
+    if json_path is not None and out.resolve() in json_path.resolve().parents:
+        top = json_path.resolve().relative_to(out.resolve()).parts[0]
+        if top in ("runs", "plots", "summary.json", "summary.md", "summary.csv", LOCK_NAME):
+            fail(f"--json {json_path} is where eval writes its own results in --out {out}; give another path")
+    check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path],
+                  [LinearModel.file_of(plan.detector)])
+
+
+def _refuse_unused(ego: str, given: dict, detector: str, address: str | None, eng) -> None:
+    """A one-line exit 2 for options that would be ignored: slot options (``given``: task -> Source or None) or a
+    people model with highway-env's MOBIL car as the ego, an --address the engine does not use; or for a Ray cluster
+    that does not answer at --address (Ray itself would retry for minutes)."""
+    import socket
+
+    from percept.evaluate.plan import Engine
+
+    if ego == "mobil" and (any(src is not None for src in given.values()) or detector != "sim"):
+        fail("--ego mobil puts highway-env's own car in the ego's place, on ground truth: no slot runs, so leave out "
+             "the slot options and --detector")
+    if address is None or address == "auto":
+        return
+    if eng is not Engine.RAY:
+        fail("--address names a Ray cluster; give it with --engine ray")
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        fail(f"--address must be HOST:PORT (or ray://HOST:PORT, or auto), got '{address}'")
+    try:
+        socket.create_connection((host, int(port)), timeout=5).close()
+    except OSError as e:
+        fail(f"no Ray cluster answers at {address} ({e.strerror or e}); start one (`ray start --head`) or leave "
+             f"out --address for a local Ray")
 
 
 def _plan(scenario, condition, seeds, workers, engine, duration, detector, sources, rear=None, lane_changes=True,

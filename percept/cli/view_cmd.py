@@ -41,7 +41,14 @@ def rerun_executable() -> str | None:
 
 
 def rerun_env() -> dict:
-    return {**os.environ, "RERUN_ANALYTICS": os.environ.get("RERUN_ANALYTICS", "0")}
+    """The environment of a rerun child process: analytics off unless asked for, and the user's own log filter only
+    (not the one the recorder sets, which hides the web viewer's line saying where to open it)."""
+    from percept.review import QUIET_RUST_LOG
+
+    env = {**os.environ, "RERUN_ANALYTICS": os.environ.get("RERUN_ANALYTICS", "0")}
+    if env.get("RUST_LOG") == QUIET_RUST_LOG:
+        del env["RUST_LOG"]
+    return env
 
 
 def recording_problem(exe: str, recording: Path) -> str | None:
@@ -158,6 +165,10 @@ def register(app: typer.Typer) -> None:
         if code != 0 and not web and not has_display():
             fail(f"no display to open the viewer's window on (DISPLAY and WAYLAND_DISPLAY are not set); try "
                  f"`percept view --web {recording}` and open the address it prints")
+        if code != 0 and web:
+            fail(f"the Rerun web viewer stopped with exit code {code} (its reason is above); --bind {bind} must be an "
+                 f"address of this machine (127.0.0.1, or 0.0.0.0 for every interface) and its ports 9090 and 9876 "
+                 f"free")
         if code != 0:
             why = f" ({why if len(why) <= 120 else why[:119] + '…'})" if why else ""
             fail(f"the Rerun viewer stopped with exit code {code}{why}; without a display, try `percept view --web "

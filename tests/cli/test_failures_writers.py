@@ -17,7 +17,7 @@ import pytest
 from typer.testing import CliRunner
 
 from percept.cli import app
-from percept.outputs import LOCK_NAME, FolderBusy, folder_lock
+from percept.folder_lock import LOCK_NAME, FolderBusy, folder_lock
 
 runner = CliRunner()
 FAST_EVAL = ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "0.2", "--privileged"]

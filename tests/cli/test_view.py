@@ -58,6 +58,14 @@ def test_view_reports_a_viewer_that_fails(rrd, monkeypatch, one_line_error):
     one_line_error(runner.invoke(app, ["view", str(rrd)]), "try `percept view --web")
 
 
+def test_a_web_viewer_that_fails_points_at_the_bind_address_not_at_web(rrd, monkeypatch, one_line_error):
+    monkeypatch.setattr(view_cmd, "recording_problem", lambda exe, path: None)
+    monkeypatch.setattr(subprocess, "run", lambda cmd, env: subprocess.CompletedProcess(cmd, 1))
+    result = runner.invoke(app, ["view", str(rrd), "--web", "--bind", "8.8.8.8"])
+    one_line_error(result, "--bind 8.8.8.8 must be an address of this machine")
+    assert "try `percept view --web" not in result.output
+
+
 def test_view_bad_input(tmp_path, rrd, one_line_error):
     one_line_error(runner.invoke(app, ["view", str(tmp_path / "missing.rrd")]), "does not exist")
     (tmp_path / "notes.txt").write_text("x")
@@ -104,3 +112,35 @@ def test_the_viewer_is_started_as_itself_not_through_a_script():
     left the viewer and its servers running. The viewer binary is run directly."""
     with open(rerun_executable(), "rb") as f:
         assert f.read(2) != b"#!"
+
+
+def test_the_web_viewer_says_where_to_open_it(rrd):
+    """The recorder's quiet log filter is not handed to the viewer, whose web server names its address at INFO."""
+    import os
+    import signal
+    import sys
+    import threading
+    import time
+
+    script = "from percept.cli import app; app()"
+    p = subprocess.Popen([sys.executable, "-c", script, "view", "--web", str(rrd)], stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    seen: list[str] = []
+    threading.Thread(target=lambda: seen.extend(p.stdout), daemon=True).start()
+    try:
+        end = time.monotonic() + 60
+        while time.monotonic() < end and not any("web-viewer at http://127.0.0.1:" in ln for ln in seen):
+            time.sleep(0.2)
+        assert any("web-viewer at http://127.0.0.1:" in ln for ln in seen), "".join(seen)
+    finally:  # the viewer and its servers with it
+        os.killpg(p.pid, signal.SIGTERM)
+        p.wait(timeout=30)
+
+
+def test_a_log_filter_the_user_set_reaches_the_viewer(monkeypatch):
+    from percept.review import QUIET_RUST_LOG
+
+    monkeypatch.setenv("RUST_LOG", QUIET_RUST_LOG)
+    assert "RUST_LOG" not in view_cmd.rerun_env()
+    monkeypatch.setenv("RUST_LOG", "debug")
+    assert view_cmd.rerun_env()["RUST_LOG"] == "debug"

@@ -1,0 +1,47 @@
+"""`drive` and `eval` outputs that would destroy an input or the batch's own files, and record options that cannot
+both hold: refused in one line before any run."""
+
+import shutil
+
+import pytest
+from typer.testing import CliRunner
+
+from percept.cli import app
+from percept.detection.hog import SIM_MODEL_PATH
+
+runner = CliRunner()
+
+
+@pytest.fixture
+def model(tmp_path):
+    """A copy of the packaged people model."""
+    path = tmp_path / "people.npz"
+    shutil.copy(SIM_MODEL_PATH, path)
+    return path
+
+
+@pytest.mark.parametrize("command, output", [(["drive", "--no-record"], "--json"), (["drive"], "--record"),
+                                             (["eval", "--scenario", "highway", "--seeds", "0"], "--json")])
+def test_an_output_on_the_people_model_is_refused_and_the_model_kept(tmp_path, model, command, output,
+                                                                     one_line_error):
+    before = model.read_bytes()
+    args = [*command, "--duration", "1", "--detector", str(model), output, str(model)]
+    if command[0] == "eval":
+        args += ["--out", str(tmp_path / "e")]
+    result = runner.invoke(app, args)
+    one_line_error(result, ".npz" if output == "--record" else "is also an input")
+    assert model.read_bytes() == before
+
+
+@pytest.mark.parametrize("inside", ["summary.md", "runs/highway-clear-0.json", "plots/x.png"])
+def test_eval_json_inside_its_out_folder_is_refused(tmp_path, inside, one_line_error):
+    out = tmp_path / "e"
+    result = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--out", str(out),
+                                 "--json", str(out / inside)])
+    one_line_error(result, "is where eval writes its own results")
+    assert not (out / "runs" / "highway-clear-0.json").exists()
+
+
+def test_record_and_no_record_together_are_refused(tmp_path, one_line_error):
+    one_line_error(runner.invoke(app, ["drive", "--duration", "1", "--no-record", "--record", str(tmp_path / "r.rrd")]),
+                   "contradict")
