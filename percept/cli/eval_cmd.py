@@ -77,9 +77,14 @@ def eval_(
             _strict(summary)
 
 
+EVAL_SIGNS = {"summary.json": b'{\n  "settings"', "summary.md": b"# Evaluation: ", "summary.csv": b"scenario,condition,"}
+"""How each summary eval writes begins: a file of that name that begins otherwise is someone else's."""
+
+
 def _check_outputs(plan, out: Path, json_path: Path | None) -> None:
     """``check_outputs`` of the batch's files, with the people model as an input; a one-line exit 2 for a --json
-    that is one of the files eval writes in ``out`` (its summaries, its lock, anything in runs/ or plots/)."""
+    that is one of the files eval writes in ``out`` (its summaries, its lock, anything in runs/ or plots/), or for a
+    summary file there that eval did not write."""
     from percept.detection import LinearModel
     from percept.folder_lock import LOCK_NAME
 
@@ -87,6 +92,10 @@ def _check_outputs(plan, out: Path, json_path: Path | None) -> None:
         top = json_path.resolve().relative_to(out.resolve()).parts[0]
         if top in ("runs", "plots", "summary.json", "summary.md", "summary.csv", LOCK_NAME):
             fail(f"--json {json_path} is where eval writes its own results in --out {out}; give another path")
+    for name, own in EVAL_SIGNS.items():
+        path = out / name
+        if path.is_file() and not path.read_bytes().startswith(own):
+            fail(f"{path} was not written by percept eval and would be replaced; move it or choose another --out")
     check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path],
                   [LinearModel.file_of(plan.detector)])
 

@@ -45,3 +45,13 @@ def test_eval_json_inside_its_out_folder_is_refused(tmp_path, inside, one_line_e
 def test_record_and_no_record_together_are_refused(tmp_path, one_line_error):
     one_line_error(runner.invoke(app, ["drive", "--duration", "1", "--no-record", "--record", str(tmp_path / "r.rrd")]),
                    "contradict")
+
+
+@pytest.mark.parametrize("name", ["summary.md", "summary.json", "summary.csv"])
+def test_a_summary_eval_did_not_write_is_not_replaced(tmp_path, name, one_line_error):
+    out = tmp_path / "e"
+    out.mkdir()
+    (out / name).write_text("my own notes")
+    result = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--out", str(out)])
+    one_line_error(result, "was not written by percept eval")
+    assert (out / name).read_text() == "my own notes"
