@@ -103,15 +103,25 @@ class CameraCalibration:
 
     @classmethod
     def load(cls, path: Path) -> "CameraCalibration":
+        """The calibration ``percept calibrate`` wrote to ``path``; ValueError naming what is wrong otherwise."""
+        not_ours = f"{path} is not a percept calibration file ({{}}); make one with `percept calibrate DIR`"
         try:
-            return cls.from_dict(json.loads(Path(path).read_text()))
+            d = json.loads(Path(path).read_text())
         except FileNotFoundError:
             raise ValueError(f"calibration file {path} does not exist; make one with `percept calibrate DIR`") from None
+        except IsADirectoryError:
+            raise ValueError(f"{path} is a folder; give the calibration file `percept calibrate` wrote") from None
         except (OSError, UnicodeDecodeError) as e:
             raise ValueError(f"cannot read calibration file {path} ({e})") from None
+        except ValueError as e:
+            raise ValueError(not_ours.format(e)) from None
+        if isinstance(d, dict) and {"left", "right"} <= d.keys():
+            raise ValueError(f"{path} calibrates a stereo rig; give one camera's, made by `percept calibrate DIR` "
+                             "without --stereo")
+        try:
+            return cls.from_dict(d)
         except (KeyError, TypeError, ValueError, AttributeError) as e:
-            raise ValueError(f"{path} is not a percept calibration file ({e}); "
-                             "make one with `percept calibrate DIR`") from None
+            raise ValueError(not_ours.format(e)) from None
 
 
 def chessboard_images(folder: Path) -> list[Path]:

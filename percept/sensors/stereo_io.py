@@ -221,6 +221,9 @@ def read_disparity(path: Path | str) -> np.ndarray:
                                      "'disparity'")
                 d = z["disparity" if "disparity" in keys else keys[0]]
         elif suffix == ".npy":
+            with open(path, "rb") as f:  # anything else np.load would try to unpickle, and refuse in those words
+                if f.read(6) != b"\x93NUMPY":
+                    raise ValueError("not a NumPy .npy array (np.save writes one)")
             d = np.load(path, allow_pickle=False)
         elif suffix == ".pfm":
             try:

@@ -180,6 +180,9 @@ def test_missing_calibration_and_disparity_files(tmp_path):
     (tmp_path / "bad.npz").write_bytes(b"garbage")
     with pytest.raises(ValueError, match="cannot read disparity file"):
         read_disparity(tmp_path / "bad.npz")
+    (tmp_path / "text.npy").write_text("0 1\n2 3\n")
+    with pytest.raises(ValueError, match="not a NumPy .npy array"):
+        read_disparity(tmp_path / "text.npy")
     np.save(tmp_path / "d.npy", np.array([[0.0, np.inf], [4.0, 2.0]]))
     d = read_disparity(tmp_path / "d.npy")
     assert np.isnan(d[0]).all() and resize_disparity(d, 4, 4)[2:, :2].tolist() == [[8.0, 8.0], [8.0, 8.0]]

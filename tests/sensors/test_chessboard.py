@@ -82,6 +82,11 @@ def test_calibration_file_round_trip_and_bad_files(tmp_path):
     (tmp_path / "nan.json").write_text(json.dumps({**cal.to_dict(), "dist": [0.1, "nan", 0, 0, 0]}))
     with pytest.raises(ValueError, match="not a percept calibration file.*finite"):
         CameraCalibration.load(tmp_path / "nan.json")
+    with pytest.raises(ValueError, match="is a folder"):
+        CameraCalibration.load(tmp_path)
+    (tmp_path / "rig.json").write_text(json.dumps({"left": cal.to_dict(), "right": cal.to_dict(), "baseline_m": 0.5}))
+    with pytest.raises(ValueError, match="calibrates a stereo rig; give one camera's"):
+        CameraCalibration.load(tmp_path / "rig.json")
 
 
 def test_no_board_and_no_images(tmp_path):
