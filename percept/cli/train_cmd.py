@@ -11,6 +11,9 @@ import typer
 from . import options as opt
 from .common import check_outputs, console, fail, on_interrupt, progress_bar, write_error, write_json
 
+SECOND_THRESHOLD = -0.5
+"""The second stage's score a detection needs on one of its windows, unless --second-threshold says otherwise."""
+
 
 def train_detector(
     out: Annotated[Path, typer.Option("--out", dir_okay=False, help="Model file to write (.npz); its training "
@@ -31,9 +34,9 @@ def train_detector(
     first_stage: Annotated[str | None, typer.Option(
         "--first-stage", help="Write a two-stage cascade: this model (sim, inria or a .npz file; of a cascade, its "
         "first stage) finds the people and the model trained here confirms them. Default: none (one model).")] = None,
-    second_threshold: Annotated[float, typer.Option(
-        "--second-threshold", help="With --first-stage: the second stage's score a detection needs on one of its "
-        "windows, -5 to 5.")] = -0.5,
+    second_threshold: Annotated[float | None, typer.Option(
+        "--second-threshold", help=f"With --first-stage: the second stage's score a detection needs on one of its "
+        f"windows, -5 to 5 (default {SECOND_THRESHOLD:g}).", show_default=False)] = None,
 ):
     """Render pedestrians and backgrounds, cut 64x128 windows (as the constrained search sees them, 4-pixel cells),
     train a linear SVM with OpenCV's cv2.ml, mine hard negatives with it (on the same frames, and on those of the
@@ -50,13 +53,7 @@ def train_detector(
 
     opt.check_number("--every", every, 1, 100)
     opt.check_number("--c", c, 1e-5, 10.0)
-    opt.check_number("--second-threshold", second_threshold, -5.0, 5.0)
-    try:
-        first = None if first_stage is None else replace(LinearModel.named(first_stage), second=None)
-    except ValueError as e:
-        fail(f"--first-stage: {e}")
-    # the first stage's record is read with its model, not after the training
-    first_record = None if first_stage is None else _first_stage_record(first_stage)
+    first, second_threshold, first_record = _first_stage(first_stage, second_threshold)
     try:
         plan = _plan(seeds, every, duration, c, condition, negatives_from, negative_seeds)
     except ValueError as e:
@@ -72,6 +69,25 @@ def train_detector(
             fail(str(e))
     _save(model, record, plan, out, record_path, seeds, negative_seeds, first, first_stage, second_threshold,
           first_record)
+
+
+def _first_stage(name: str | None, threshold: float | None) -> tuple:
+    """The cascade's first stage as (its model without a second stage, the second stage's threshold, its training
+    record), or (None, SECOND_THRESHOLD, None) without one; a one-line exit 2 on a bad option."""
+    from percept.detection import LinearModel
+
+    if name is None:
+        if threshold is not None:
+            fail("--second-threshold is the second stage's: give it with --first-stage")
+        return None, SECOND_THRESHOLD, None
+    threshold = SECOND_THRESHOLD if threshold is None else threshold
+    opt.check_number("--second-threshold", threshold, -5.0, 5.0)
+    try:
+        first = replace(LinearModel.named(name), second=None)
+    except ValueError as e:
+        fail(f"--first-stage: {e}")
+    # the first stage's record is read with its model, not after the training
+    return first, threshold, _first_stage_record(name)
 
 
 def _plan(seeds: str, every: int, duration, c: float, condition, negatives_from, negative_seeds: str):

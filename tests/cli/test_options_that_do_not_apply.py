@@ -17,3 +17,9 @@ def test_the_mobil_ego_takes_no_slot_options(tmp_path, extra, one_line_error):
 
 def test_bench_scenarios_need_the_whole_stack(one_line_error):
     one_line_error(runner.invoke(app, ["bench", "--frames", "1", "--scenario", "dense"]), "add --stack")
+
+
+def test_a_second_stage_threshold_needs_a_first_stage(tmp_path, one_line_error):
+    one_line_error(runner.invoke(app, ["train-detector", "--second-threshold", "1", "--out", str(tmp_path / "m.npz")]),
+                   "give it with --first-stage")
+    assert not (tmp_path / "m.npz").exists()

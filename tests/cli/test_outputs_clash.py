@@ -55,3 +55,12 @@ def test_a_summary_eval_did_not_write_is_not_replaced(tmp_path, name, one_line_e
     result = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--out", str(out)])
     one_line_error(result, "was not written by percept eval")
     assert (out / name).read_text() == "my own notes"
+
+
+def test_a_file_where_eval_writes_its_plots_is_refused_before_any_run(tmp_path, one_line_error):
+    out = tmp_path / "e"
+    out.mkdir()
+    (out / "plots").write_text("mine")
+    result = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--out", str(out)])
+    one_line_error(result, "where eval writes its plots")
+    assert not (out / "summary.json").exists() and (out / "plots").read_text() == "mine"
