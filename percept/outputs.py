@@ -53,7 +53,7 @@ def _temporary(path: Path) -> tuple[int, Path]:
     return fd, Path(name)
 
 
-def destination(path: Path | str) -> Path:
+def _destination(path: Path | str) -> Path:
     """Where a write to ``path`` lands: the file a symbolic link points to (so that the link stays a link), else
     ``path``."""
     path = Path(path)
@@ -136,7 +136,7 @@ def write_files_atomic(files: Mapping[Path | str, bytes]) -> None:
 def _write_files(files: Mapping[Path | str, bytes]) -> None:
     staged: list[tuple[Path, Path]] = []
     renamed: list[Path] = []
-    targets = {destination(path): data for path, data in files.items()}
+    targets = {_destination(path): data for path, data in files.items()}
     for path in [p for p in targets if _special(p)]:  # nothing to stage: written through
         with open(path, "wb") as f:
             f.write(targets.pop(path))
@@ -166,7 +166,7 @@ def atomic_path(path: Path | str) -> Iterator[Path]:
     The writer must have closed the file (e.g. ``VideoWriter.release()``) by the end of the block. A writer that
     reports failure by a return value must raise inside the block, or nothing tells this manager to discard.
     """
-    path = destination(path)
+    path = _destination(path)
     if _special(path):  # no temporary can be renamed over it: the writer writes to it
         yield path
         return
