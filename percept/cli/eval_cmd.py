@@ -90,7 +90,7 @@ def _check_outputs(plan, out: Path, json_path: Path | None) -> None:
 
     if json_path is not None and out.resolve() in json_path.resolve().parents:
         top = json_path.resolve().relative_to(out.resolve()).parts[0]
-        if top in ("runs", "plots", "summary.json", "summary.md", "summary.csv", LOCK_NAME):
+        if top in ("runs", "plots", *EVAL_SIGNS, LOCK_NAME):
             fail(f"--json {json_path} is where eval writes its own results in --out {out}; give another path")
     if (out / "plots").exists() and not (out / "plots").is_dir():
         fail(f"{out / 'plots'} is a file, where eval writes its plots; move it or choose another --out")
