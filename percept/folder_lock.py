@@ -21,7 +21,8 @@ LOCK_NAME = ".percept-lock"  # the owner file of a folder that a command is writ
 
 
 class FolderBusy(ValueError):
-    """Another live process is writing the folder; the message names it."""
+    """The folder cannot be had: another live process is writing it (the message names it), or its lock path is
+    taken by something that is not a lock file."""
 
 
 @contextlib.contextmanager
@@ -33,6 +34,9 @@ def folder_lock(folder: Path | str, command: str, warn: Callable[[str], None] = 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     lock = folder / LOCK_NAME
+    if lock.exists() and not lock.is_file():
+        raise FolderBusy(f"{lock} is not a lock file percept wrote (a folder or a special file); move it away or "
+                         f"choose another --out")
     me = json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "command": command, "argv": sys.argv,
                      "started": time.strftime("%Y-%m-%d %H:%M:%S")}).encode()
     with stop_signals_held():

@@ -43,7 +43,7 @@ def register(app: typer.Typer) -> None:
         listed in the JSON with its error.
         """
         from percept.cli.common import check_outputs, fail
-        from percept.cli.footage_out import overlay_path
+        from percept.cli.footage_out import overlay_path, without_overlays
         from percept.cli.options import check_number
         from percept.detection import LinearModel
         from percept.sensors import FootageKind, list_footage
@@ -54,6 +54,7 @@ def register(app: typer.Typer) -> None:
         try:
             linear = LinearModel.named(model)
             kind, files = list_footage(source)
+            files = without_overlays(files, out, "detect")
         except ValueError as e:
             fail(str(e))
         video = kind is FootageKind.VIDEO

@@ -54,8 +54,8 @@ def drive(
     if record is not None and record.suffix != ".rrd":
         fail(f"--record {record}: a Rerun recording is a .rrd file; give a path ending in .rrd")
     rec_path = None if no_record else (record or Path("runs") / f"{scenario}-{cfg.world.condition.value}-{seed}.rrd")
+    recording = Recording(rec_path, cfg, camera_hz, camera_quality, camera_scale)  # checks its options
     check_outputs([rec_path, rec_path and partial_path(rec_path), json_path], [LinearModel.file_of(detector)])
-    recording = Recording(rec_path, cfg, camera_hz, camera_quality, camera_scale)
     with progress_bar() as bar:
         task = bar.add_task(f"driving {scenario}/{cfg.world.condition.value}/seed {seed}", total=None)
         try:

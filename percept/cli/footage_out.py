@@ -12,6 +12,17 @@ def overlay_path(out: Path, source: Path, tag: str, video: bool) -> Path:
     return out / f"{source.stem}.{tag}{'.mp4' if video else '.png'}"
 
 
+def without_overlays(files: list[Path], out: Path | None, tag: str) -> list[Path]:
+    """``files`` less the overlays this command writes (``OUT/NAME.TAG.png``): a second run with ``--out`` inside
+    the footage folder does not read its own overlays as footage. ValueError when nothing else is left."""
+    if out is None:
+        return files
+    keep = [p for p in files if not (p.parent.resolve() == out.resolve() and p.stem.endswith(f".{tag}"))]
+    if not keep:
+        raise ValueError(f"{out} holds only percept's own {tag} overlays; give the folder of the footage itself")
+    return keep
+
+
 def write_overlay(target: Path, image) -> None:
     """One overlay PNG, complete or absent (encoded in memory, then written atomically)."""
     from percept.outputs import png_bytes, write_bytes_atomic

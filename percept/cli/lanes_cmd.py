@@ -71,7 +71,7 @@ def _lanes(source: Path, json_path, out, calib, mount_height, lane_width: float,
            max_frames, fmt: LanesFormat) -> None:
     """``percept lanes`` once its options are parsed: check them, list the footage, fit and write."""
     from percept.cli.common import check_outputs, fail
-    from percept.cli.footage_out import overlay_path
+    from percept.cli.footage_out import overlay_path, without_overlays
     from percept.lanes.realworld import FootageLanes, RealLaneConfig
     from percept.sensors import CameraCalibration, FootageKind, list_footage
 
@@ -81,6 +81,7 @@ def _lanes(source: Path, json_path, out, calib, mount_height, lane_width: float,
                              speed_mps=speed)
         cal = CameraCalibration.load(calib) if calib is not None else None
         kind, files = list_footage(source)
+        files = without_overlays(files, out, "lanes")
     except ValueError as e:
         fail(str(e))
     video = kind is FootageKind.VIDEO

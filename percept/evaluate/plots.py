@@ -136,6 +136,9 @@ def write_plots(plan, results: list[dict], folder: Path, tasks) -> list[Path]:
     for name, img in images.items():
         write_bytes_atomic(folder / name, png_bytes(img))
         out.append(folder / name)
+    # plots/ is eval's own: a plot an earlier batch drew that this one does not would read as this batch's
+    for stale in set(folder.glob("*.png")) - set(out):
+        stale.unlink(missing_ok=True)
     return out
 
 

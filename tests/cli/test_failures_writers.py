@@ -179,3 +179,18 @@ def test_a_bad_detector_file_is_refused_in_one_line_before_anything_is_written(t
         r = runner.invoke(app, [*command, "--detector", name])
         one_line_error(r, f"--detector: model file {name} is not a percept HOG model {why}")
         assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.npz", "garbage.npz", "keyless.npz"]
+
+
+def test_a_lock_path_that_is_a_folder_is_named_in_one_line(tmp_path, one_line_error):
+    out = tmp_path / "ev"
+    (out / LOCK_NAME).mkdir(parents=True)
+    r = runner.invoke(app, [*FAST_EVAL, "--out", str(out)])
+    one_line_error(r, f"{out / LOCK_NAME} is not a lock file percept wrote")
+    assert (out / LOCK_NAME).is_dir() and sorted(p.name for p in out.iterdir()) == [LOCK_NAME]
+
+
+def test_a_drive_refused_for_a_bad_recording_option_makes_no_folder(tmp_path, monkeypatch, one_line_error):
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, ["drive", "--camera-hz", "0", "--duration", "0.2"])
+    one_line_error(r, "--camera-hz must be a finite number")
+    assert list(tmp_path.iterdir()) == []

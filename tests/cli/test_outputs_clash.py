@@ -1,7 +1,12 @@
 """`drive` and `eval` outputs that would destroy an input or the batch's own files, and record options that cannot
-both hold: refused in one line before any run."""
+both hold: refused in one line before any run; footage commands that do not read their own overlays."""
 
+import json
 import shutil
+from pathlib import Path
+
+import cv2
+import numpy as np
 
 import pytest
 from typer.testing import CliRunner
@@ -64,3 +69,22 @@ def test_a_file_where_eval_writes_its_plots_is_refused_before_any_run(tmp_path, 
     result = runner.invoke(app, ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "1", "--out", str(out)])
     one_line_error(result, "where eval writes its plots")
     assert not (out / "summary.json").exists() and (out / "plots").read_text() == "mine"
+
+
+@pytest.mark.parametrize("command", ["lanes", "detect"])
+def test_a_footage_folder_holding_its_own_overlays_is_read_without_them(tmp_path, command, one_line_error):
+    folder = tmp_path / "shots"
+    folder.mkdir()
+    rng = np.random.default_rng(0)
+    cv2.imwrite(str(folder / "a.png"), rng.integers(0, 255, (240, 320, 3), dtype=np.uint8))
+    for k in range(2):  # the second run finds the first one's overlay beside the image
+        js = tmp_path / f"run{k}.json"
+        r = runner.invoke(app, [command, str(folder), "--out", str(folder), "--json", str(js)])
+        assert r.exit_code == 0, r.output
+        assert [Path(x["file"]).name for x in json.loads(js.read_text())["results"]] == ["a.png"]
+    assert sorted(p.name for p in folder.iterdir()) == sorted(["a.png", f"a.{command}.png"])
+    one_line_error(runner.invoke(app, [command, str(tmp_path / "only"), "--out", str(tmp_path / "only")]), "")
+    (tmp_path / "only").mkdir()
+    shutil.copy(folder / f"a.{command}.png", tmp_path / "only")
+    one_line_error(runner.invoke(app, [command, str(tmp_path / "only"), "--out", str(tmp_path / "only")]),
+                   f"holds only percept's own {command} overlays")

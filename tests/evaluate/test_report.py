@@ -130,3 +130,14 @@ def test_the_eval_tables_fit_an_80_column_terminal():
     rows = [line for line in lines if line.split()[:2] == ["highway", "clear"]]
     assert len(rows) == 5 and "0.0123" in rows[1] and "0.800" in rows[3]
     assert all(line.rstrip()[-1].isdigit() or line.rstrip().endswith("n/a") for line in rows)
+
+
+def test_plots_an_earlier_batch_drew_and_this_one_does_not_are_removed(tmp_path):
+    stale = tmp_path / "plots" / "odometry.trajectory.loop-night-7.png"
+    stale.parent.mkdir()
+    stale.write_bytes(b"an earlier batch's plot")
+    notes = tmp_path / "plots" / "notes.txt"  # not a plot: left alone
+    notes.write_text("kept")
+    written = write_reports(PLAN, [run(k) for k in range(4)], SETTINGS, tmp_path, TASKS)
+    assert not stale.exists() and notes.read_text() == "kept"
+    assert sorted(tmp_path.glob("plots/*.png")) == sorted(p for p in written if p.suffix == ".png")
