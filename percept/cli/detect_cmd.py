@@ -43,7 +43,7 @@ def register(app: typer.Typer) -> None:
         listed in the JSON with its error.
         """
         from percept.cli.common import check_outputs, fail
-        from percept.cli.footage_out import overlay_path, without_overlays
+        from percept.cli.footage_out import footage_for, overlay_path
         from percept.cli.options import check_number
         from percept.detection import LinearModel
         from percept.sensors import FootageKind, list_footage
@@ -54,12 +54,10 @@ def register(app: typer.Typer) -> None:
         try:
             linear = LinearModel.named(model)
             kind, files = list_footage(source)
-            files = without_overlays(files, out, "detect")
+            files = footage_for(files, out, "detect")
         except ValueError as e:
             fail(str(e))
         video = kind is FootageKind.VIDEO
-        if out is not None and out.exists() and not out.is_dir():
-            fail(f"--out {out} is a file; give a folder for the overlays")
         check_outputs([json_path, *([] if out is None else [overlay_path(out, p, "detect", video) for p in files])],
                       [*files, LinearModel.file_of(model)])
         header = {"source": str(source), "kind": kind.value, "model": linear.name, "scale_step": scale_step,

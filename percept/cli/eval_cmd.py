@@ -77,26 +77,22 @@ def eval_(
             _strict(summary)
 
 
-EVAL_SIGNS = {"summary.json": b'{\n  "settings"', "summary.md": b"# Evaluation: ", "summary.csv": b"scenario,condition,"}
-"""How each summary eval writes begins: a file of that name that begins otherwise is someone else's."""
-
-
 def _check_outputs(plan, out: Path, json_path: Path | None) -> None:
     """``check_outputs`` of the batch's files, with the people model as an input; a one-line exit 2 for a --json
     that is one of the files eval writes in ``out`` (its summaries, its lock, anything in runs/ or plots/), or for a
     summary file there that eval did not write."""
     from percept.detection import LinearModel
+    from percept.evaluate import SUMMARY_STARTS, written_by_eval
     from percept.folder_lock import LOCK_NAME
 
     if json_path is not None and out.resolve() in json_path.resolve().parents:
         top = json_path.resolve().relative_to(out.resolve()).parts[0]
-        if top in ("runs", "plots", *EVAL_SIGNS, LOCK_NAME):
+        if top in ("runs", "plots", *SUMMARY_STARTS, LOCK_NAME):
             fail(f"--json {json_path} is where eval writes its own results in --out {out}; give another path")
     if (out / "plots").exists() and not (out / "plots").is_dir():
         fail(f"{out / 'plots'} is a file, where eval writes its plots; move it or choose another --out")
-    for name, own in EVAL_SIGNS.items():
-        path = out / name
-        if path.is_file() and not path.read_bytes().startswith(own):
+    for path in (out / name for name in SUMMARY_STARTS):
+        if path.is_file() and not written_by_eval(path):
             fail(f"{path} was not written by percept eval and would be replaced; move it or choose another --out")
     check_outputs([out / "summary.json", out / "runs" / f"{plan.jobs[0].name}.json", json_path],
                   [LinearModel.file_of(plan.detector)])

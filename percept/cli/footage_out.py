@@ -12,11 +12,14 @@ def overlay_path(out: Path, source: Path, tag: str, video: bool) -> Path:
     return out / f"{source.stem}.{tag}{'.mp4' if video else '.png'}"
 
 
-def without_overlays(files: list[Path], out: Path | None, tag: str) -> list[Path]:
-    """``files`` less the overlays this command writes (``OUT/NAME.TAG.png``): a second run with ``--out`` inside
-    the footage folder does not read its own overlays as footage. ValueError when nothing else is left."""
+def footage_for(files: list[Path], out: Path | None, tag: str) -> list[Path]:
+    """The footage a command with overlays in ``out`` (None: none) reads: ``files`` less the overlays it writes
+    (``OUT/NAME.TAG.png``), so that a second run with ``--out`` inside the footage folder does not read its own
+    overlays as footage. ValueError when ``out`` is a file or nothing else is left."""
     if out is None:
         return files
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is a file; give a folder for the overlays")
     keep = [p for p in files if not (p.parent.resolve() == out.resolve() and p.stem.endswith(f".{tag}"))]
     if not keep:
         raise ValueError(f"{out} holds only percept's own {tag} overlays; give the folder of the footage itself")

@@ -71,7 +71,7 @@ def _lanes(source: Path, json_path, out, calib, mount_height, lane_width: float,
            max_frames, fmt: LanesFormat) -> None:
     """``percept lanes`` once its options are parsed: check them, list the footage, fit and write."""
     from percept.cli.common import check_outputs, fail
-    from percept.cli.footage_out import overlay_path, without_overlays
+    from percept.cli.footage_out import footage_for, overlay_path
     from percept.lanes.realworld import FootageLanes, RealLaneConfig
     from percept.sensors import CameraCalibration, FootageKind, list_footage
 
@@ -81,15 +81,13 @@ def _lanes(source: Path, json_path, out, calib, mount_height, lane_width: float,
                              speed_mps=speed)
         cal = CameraCalibration.load(calib) if calib is not None else None
         kind, files = list_footage(source)
-        files = without_overlays(files, out, "lanes")
+        files = footage_for(files, out, "lanes")
     except ValueError as e:
         fail(str(e))
     video = kind is FootageKind.VIDEO
     if video and fmt is LanesFormat.TUSIMPLE:
         fail("--format tusimple is for images (TuSimple scores stills); extract the video's frames into a folder")
     overlays = [] if out is None else [overlay_path(out, p, "lanes", video) for p in files]
-    if out is not None and out.exists() and not out.is_dir():
-        fail(f"--out {out} is a file; give a folder for the overlays")
     check_outputs([json_path, *overlays], [*files, calib])
     runner = FootageLanes(cfg, cal)
     header = {"source": str(source), "kind": kind.value, "calibration": None if calib is None else str(calib),

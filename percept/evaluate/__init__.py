@@ -3,6 +3,7 @@ reports and plots a person reads."""
 
 from .batch import Engine, EvalPlan, Job, evaluate, parse_seeds, summarize
 from .environment import environments, numeric_environment
+from .report import SUMMARY_STARTS, written_by_eval
 
-__all__ = ["Engine", "EvalPlan", "Job", "environments", "evaluate", "numeric_environment", "parse_seeds",
-           "summarize"]
+__all__ = ["SUMMARY_STARTS", "Engine", "EvalPlan", "Job", "environments", "evaluate", "numeric_environment",
+           "parse_seeds", "summarize", "written_by_eval"]

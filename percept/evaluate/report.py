@@ -90,10 +90,25 @@ def listed_runs(results: list[dict], tasks) -> list[tuple[dict, str]]:
                                           for t in tasks for c in t.counts if c.listed})
 
 
+CSV_FIELDS = ("scenario", "condition", "metric", "runs", "mean", "p95", "worst", "total", "better")
+"""The columns of summary.csv."""
+MD_TITLE = "# Evaluation: "
+"""How summary.md begins (then the number of runs)."""
+SUMMARY_STARTS = {"summary.json": b'{\n  "settings"', "summary.md": MD_TITLE.encode(),
+                  "summary.csv": ",".join(CSV_FIELDS).encode()}
+"""How each summary eval writes begins (summary.json: ``batch.evaluate`` writes its settings first): a file of that
+name that begins otherwise is not eval's, and is not replaced."""
+
+
+def written_by_eval(path: Path) -> bool:
+    """Whether ``path`` (a summary.json, .md or .csv that exists) begins as eval writes it."""
+    return path.read_bytes().startswith(SUMMARY_STARTS[path.name])
+
+
 def summary_csv(rows: list[dict]) -> str:
     """The long table (``metric_rows``) as CSV, numbers to 6 significant digits."""
     buf = io.StringIO()
-    fields = ["scenario", "condition", "metric", "runs", "mean", "p95", "worst", "total", "better"]
+    fields = list(CSV_FIELDS)
     w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n")
     w.writeheader()
     for r in rows:
@@ -125,7 +140,7 @@ def summary_md(plan, results: list[dict], rows: list[dict], settings: dict, task
     rows = {(r["scenario"], r["condition"], r["metric"]): r for r in rows}
     ok, safety = [r for r in results if "error" not in r], safety_counts(tasks)
     slots = ", ".join(f"{k} {v}" for k, v in settings.get("slots", {}).items())
-    lines = [f"# Evaluation: {len(ok)} runs", "",
+    lines = [f"{MD_TITLE}{len(ok)} runs", "",
              f"Scenarios {', '.join(plan.scenarios)}; conditions {', '.join(plan.conditions)}; seeds "
              f"{_seed_text(plan.seeds)}; slots: {slots}; percept {settings.get('percept')}.", "",
              *_environment_lines(results),

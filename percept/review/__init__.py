@@ -17,4 +17,5 @@ from .context import Part, PartContext, Plot, RecordOptions
 from .recorder import RunRecorder, partial_path
 from .series import ColumnBuffer
 
-__all__ = ["QUIET_RUST_LOG", "ColumnBuffer", "Part", "PartContext", "Plot", "RecordOptions", "RunRecorder", "blueprint", "partial_path"]
+__all__ = ["QUIET_RUST_LOG", "ColumnBuffer", "Part", "PartContext", "Plot", "RecordOptions", "RunRecorder", "blueprint",
+           "partial_path"]

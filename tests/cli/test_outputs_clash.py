@@ -88,3 +88,14 @@ def test_a_footage_folder_holding_its_own_overlays_is_read_without_them(tmp_path
     shutil.copy(folder / f"a.{command}.png", tmp_path / "only")
     one_line_error(runner.invoke(app, [command, str(tmp_path / "only"), "--out", str(tmp_path / "only")]),
                    f"holds only percept's own {command} overlays")
+
+
+def test_the_summaries_eval_writes_are_known_as_its_own_and_replaced_next_time(tmp_path):
+    from percept.evaluate import SUMMARY_STARTS, written_by_eval
+
+    out = tmp_path / "e"
+    args = ["eval", "--scenario", "highway", "--seeds", "0", "--duration", "0.2", "--privileged", "--out", str(out)]
+    assert runner.invoke(app, args).exit_code == 0
+    assert all(written_by_eval(out / name) for name in SUMMARY_STARTS)
+    r = runner.invoke(app, [*args, "--redo"])
+    assert r.exit_code == 0, r.output
